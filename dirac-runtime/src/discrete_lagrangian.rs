@@ -1,0 +1,284 @@
+//! The discrete Lagrangian `L_d(Q_0, …, Q_s)` of a system under a quadrature, and its slot
+//! derivatives and second derivatives by hyper-dual numbers.
+//!
+//! With node positions `q_i = Σ_j ℓ_j(c_i) Q_j` and velocities `v_i = (1/h) Σ_j ℓ'_j(c_i) Q_j`,
+//! `L_d = h Σ_i b_i L(q_i, v_i)`. Its derivative in the point `Q_j` is
+//! `h Σ_i b_i [ℓ_j(c_i) ∂_q L + (ℓ'_j(c_i)/h) ∂_v L]`, and its second derivatives follow by the
+//! chain rule from the Hessian of `L` at the nodes. Every derivative of `L` comes from one
+//! evaluation of the user's Lagrangian over [`HyperDualSVec64`]: seeding the two dual directions
+//! along `(α_x, β_x)` and `(α_y, β_y)` in `(q, v)` yields both gradients along those directions and
+//! the mixed second derivative in one pass.
+
+use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
+use num_dual::{Derivative, HyperDualSVec64};
+
+use crate::quadrature::Quadrature;
+use crate::system::DiracSystem;
+
+/// A direction in `(q, v)`: moving the seeded variable by `δ` moves `q` by `position · δ` and `v`
+/// by `velocity · δ`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Seed {
+    pub position: f64,
+    pub velocity: f64,
+}
+
+impl Seed {
+    pub const POSITION: Seed = Seed { position: 1.0, velocity: 0.0 };
+    pub const VELOCITY: Seed = Seed { position: 0.0, velocity: 1.0 };
+    pub const NONE: Seed = Seed { position: 0.0, velocity: 0.0 };
+}
+
+/// `L` with its gradients along two seeded directions and the mixed second derivative.
+pub(crate) struct Seeded<const N: usize> {
+    pub value: f64,
+    /// `∂L/∂x` along the first seed.
+    pub first: SVector<f64, N>,
+    /// `∂L/∂y` along the second seed.
+    pub second: SVector<f64, N>,
+    /// `∂²L/∂x∂y` (rows: first seed, columns: second seed).
+    pub mixed: SMatrix<f64, N, N>,
+}
+
+/// Evaluates `L(q, v)` over hyper-dual numbers seeded along `x` and `y`.
+pub(crate) fn seeded<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+    x: Seed,
+    y: Seed,
+) -> Seeded<N> {
+    type H<const N: usize> = HyperDualSVec64<N, N>;
+    let lift = |value: &SVector<f64, N>, wx: f64, wy: f64| {
+        SVector::<H<N>, N>::from_fn(|c, _| {
+            let eps1 = if wx == 0.0 {
+                Derivative::none()
+            } else {
+                Derivative::some(SVector::<f64, N>::from_fn(|i, _| if i == c { wx } else { 0.0 }))
+            };
+            let eps2 = if wy == 0.0 {
+                Derivative::none()
+            } else {
+                Derivative::some(SMatrix::<f64, 1, N>::from_fn(|_, i| if i == c { wy } else { 0.0 }))
+            };
+            H::<N>::new(value[c], eps1, eps2, Derivative::none())
+        })
+    };
+    let l = system.lagrangian(&lift(q, x.position, y.position), &lift(v, x.velocity, y.velocity));
+    Seeded {
+        value: l.re,
+        first: l.eps1.unwrap_generic(Const::<N>, U1),
+        second: l.eps2.unwrap_generic(U1, Const::<N>).transpose(),
+        mixed: l.eps1eps2.unwrap_generic(Const::<N>, Const::<N>),
+    }
+}
+
+/// The discrete Lagrangian of `system` under `quadrature` with step `h`.
+///
+/// ```
+/// use dirac_runtime::{DiracSystem, DiscreteLagrangian, Quadrature, Scalar};
+/// use nalgebra::{SVector, vector};
+/// struct Free;
+/// impl DiracSystem<1> for Free {
+///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+///         v[0] * v[0] * 0.5
+///     }
+/// }
+/// // A free particle: L_d = (q1 − q0)² / (2h) for every quadrature.
+/// let ld = DiscreteLagrangian::new(Free, Quadrature::trapezoid(), 0.5);
+/// assert!((ld.value(&[vector![1.0], vector![2.0]]) - 1.0).abs() < 1e-15);
+/// ```
+#[derive(Debug, Clone)]
+pub struct DiscreteLagrangian<S, const N: usize> {
+    system: S,
+    quadrature: Quadrature,
+    h: f64,
+}
+
+impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
+    /// `L_d` for step `h`.
+    pub fn new(system: S, quadrature: Quadrature, h: f64) -> Self {
+        Self { system, quadrature, h }
+    }
+
+    /// The continuous system.
+    pub fn system(&self) -> &S {
+        &self.system
+    }
+
+    /// The quadrature.
+    pub fn quadrature(&self) -> &Quadrature {
+        &self.quadrature
+    }
+
+    /// The step size.
+    pub fn h(&self) -> f64 {
+        self.h
+    }
+
+    /// Position and velocity at node `i` of the path through `points`.
+    fn node(&self, i: usize, points: &[SVector<f64, N>]) -> (SVector<f64, N>, SVector<f64, N>) {
+        let mut q = SVector::zeros();
+        let mut v = SVector::zeros();
+        for (j, point) in points.iter().enumerate() {
+            q += point * self.quadrature.basis(i, j);
+            v += point * (self.quadrature.basis_derivative(i, j) / self.h);
+        }
+        (q, v)
+    }
+
+    /// `L_d(Q_0, …, Q_s)`; `points` holds the `s + 1` points of the step.
+    ///
+    /// # Panics
+    /// If `points.len()` is not the quadrature's degree plus one.
+    pub fn value(&self, points: &[SVector<f64, N>]) -> f64 {
+        assert_eq!(points.len(), self.quadrature.degree() + 1, "L_d takes degree + 1 points");
+        (0..self.quadrature.nodes().len())
+            .map(|i| {
+                let (q, v) = self.node(i, points);
+                self.h * self.quadrature.weights()[i] * self.system.lagrangian(&q, &v)
+            })
+            .sum()
+    }
+
+    /// The discrete Euler–Lagrange system of one step and the new momentum.
+    ///
+    /// Unknowns are `Q_1, …, Q_s` (`Q_s = q_{k+1}`), blocks of `N`. Writes the residual
+    /// `[p_k + ∂L_d/∂Q_0; ∂L_d/∂Q_1; …; ∂L_d/∂Q_{s−1}]` and adds its Jacobian into `jacobian`
+    /// (which the caller zeroes); returns `∂L_d/∂Q_s`, which is `p_{k+1}` at the solution.
+    pub(crate) fn euler_lagrange(
+        &self,
+        points: &[SVector<f64, N>],
+        momentum: &SVector<f64, N>,
+        residual: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> SVector<f64, N> {
+        let s = self.quadrature.degree();
+        let h = self.h;
+        residual.fill(0.0);
+        residual.rows_mut(0, N).copy_from(momentum);
+        let mut end = SVector::zeros();
+        let quad = &self.quadrature;
+        for (i, &b) in quad.weights().iter().enumerate() {
+            let w = h * b;
+            let (q, v) = self.node(i, points);
+            let a = |j: usize| quad.basis(i, j);
+            let d = |j: usize| quad.basis_derivative(i, j) / h;
+            if s == 1 {
+                // One pair of slots: seed the directions of Q_0 and Q_1 themselves.
+                let l = seeded(
+                    &self.system,
+                    &q,
+                    &v,
+                    Seed { position: a(0), velocity: d(0) },
+                    Seed { position: a(1), velocity: d(1) },
+                );
+                let mut r = residual.rows_mut(0, N);
+                r += l.first * w;
+                end += l.second * w;
+                let mut block = jacobian.fixed_view_mut::<N, N>(0, 0);
+                block += l.mixed * w;
+            } else {
+                // Many pairs: the Hessian of L at the node, then the chain rule.
+                let qv = seeded(&self.system, &q, &v, Seed::POSITION, Seed::VELOCITY);
+                let qq = seeded(&self.system, &q, &v, Seed::POSITION, Seed::POSITION).mixed;
+                let vv = seeded(&self.system, &q, &v, Seed::VELOCITY, Seed::VELOCITY).mixed;
+                let (lq, lv, qv) = (qv.first, qv.second, qv.mixed);
+                for j in 0..=s {
+                    let g = (lq * a(j) + lv * d(j)) * w;
+                    if j < s {
+                        let mut r = residual.rows_mut(j * N, N);
+                        r += g;
+                    } else {
+                        end += g;
+                    }
+                }
+                for j in 0..s {
+                    for k in 1..=s {
+                        let mut block = jacobian.fixed_view_mut::<N, N>(j * N, (k - 1) * N);
+                        block += (qq * (a(j) * a(k))
+                            + qv * (a(j) * d(k))
+                            + qv.transpose() * (d(j) * a(k))
+                            + vv * (d(j) * d(k)))
+                            * w;
+                    }
+                }
+            }
+        }
+        end
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scalar::Scalar;
+    use nalgebra::vector;
+
+    /// A pendulum-like coupled Lagrangian with nonzero q–v cross terms.
+    struct Coupled;
+    impl DiracSystem<2> for Coupled {
+        fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+            v[0] * v[0] * 0.5 + v[1] * v[1] * (q[0].cos() + 2.0) * 0.5 + v[0] * v[1] * q[1] * 0.3
+                - q[0].powi(2) * q[1].sin()
+        }
+    }
+
+    /// Central finite difference of `f` in the `c`-th component of point `j`.
+    fn fd(
+        ld: &DiscreteLagrangian<Coupled, 2>,
+        points: &[SVector<f64, 2>],
+        j: usize,
+        c: usize,
+    ) -> f64 {
+        let eps = 1e-6;
+        let mut plus = points.to_vec();
+        let mut minus = points.to_vec();
+        plus[j][c] += eps;
+        minus[j][c] -= eps;
+        (ld.value(&plus) - ld.value(&minus)) / (2.0 * eps)
+    }
+
+    fn check(quadrature: Quadrature) {
+        let s = quadrature.degree();
+        let ld = DiscreteLagrangian::new(Coupled, quadrature, 0.1);
+        let points: Vec<_> =
+            (0..=s).map(|j| vector![0.3 + 0.05 * j as f64, -0.2 + 0.03 * (j * j) as f64]).collect();
+        let p = vector![0.7, -0.4];
+        let mut r = DVector::zeros(2 * s);
+        let mut jac = DMatrix::zeros(2 * s, 2 * s);
+        let end = ld.euler_lagrange(&points, &p, &mut r, &mut jac);
+        for c in 0..2 {
+            assert!((r[c] - p[c] - fd(&ld, &points, 0, c)).abs() < 1e-8);
+            for j in 1..s {
+                assert!((r[j * 2 + c] - fd(&ld, &points, j, c)).abs() < 1e-8);
+            }
+            assert!((end[c] - fd(&ld, &points, s, c)).abs() < 1e-8);
+        }
+        // Jacobian columns against differences of the residual.
+        let eps = 1e-6;
+        for k in 1..=s {
+            for c in 0..2 {
+                let mut plus = points.clone();
+                let mut minus = points.clone();
+                plus[k][c] += eps;
+                minus[k][c] -= eps;
+                let (mut rp, mut rm) = (DVector::zeros(2 * s), DVector::zeros(2 * s));
+                let mut scratch = DMatrix::zeros(2 * s, 2 * s);
+                ld.euler_lagrange(&plus, &p, &mut rp, &mut scratch);
+                ld.euler_lagrange(&minus, &p, &mut rm, &mut scratch);
+                let column = (rp - rm) / (2.0 * eps);
+                let exact = jac.column((k - 1) * 2 + c);
+                assert!((column - exact).amax() < 1e-6, "column {k},{c}");
+            }
+        }
+    }
+
+    #[test]
+    fn slot_derivatives_match_finite_differences() {
+        check(Quadrature::midpoint());
+        check(Quadrature::trapezoid());
+        check(Quadrature::gauss(2).unwrap());
+        check(Quadrature::gauss(3).unwrap());
+    }
+}

@@ -1,0 +1,62 @@
+//! Errors are values: every failure of the runtime is a [`DiracError`], and a failed step leaves the
+//! stepper's state as it was.
+
+use thiserror::Error;
+
+/// What went wrong, with enough context to act on it.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum DiracError {
+    /// The step size is zero, negative or not finite.
+    #[error("the step size must be positive and finite, got h = {h}")]
+    InvalidStep {
+        /// The rejected step size.
+        h: f64,
+    },
+    /// A parameter, an initial value or a computed value is NaN or infinite.
+    #[error("{what} is not finite ({value}); nothing was changed")]
+    NonFinite {
+        /// Which quantity, e.g. `parameter m` or `initial momentum of theta`.
+        what: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// The quadrature's description is inconsistent.
+    #[error("invalid quadrature: {0}")]
+    InvalidQuadrature(String),
+    /// [`Stepper::step`](crate::Stepper::step) was called before the initial state was set.
+    #[error("the stepper has no initial state: call start_from_velocity or start_from_momentum first")]
+    NotStarted,
+    /// Newton's method did not reach the tolerance within its iteration cap.
+    #[error(
+        "{problem} did not converge at step {step}: residual {residual:.3e} after {iterations} \
+         iterations (tolerance {tolerance:.1e}); try a smaller step or a larger iteration cap"
+    )]
+    NoConvergence {
+        /// What was being solved, e.g. `the discrete Euler–Lagrange equations`.
+        problem: &'static str,
+        /// Index of the step that failed (the number of steps taken before it).
+        step: u64,
+        /// Infinity norm of the last residual.
+        residual: f64,
+        /// Newton iterations performed.
+        iterations: usize,
+        /// The residual tolerance that was not met.
+        tolerance: f64,
+    },
+    /// The Newton matrix is singular: the discrete equations do not determine the unknowns.
+    #[error(
+        "{problem} has a singular Jacobian at step {step}: the unknowns for {unknowns} are not \
+         determined (is the Lagrangian degenerate in these velocities?)"
+    )]
+    SingularJacobian {
+        /// What was being solved.
+        problem: &'static str,
+        /// Index of the step that failed.
+        step: u64,
+        /// The unknowns the elimination could not pivot on, by coordinate name.
+        unknowns: String,
+    },
+    /// Writing a trajectory failed.
+    #[error("could not write the trajectory: {0}")]
+    Io(String),
+}

@@ -1,0 +1,94 @@
+//! LU factorisation with partial pivoting, in place, without allocation: the linear solve inside
+//! every Newton iteration.
+
+use nalgebra::{DMatrix, DVector};
+
+/// Why a factorisation failed: the column whose pivot vanished.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SingularPivot {
+    /// Column (unknown) that could not be eliminated.
+    pub column: usize,
+}
+
+/// Factorises `a` in place (`P a = L U`, unit lower `L` below the diagonal) and records the row
+/// permutation in `pivots`. A pivot at or below `tolerance · max|a|` counts as zero.
+pub(crate) fn factorise(
+    a: &mut DMatrix<f64>,
+    pivots: &mut [usize],
+    tolerance: f64,
+) -> Result<(), SingularPivot> {
+    let n = a.nrows();
+    let scale = a.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let threshold = tolerance * scale;
+    for k in 0..n {
+        let (mut p, mut best) = (k, a[(k, k)].abs());
+        for i in k + 1..n {
+            if a[(i, k)].abs() > best {
+                (p, best) = (i, a[(i, k)].abs());
+            }
+        }
+        pivots[k] = p;
+        if best <= threshold || !best.is_finite() {
+            return Err(SingularPivot { column: k });
+        }
+        if p != k {
+            a.swap_rows(k, p);
+        }
+        let pivot = a[(k, k)];
+        for i in k + 1..n {
+            let factor = a[(i, k)] / pivot;
+            a[(i, k)] = factor;
+            for j in k + 1..n {
+                a[(i, j)] -= factor * a[(k, j)];
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Solves `A x = b` in place of `b` with the factors from [`factorise`].
+pub(crate) fn solve(lu: &DMatrix<f64>, pivots: &[usize], b: &mut DVector<f64>) {
+    let n = lu.nrows();
+    for k in 0..n {
+        b.swap_rows(k, pivots[k]);
+    }
+    for i in 0..n {
+        let mut s = b[i];
+        for j in 0..i {
+            s -= lu[(i, j)] * b[j];
+        }
+        b[i] = s;
+    }
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for j in i + 1..n {
+            s -= lu[(i, j)] * b[j];
+        }
+        b[i] = s / lu[(i, i)];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solves_a_system_that_needs_pivoting() {
+        let a = DMatrix::from_row_slice(3, 3, &[0.0, 2.0, 1.0, 1.0, 1.0, 1.0, 4.0, -1.0, 3.0]);
+        let x = DVector::from_vec(vec![1.0, -2.0, 0.5]);
+        let mut b = &a * &x;
+        let mut lu = a.clone();
+        let mut pivots = [0; 3];
+        factorise(&mut lu, &mut pivots, 1e-14).unwrap();
+        solve(&lu, &pivots, &mut b);
+        assert!((b - x).amax() < 1e-14);
+    }
+
+    #[test]
+    fn reports_the_column_of_a_singular_matrix() {
+        let mut a = DMatrix::from_row_slice(3, 3, &[1.0, 2.0, 3.0, 2.0, 4.0, 6.0, 1.0, 0.0, 1.0]);
+        let mut pivots = [0; 3];
+        let err = factorise(&mut a, &mut pivots, 1e-14).unwrap_err();
+        assert_eq!(err.column, 2);
+    }
+}

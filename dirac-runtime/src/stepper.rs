@@ -1,0 +1,322 @@
+//! The stepper: solves the implicit discrete Euler–Lagrange equations in position–momentum form,
+//!
+//! ```text
+//! p_k + D_1 L_d(q_k, q_{k+1}) = 0          (solved for q_{k+1} and the internal points)
+//! p_{k+1} = D_2 L_d(q_k, q_{k+1})
+//! ```
+//!
+//! with Newton's method on the exact Jacobian. A failed step returns an error and changes nothing.
+
+use nalgebra::{DVector, SVector};
+
+use crate::discrete_lagrangian::DiscreteLagrangian;
+use crate::error::DiracError;
+use crate::legendre;
+use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
+use crate::quadrature::Quadrature;
+use crate::system::DiracSystem;
+use crate::trajectory::Trajectory;
+
+const EULER_LAGRANGE: &str = "the discrete Euler–Lagrange equations";
+const LEGENDRE: &str = "the Legendre transform (velocity from momentum)";
+
+/// The state of a stepper: time, position, momentum.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct State<const N: usize> {
+    t: f64,
+    q: SVector<f64, N>,
+    p: SVector<f64, N>,
+    /// Velocity at `(q, p)` by the Legendre transform: first-step predictor and energy.
+    v: SVector<f64, N>,
+}
+
+/// A variational integrator for one system, one quadrature and one step size.
+///
+/// ```
+/// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+/// use nalgebra::{SVector, vector};
+///
+/// struct Oscillator { m: f64, k: f64 }
+/// impl DiracSystem<1> for Oscillator {
+///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+///         v[0] * v[0] * (0.5 * self.m) - q[0] * q[0] * (0.5 * self.k)
+///     }
+/// }
+///
+/// let mut stepper = Stepper::new(Oscillator { m: 1.0, k: 0.5 }, Quadrature::gauss(2)?, 0.1)?;
+/// stepper.start_from_momentum(vector![0.5], vector![0.0])?;
+/// let trajectory = stepper.run(10)?;
+/// let exact = 0.5 * 0.5_f64.sqrt().cos();
+/// assert!((trajectory.q()[10][0] - exact).abs() < 1e-6);
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Stepper<S, const N: usize> {
+    discrete: DiscreteLagrangian<S, N>,
+    newton: Newton,
+    legendre: Newton,
+    state: Option<State<N>>,
+    steps: u64,
+    /// Points `Q_0, …, Q_s` of the step being solved.
+    points: Vec<SVector<f64, N>>,
+    /// Newton unknowns `Q_1, …, Q_s` (the iterate).
+    unknowns: DVector<f64>,
+    /// The accepted solution of the last step, for the predictor.
+    previous: Option<(DVector<f64>, SVector<f64, N>)>,
+    report: Option<NewtonReport>,
+}
+
+impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
+    /// A stepper for `system` with `quadrature` and step `h`. Fails on a non-positive or
+    /// non-finite step, or a non-finite parameter.
+    pub fn new(system: S, quadrature: Quadrature, h: f64) -> Result<Self, DiracError> {
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(DiracError::InvalidStep { h });
+        }
+        if let Some((name, value)) = system.parameters().into_iter().find(|(_, v)| !v.is_finite()) {
+            return Err(DiracError::NonFinite { what: format!("parameter {name}"), value });
+        }
+        let unknowns = N * quadrature.degree();
+        let points = vec![SVector::zeros(); quadrature.degree() + 1];
+        let options = NewtonOptions::default();
+        Ok(Self {
+            discrete: DiscreteLagrangian::new(system, quadrature, h),
+            newton: Newton::new(unknowns, options),
+            legendre: Newton::new(N, options),
+            state: None,
+            steps: 0,
+            points,
+            unknowns: DVector::zeros(unknowns),
+            previous: None,
+            report: None,
+        })
+    }
+
+    /// A stepper with the system's own quadrature (the one named in `#[dirac_system]`).
+    pub fn from_system(system: S, h: f64) -> Result<Self, DiracError> {
+        let quadrature = system.quadrature();
+        Self::new(system, quadrature, h)
+    }
+
+    /// Replaces the Newton options (tolerances, iteration cap).
+    pub fn with_newton_options(mut self, options: NewtonOptions) -> Self {
+        self.newton = Newton::new(self.unknowns.len(), options);
+        self.legendre = Newton::new(N, options);
+        self
+    }
+
+    /// Starts from position `q0` and velocity `v0` at `t = 0`, with `p0 = ∂L/∂v(q0, v0)`.
+    pub fn start_from_velocity(
+        &mut self,
+        q0: SVector<f64, N>,
+        v0: SVector<f64, N>,
+    ) -> Result<(), DiracError> {
+        self.check_finite("initial position", &q0)?;
+        self.check_finite("initial velocity", &v0)?;
+        let p0 = legendre::momentum(self.system(), &q0, &v0);
+        self.check_finite("initial momentum", &p0)?;
+        self.reset(State { t: 0.0, q: q0, p: p0, v: v0 });
+        Ok(())
+    }
+
+    /// Starts from position `q0` and momentum `p0` at `t = 0`.
+    pub fn start_from_momentum(
+        &mut self,
+        q0: SVector<f64, N>,
+        p0: SVector<f64, N>,
+    ) -> Result<(), DiracError> {
+        self.check_finite("initial position", &q0)?;
+        self.check_finite("initial momentum", &p0)?;
+        let v0 = legendre::velocity(self.discrete.system(), &mut self.legendre, &q0, &p0, &SVector::zeros())
+            .map_err(|f| self.failure(LEGENDRE, f, N))?;
+        self.reset(State { t: 0.0, q: q0, p: p0, v: v0 });
+        Ok(())
+    }
+
+    fn reset(&mut self, state: State<N>) {
+        self.state = Some(state);
+        self.steps = 0;
+        self.previous = None;
+        self.report = None;
+    }
+
+    /// Advances one step. On error the state is unchanged.
+    pub fn step(&mut self) -> Result<(), DiracError> {
+        let state = self.state.ok_or(DiracError::NotStarted)?;
+        let s = self.discrete.quadrature().degree();
+        let h = self.discrete.h();
+        // Predictor: the last step's points shifted by its increment, or the path q + c h v.
+        match &self.previous {
+            Some((solution, increment)) => {
+                for j in 0..s {
+                    let mut block = self.unknowns.rows_mut(j * N, N);
+                    block.copy_from(&(solution.rows(j * N, N) + increment));
+                }
+            }
+            None => {
+                for j in 0..s {
+                    let c = (j + 1) as f64 / s as f64;
+                    self.unknowns.rows_mut(j * N, N).copy_from(&(state.q + state.v * (c * h)));
+                }
+            }
+        }
+        self.points[0] = state.q;
+        let mut end = SVector::zeros();
+        let (discrete, points) = (&self.discrete, &mut self.points);
+        let result = self.newton.solve(&mut self.unknowns, state.p.amax(), |x, r, jac| {
+            for (j, point) in points.iter_mut().enumerate().skip(1) {
+                point.copy_from(&x.fixed_rows::<N>((j - 1) * N));
+            }
+            end = discrete.euler_lagrange(points, &state.p, r, jac);
+        });
+        let report = result.map_err(|f| self.failure(EULER_LAGRANGE, f, N * s))?;
+        let q = self.unknowns.fixed_rows::<N>((s - 1) * N).into_owned();
+        self.check_finite("new position", &q)?;
+        self.check_finite("new momentum", &end)?;
+        // Velocity at the new state: exact Legendre inverse, seeded with the step's mean velocity.
+        let v = legendre::velocity(self.discrete.system(), &mut self.legendre, &q, &end, &((q - state.q) / h))
+            .map_err(|f| self.failure(LEGENDRE, f, N))?;
+        match &mut self.previous {
+            Some((solution, increment)) => {
+                solution.copy_from(&self.unknowns);
+                *increment = q - state.q;
+            }
+            None => self.previous = Some((self.unknowns.clone(), q - state.q)),
+        }
+        self.steps += 1;
+        let t = self.start_time() + self.steps as f64 * h;
+        self.state = Some(State { t, q, p: end, v });
+        self.report = Some(report);
+        Ok(())
+    }
+
+    fn start_time(&self) -> f64 {
+        self.state.map_or(0.0, |s| s.t - self.steps as f64 * self.discrete.h())
+    }
+
+    /// Runs `steps` steps and returns the trajectory, starting with the current state.
+    pub fn run(&mut self, steps: usize) -> Result<Trajectory<N>, DiracError> {
+        let mut trajectory = Trajectory::new(self.coordinate_names());
+        self.record(&mut trajectory, steps, 1)?;
+        Ok(trajectory)
+    }
+
+    /// Appends the current state and then every `every`-th of the next `steps` states to
+    /// `trajectory`. On error, the trajectory keeps what was recorded before the failing step.
+    pub fn record(
+        &mut self,
+        trajectory: &mut Trajectory<N>,
+        steps: usize,
+        every: usize,
+    ) -> Result<(), DiracError> {
+        let every = every.max(1);
+        self.push_to(trajectory)?;
+        for k in 1..=steps {
+            self.step()?;
+            if k % every == 0 {
+                self.push_to(trajectory)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn push_to(&self, trajectory: &mut Trajectory<N>) -> Result<(), DiracError> {
+        let state = self.state.ok_or(DiracError::NotStarted)?;
+        trajectory.push(state.t, state.q, state.p, self.energy()?);
+        Ok(())
+    }
+
+    /// The system.
+    pub fn system(&self) -> &S {
+        self.discrete.system()
+    }
+
+    /// The quadrature.
+    pub fn quadrature(&self) -> &Quadrature {
+        self.discrete.quadrature()
+    }
+
+    /// The step size.
+    pub fn h(&self) -> f64 {
+        self.discrete.h()
+    }
+
+    /// Steps taken since the start.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Current time (0 before the start).
+    pub fn t(&self) -> f64 {
+        self.state.map_or(0.0, |s| s.t)
+    }
+
+    /// Current position (zeros before the start).
+    pub fn q(&self) -> SVector<f64, N> {
+        self.state.map_or(SVector::zeros(), |s| s.q)
+    }
+
+    /// Current momentum (zeros before the start).
+    pub fn p(&self) -> SVector<f64, N> {
+        self.state.map_or(SVector::zeros(), |s| s.p)
+    }
+
+    /// Current velocity, the Legendre inverse of the momentum (zeros before the start).
+    pub fn v(&self) -> SVector<f64, N> {
+        self.state.map_or(SVector::zeros(), |s| s.v)
+    }
+
+    /// Energy `⟨p, v⟩ − L(q, v)` of the current state.
+    pub fn energy(&self) -> Result<f64, DiracError> {
+        let state = self.state.ok_or(DiracError::NotStarted)?;
+        Ok(legendre::energy(self.system(), &state.q, &state.v))
+    }
+
+    /// How Newton's method went on the last step.
+    pub fn last_report(&self) -> Option<NewtonReport> {
+        self.report
+    }
+
+    /// Coordinate names, from the system.
+    pub fn coordinate_names(&self) -> Vec<String> {
+        (0..N).map(|i| self.system().coordinate_name(i)).collect()
+    }
+
+    fn check_finite(&self, what: &str, x: &SVector<f64, N>) -> Result<(), DiracError> {
+        match x.iter().position(|v| !v.is_finite()) {
+            None => Ok(()),
+            Some(i) => Err(DiracError::NonFinite {
+                what: format!("{what} of {}", self.system().coordinate_name(i)),
+                value: x[i],
+            }),
+        }
+    }
+
+    /// Turns a Newton failure into an error naming the step and, if singular, the unknowns.
+    fn failure(&self, problem: &'static str, failure: NewtonFailure, size: usize) -> DiracError {
+        match failure {
+            NewtonFailure::NoConvergence { residual, iterations } => DiracError::NoConvergence {
+                problem,
+                step: self.steps,
+                residual,
+                iterations,
+                tolerance: self.newton.options().residual_tolerance,
+            },
+            NewtonFailure::Singular(pivot) => {
+                let s = size / N;
+                let column = pivot.column;
+                let name = self.system().coordinate_name(column % N);
+                let slot = match (problem == LEGENDRE, column / N + 1) {
+                    (true, _) => "velocity".to_string(),
+                    (false, j) if j == s => "q_{k+1}".to_string(),
+                    (false, j) => format!("internal point {j}"),
+                };
+                DiracError::SingularJacobian { problem, step: self.steps, unknowns: format!("{name} ({slot})") }
+            }
+            NewtonFailure::NonFinite => DiracError::NonFinite {
+                what: format!("the residual of {problem} at step {}", self.steps),
+                value: f64::NAN,
+            },
+        }
+    }
+}

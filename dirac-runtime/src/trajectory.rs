@@ -1,0 +1,119 @@
+//! Recorded trajectories: time, positions, momenta and energy, with CSV output.
+
+use std::io::Write;
+use std::path::Path;
+
+use nalgebra::SVector;
+
+use crate::error::DiracError;
+
+/// A sampled trajectory `(t, q, p, E)` of a system with `N` coordinates.
+///
+/// ```
+/// use dirac_runtime::Trajectory;
+/// use nalgebra::vector;
+/// let mut trajectory = Trajectory::new(vec!["x".into()]);
+/// trajectory.push(0.0, vector![1.0], vector![0.0], 0.5);
+/// trajectory.push(0.1, vector![0.99], vector![-0.1], 0.5001);
+/// let mut csv = Vec::new();
+/// trajectory.write_csv(&mut csv)?;
+/// assert!(String::from_utf8(csv).unwrap().starts_with("t,x,p_x,energy\n0,1,0,0.5\n"));
+/// assert!((trajectory.max_energy_error() - 1e-4).abs() < 1e-12);
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trajectory<const N: usize> {
+    names: Vec<String>,
+    t: Vec<f64>,
+    q: Vec<SVector<f64, N>>,
+    p: Vec<SVector<f64, N>>,
+    energy: Vec<f64>,
+}
+
+impl<const N: usize> Trajectory<N> {
+    /// An empty trajectory whose coordinates are called `names` (one per coordinate).
+    pub fn new(names: Vec<String>) -> Self {
+        debug_assert_eq!(names.len(), N);
+        Self { names, t: Vec::new(), q: Vec::new(), p: Vec::new(), energy: Vec::new() }
+    }
+
+    /// Appends a sample.
+    pub fn push(&mut self, t: f64, q: SVector<f64, N>, p: SVector<f64, N>, energy: f64) {
+        self.t.push(t);
+        self.q.push(q);
+        self.p.push(p);
+        self.energy.push(energy);
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    /// Whether there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
+    /// Coordinate names.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Sample times.
+    pub fn t(&self) -> &[f64] {
+        &self.t
+    }
+
+    /// Positions.
+    pub fn q(&self) -> &[SVector<f64, N>] {
+        &self.q
+    }
+
+    /// Momenta.
+    pub fn p(&self) -> &[SVector<f64, N>] {
+        &self.p
+    }
+
+    /// Energies.
+    pub fn energy(&self) -> &[f64] {
+        &self.energy
+    }
+
+    /// `max_k |E_k − E_0|`: the largest energy error against the first sample (0 when empty).
+    pub fn max_energy_error(&self) -> f64 {
+        let Some(&e0) = self.energy.first() else { return 0.0 };
+        self.energy.iter().fold(0.0, |m, e| m.max((e - e0).abs()))
+    }
+
+    /// Writes `t, <coordinates>, p_<coordinates>, energy` as CSV with a header row.
+    pub fn write_csv<W: Write>(&self, writer: W) -> Result<(), DiracError> {
+        let io = |e: csv::Error| DiracError::Io(e.to_string());
+        let mut w = csv::Writer::from_writer(writer);
+        let header = std::iter::once("t".to_string())
+            .chain(self.names.iter().cloned())
+            .chain(self.names.iter().map(|n| format!("p_{n}")))
+            .chain(std::iter::once("energy".to_string()));
+        w.write_record(header).map_err(io)?;
+        let mut row = Vec::with_capacity(2 * N + 2);
+        for k in 0..self.len() {
+            row.clear();
+            row.push(self.t[k]);
+            row.extend(self.q[k].iter());
+            row.extend(self.p[k].iter());
+            row.push(self.energy[k]);
+            w.write_record(row.iter().map(|x| x.to_string())).map_err(io)?;
+        }
+        w.flush().map_err(|e| DiracError::Io(e.to_string()))
+    }
+
+    /// Writes the CSV to a file, creating its directory if needed.
+    pub fn save_csv(&self, path: impl AsRef<Path>) -> Result<(), DiracError> {
+        let path = path.as_ref();
+        let io = |e: std::io::Error| DiracError::Io(format!("{}: {e}", path.display()));
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(io)?;
+        }
+        self.write_csv(std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?))
+    }
+}

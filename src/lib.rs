@@ -1,0 +1,38 @@
+//! # dirac
+//!
+//! Structure-preserving integrators generated at compile time. Annotate a struct of parameters
+//! with [`#[dirac_system(...)]`](dirac_system), naming its coordinates, its Lagrangian and a
+//! quadrature; build a [`Stepper`]; step it or run it for a [`Trajectory`].
+//!
+//! ```
+//! use dirac::prelude::*;
+//!
+//! /// A pendulum of unit length and mass: q̈ = −sin q.
+//! #[dirac_system(
+//!     coordinates(theta),
+//!     lagrangian = 0.5 * dot(theta).powi(2) + cos(theta),
+//!     quadrature = galerkin(2),
+//! )]
+//! struct Pendulum;
+//!
+//! let mut stepper = Stepper::from_system(Pendulum, 0.05)?;
+//! stepper.start_from_momentum(vector![1.0], vector![0.0])?;
+//! let trajectory = stepper.run(100)?; // to T = 5
+//! assert!((trajectory.q()[100][0] - -0.02395128485293).abs() < 1e-6);
+//! # Ok::<(), DiracError>(())
+//! ```
+//!
+//! See the crate README for the attribute's syntax, the quadratures and their measured orders.
+
+pub use dirac_macros::dirac_system;
+pub use dirac_runtime::*;
+
+/// Everything a model file needs: the attribute, the runtime types and `vector!`/`SVector`.
+pub mod prelude {
+    pub use dirac_macros::dirac_system;
+    pub use dirac_runtime::nalgebra::{SMatrix, SVector, vector};
+    pub use dirac_runtime::{
+        DiracError, DiracSystem, DiscreteLagrangian, DualNum, NewtonOptions, Quadrature, Rule,
+        Scalar, Stepper, Trajectory,
+    };
+}
