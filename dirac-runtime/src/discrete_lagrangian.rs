@@ -116,15 +116,22 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
         self.h
     }
 
-    /// Position and velocity at node `i` of the path through `points`.
-    fn node(&self, i: usize, points: &[SVector<f64, N>]) -> (SVector<f64, N>, SVector<f64, N>) {
-        let mut q = SVector::zeros();
+    /// Position and velocity at node `i` of the path from `base = Q_0` with increments
+    /// `Z_j = Q_j − Q_0` (`j = 1..=s`). The velocity is summed from the increments, not from the
+    /// points, so it carries no cancellation of the large `Q_0` terms.
+    fn node(
+        &self,
+        i: usize,
+        base: &SVector<f64, N>,
+        increments: &[SVector<f64, N>],
+    ) -> (SVector<f64, N>, SVector<f64, N>) {
+        let mut dq = SVector::zeros();
         let mut v = SVector::zeros();
-        for (j, point) in points.iter().enumerate() {
-            q += point * self.quadrature.basis(i, j);
-            v += point * (self.quadrature.basis_derivative(i, j) / self.h);
+        for (j, z) in increments.iter().enumerate() {
+            dq += z * self.quadrature.basis(i, j + 1);
+            v += z * (self.quadrature.basis_derivative(i, j + 1) / self.h);
         }
-        (q, v)
+        (base + dq, v)
     }
 
     /// `L_d(Q_0, …, Q_s)`; `points` holds the `s + 1` points of the step.
@@ -133,9 +140,10 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
     /// If `points.len()` is not the quadrature's degree plus one.
     pub fn value(&self, points: &[SVector<f64, N>]) -> f64 {
         assert_eq!(points.len(), self.quadrature.degree() + 1, "L_d takes degree + 1 points");
+        let increments: Vec<_> = points[1..].iter().map(|q| q - points[0]).collect();
         (0..self.quadrature.nodes().len())
             .map(|i| {
-                let (q, v) = self.node(i, points);
+                let (q, v) = self.node(i, &points[0], &increments);
                 self.h * self.quadrature.weights()[i] * self.system.lagrangian(&q, &v)
             })
             .sum()
@@ -143,25 +151,28 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
 
     /// The discrete Euler–Lagrange system of one step and the new momentum.
     ///
-    /// Unknowns are `Q_1, …, Q_s` (`Q_s = q_{k+1}`), blocks of `N`. Writes the residual
+    /// The points are `Q_0 = base` and `Q_j = base + Z_j`; the unknowns are the increments
+    /// `Z_1, …, Z_s` (`Q_s = q_{k+1}`), blocks of `N`. Writes the residual
     /// `[p_k + ∂L_d/∂Q_0; ∂L_d/∂Q_1; …; ∂L_d/∂Q_{s−1}]` and adds its Jacobian into `jacobian`
-    /// (which the caller zeroes); returns `∂L_d/∂Q_s`, which is `p_{k+1}` at the solution.
+    /// (which the caller zeroes).
     pub(crate) fn euler_lagrange(
         &self,
-        points: &[SVector<f64, N>],
+        base: &SVector<f64, N>,
+        increments: &[SVector<f64, N>],
         momentum: &SVector<f64, N>,
         residual: &mut DVector<f64>,
         jacobian: &mut DMatrix<f64>,
-    ) -> SVector<f64, N> {
+    ) -> StepEquations<N> {
         let s = self.quadrature.degree();
         let h = self.h;
         residual.fill(0.0);
         residual.rows_mut(0, N).copy_from(momentum);
-        let mut end = SVector::zeros();
+        let mut impulse = SVector::zeros();
+        let mut magnitude = momentum.abs();
         let quad = &self.quadrature;
         for (i, &b) in quad.weights().iter().enumerate() {
             let w = h * b;
-            let (q, v) = self.node(i, points);
+            let (q, v) = self.node(i, base, increments);
             let a = |j: usize| quad.basis(i, j);
             let d = |j: usize| quad.basis_derivative(i, j) / h;
             if s == 1 {
@@ -175,7 +186,8 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
                 );
                 let mut r = residual.rows_mut(0, N);
                 r += l.first * w;
-                end += l.second * w;
+                impulse += (l.first + l.second) * w;
+                magnitude += (l.first.abs() + l.second.abs()) * w;
                 let mut block = jacobian.fixed_view_mut::<N, N>(0, 0);
                 block += l.mixed * w;
             } else {
@@ -184,13 +196,13 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
                 let qq = seeded(&self.system, &q, &v, Seed::POSITION, Seed::POSITION).mixed;
                 let vv = seeded(&self.system, &q, &v, Seed::VELOCITY, Seed::VELOCITY).mixed;
                 let (lq, lv, qv) = (qv.first, qv.second, qv.mixed);
-                for j in 0..=s {
+                impulse += lq * w;
+                magnitude += (lq.abs() + lv.abs() * s as f64 / h) * w;
+                for j in 0..s {
                     let g = (lq * a(j) + lv * d(j)) * w;
                     if j < s {
                         let mut r = residual.rows_mut(j * N, N);
                         r += g;
-                    } else {
-                        end += g;
                     }
                 }
                 for j in 0..s {
@@ -205,8 +217,18 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
                 }
             }
         }
-        end
+        StepEquations { impulse, scale: magnitude.amax() }
     }
+}
+
+/// What one evaluation of the step equations yields besides the residual and Jacobian.
+pub(crate) struct StepEquations<const N: usize> {
+    /// `Σ_j ∂L_d/∂Q_j = h Σ_i b_i ∂_q L(q_i, v_i)` (as `Σ_j ℓ_j = 1`, `Σ_j ℓ'_j = 0`): at the
+    /// solution this is `D_2 L_d − p_k = p_{k+1} − p_k`, the momentum change over the step,
+    /// obtained without the cancellation between `p_k` and `∂L_d/∂Q_0`.
+    pub impulse: SVector<f64, N>,
+    /// Size of the terms summed into the residual: its round-off floor is a few ulps of this.
+    pub scale: f64,
 }
 
 #[cfg(test)]
@@ -247,13 +269,17 @@ mod tests {
         let p = vector![0.7, -0.4];
         let mut r = DVector::zeros(2 * s);
         let mut jac = DMatrix::zeros(2 * s, 2 * s);
-        let end = ld.euler_lagrange(&points, &p, &mut r, &mut jac);
+        let increments = |points: &[SVector<f64, 2>]| -> Vec<SVector<f64, 2>> {
+            points[1..].iter().map(|q| q - points[0]).collect()
+        };
+        let impulse = ld.euler_lagrange(&points[0], &increments(&points), &p, &mut r, &mut jac).impulse;
         for c in 0..2 {
             assert!((r[c] - p[c] - fd(&ld, &points, 0, c)).abs() < 1e-8);
             for j in 1..s {
                 assert!((r[j * 2 + c] - fd(&ld, &points, j, c)).abs() < 1e-8);
             }
-            assert!((end[c] - fd(&ld, &points, s, c)).abs() < 1e-8);
+            let total: f64 = (0..=s).map(|j| fd(&ld, &points, j, c)).sum();
+            assert!((impulse[c] - total).abs() < 1e-8);
         }
         // Jacobian columns against differences of the residual.
         let eps = 1e-6;
@@ -265,8 +291,8 @@ mod tests {
                 minus[k][c] -= eps;
                 let (mut rp, mut rm) = (DVector::zeros(2 * s), DVector::zeros(2 * s));
                 let mut scratch = DMatrix::zeros(2 * s, 2 * s);
-                ld.euler_lagrange(&plus, &p, &mut rp, &mut scratch);
-                ld.euler_lagrange(&minus, &p, &mut rm, &mut scratch);
+                ld.euler_lagrange(&plus[0], &increments(&plus), &p, &mut rp, &mut scratch);
+                ld.euler_lagrange(&minus[0], &increments(&minus), &p, &mut rm, &mut scratch);
                 let column = (rp - rm) / (2.0 * eps);
                 let exact = jac.column((k - 1) * 2 + c);
                 assert!((column - exact).amax() < 1e-6, "column {k},{c}");

@@ -59,11 +59,12 @@ pub(crate) fn velocity<S: DiracSystem<N>, const N: usize>(
     guess: &SVector<f64, N>,
 ) -> Result<SVector<f64, N>, NewtonFailure> {
     let mut x = DVector::from_column_slice(guess.as_slice());
-    newton.solve(&mut x, p.amax(), |x, r, j| {
+    newton.solve(&mut x, |x, r, j| {
         let v = SVector::<f64, N>::from_column_slice(x.as_slice());
         let l = seeded(system, q, &v, Seed::VELOCITY, Seed::VELOCITY);
         r.copy_from(&(l.first - p));
         j.copy_from(&l.mixed);
+        l.first.abs().sup(&p.abs()).amax()
     })?;
     Ok(SVector::from_column_slice(x.as_slice()))
 }

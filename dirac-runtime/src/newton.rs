@@ -7,8 +7,10 @@ use crate::lu::{self, SingularPivot};
 /// Tolerances and iteration cap of Newton's method.
 ///
 /// A solve has converged when the residual's infinity norm is at most
-/// `residual_tolerance · residual_scale` and the last update was at most
-/// `step_tolerance · (1 + |x|∞)`; the returned point is always one whose residual was checked.
+/// `residual_tolerance · scale`, where `scale` is the size of the terms summed into the residual
+/// (so the tolerance sits a fixed distance above its round-off floor), and the last update was at
+/// most `step_tolerance · (1 + |x|∞)`. The tolerance never asks for less than the round-off floor
+/// `64 ε ‖J‖∞ ‖x‖∞`. The returned point is always one whose residual was checked.
 ///
 /// ```
 /// let options = dirac_runtime::NewtonOptions { max_iterations: 50, ..Default::default() };
@@ -64,8 +66,9 @@ pub enum NewtonFailure {
 
 /// Newton's method for `F(x) = 0` on `R^n`, reusing its buffers across solves.
 ///
-/// The caller's closure fills the residual and the Jacobian at `x`. Nothing is allocated per
-/// iteration.
+/// The caller's closure fills the residual and the Jacobian at `x` and returns the residual's
+/// scale: the size of the terms it sums, against which the tolerance is relative. Nothing is
+/// allocated per iteration.
 ///
 /// ```
 /// use dirac_runtime::{Newton, NewtonOptions};
@@ -73,9 +76,10 @@ pub enum NewtonFailure {
 /// // x² = 2
 /// let mut newton = Newton::new(1, NewtonOptions::default());
 /// let mut x = DVector::from_element(1, 1.0);
-/// newton.solve(&mut x, 1.0, |x, r, j| {
+/// newton.solve(&mut x, |x, r, j| {
 ///     r[0] = x[0] * x[0] - 2.0;
 ///     j[(0, 0)] = 2.0 * x[0];
+///     2.0 // the size of the terms of the residual
 /// }).unwrap();
 /// assert!((x[0] - 2f64.sqrt()).abs() < 1e-15);
 /// ```
@@ -104,22 +108,19 @@ impl Newton {
     }
 
     /// Solves `F(x) = 0` from the initial guess in `x`; `x` holds the solution on success and an
-    /// unspecified iterate on failure. `residual_scale` sets the size of a negligible residual.
-    pub fn solve<F>(
-        &mut self,
-        x: &mut DVector<f64>,
-        residual_scale: f64,
-        mut evaluate: F,
-    ) -> Result<NewtonReport, NewtonFailure>
+    /// unspecified iterate on failure.
+    pub fn solve<F>(&mut self, x: &mut DVector<f64>, mut evaluate: F) -> Result<NewtonReport, NewtonFailure>
     where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, &mut DMatrix<f64>),
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, &mut DMatrix<f64>) -> f64,
     {
-        let tolerance = self.options.residual_tolerance * residual_scale.max(1.0);
         let mut last_update = f64::INFINITY;
         let mut residual = f64::INFINITY;
         for iteration in 1..=self.options.max_iterations {
             self.jacobian.fill(0.0);
-            evaluate(x, &mut self.residual, &mut self.jacobian);
+            let scale = evaluate(x, &mut self.residual, &mut self.jacobian);
+            // Round-off floor: what perturbing x by a few ulps does to the residual.
+            let floor = 64.0 * f64::EPSILON * row_sum_norm(&self.jacobian) * x.amax();
+            let tolerance = self.options.residual_tolerance * scale + floor;
             residual = self.residual.amax();
             if !residual.is_finite() {
                 return Err(NewtonFailure::NonFinite);
@@ -141,6 +142,11 @@ impl Newton {
     }
 }
 
+/// `‖A‖∞`, the largest absolute row sum.
+fn row_sum_norm(a: &DMatrix<f64>) -> f64 {
+    a.row_iter().map(|row| row.iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -151,10 +157,11 @@ mod tests {
         let mut newton = Newton::new(2, NewtonOptions::default());
         let mut x = DVector::from_vec(vec![0.5, 2.8]);
         let report = newton
-            .solve(&mut x, 1.0, |x, r, j| {
+            .solve(&mut x, |x, r, j| {
                 r[0] = x[0] + x[1] - 3.0;
                 r[1] = x[0] * x[1] - 2.0;
                 j.copy_from_slice(&[1.0, x[1], 1.0, x[0]]);
+                3.0
             })
             .unwrap();
         assert!((x[0] - 1.0).abs() < 1e-15 && (x[1] - 2.0).abs() < 1e-15);
@@ -166,15 +173,17 @@ mod tests {
         let mut newton = Newton::new(1, NewtonOptions { max_iterations: 3, ..Default::default() });
         let mut x = DVector::from_element(1, 0.3);
         // x² + 1 = 0 has no real root.
-        let err = newton.solve(&mut x, 1.0, |x, r, j| {
+        let err = newton.solve(&mut x, |x, r, j| {
             r[0] = x[0] * x[0] + 1.0;
             j[(0, 0)] = 2.0 * x[0];
+            1.0
         });
         assert!(matches!(err, Err(NewtonFailure::NoConvergence { iterations: 3, .. })));
         let mut x = DVector::from_element(1, 0.0);
-        let err = newton.solve(&mut x, 1.0, |x, r, j| {
+        let err = newton.solve(&mut x, |x, r, j| {
             r[0] = x[0] * x[0] + 1.0;
             j[(0, 0)] = 2.0 * x[0];
+            1.0
         });
         assert_eq!(err, Err(NewtonFailure::Singular(SingularPivot { column: 0 })));
     }

@@ -116,6 +116,13 @@ impl Quadrature {
         Self::galerkin(degree, Rule::GaussLegendre(degree))
     }
 
+    /// A quadrature whose degree and rule were already checked (by `#[dirac_system]` at compile
+    /// time). Inconsistent arguments fall back to no check: use [`galerkin`](Self::galerkin).
+    #[doc(hidden)]
+    pub fn validated(degree: usize, rule: Rule) -> Self {
+        Self::build(degree, rule)
+    }
+
     fn build(degree: usize, rule: Rule) -> Self {
         let (nodes, weights) = match rule {
             Rule::GaussLegendre(r) => gauss_legendre(r),

@@ -28,9 +28,34 @@ struct State<const N: usize> {
     p: SVector<f64, N>,
     /// Velocity at `(q, p)` by the Legendre transform: first-step predictor and energy.
     v: SVector<f64, N>,
+    /// Round-off left out of `q` and `p` by the compensated (Kahan) updates.
+    q_carry: SVector<f64, N>,
+    p_carry: SVector<f64, N>,
+}
+
+impl<const N: usize> State<N> {
+    fn new(t: f64, q: SVector<f64, N>, p: SVector<f64, N>, v: SVector<f64, N>) -> Self {
+        Self { t, q, p, v, q_carry: SVector::zeros(), p_carry: SVector::zeros() }
+    }
+}
+
+/// `sum += increment` with Kahan compensation: over millions of steps the state then carries
+/// round-off from each increment, not from each sum.
+fn compensated_add<const N: usize>(sum: &mut SVector<f64, N>, carry: &mut SVector<f64, N>, increment: &SVector<f64, N>) {
+    for i in 0..sum.len() {
+        let y = increment[i] - carry[i];
+        let t = sum[i] + y;
+        carry[i] = (t - sum[i]) - y;
+        sum[i] = t;
+    }
 }
 
 /// A variational integrator for one system, one quadrature and one step size.
+///
+/// Each step solves for the increments `Z_j = Q_j − q_k` of the `s` points of the step (the
+/// internal points and `q_{k+1}`) rather than the points themselves, so that velocities carry no
+/// cancellation; the momentum is advanced by the impulse `Σ_j ∂L_d/∂Q_j = h Σ_i b_i ∂_q L`, which
+/// equals `D_2 L_d` at the solution; both updates are compensated sums.
 ///
 /// ```
 /// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
@@ -56,13 +81,15 @@ pub struct Stepper<S, const N: usize> {
     newton: Newton,
     legendre: Newton,
     state: Option<State<N>>,
+    /// Time of the initial state.
+    start: f64,
     steps: u64,
-    /// Points `Q_0, …, Q_s` of the step being solved.
-    points: Vec<SVector<f64, N>>,
-    /// Newton unknowns `Q_1, …, Q_s` (the iterate).
+    /// Increments `Z_1, …, Z_s` of the step being solved, as vectors.
+    increments: Vec<SVector<f64, N>>,
+    /// Newton unknowns: the increments stacked (the iterate).
     unknowns: DVector<f64>,
-    /// The accepted solution of the last step, for the predictor.
-    previous: Option<(DVector<f64>, SVector<f64, N>)>,
+    /// The increments of the last accepted step: the next step's predictor.
+    previous: Option<DVector<f64>>,
     report: Option<NewtonReport>,
 }
 
@@ -77,15 +104,16 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             return Err(DiracError::NonFinite { what: format!("parameter {name}"), value });
         }
         let unknowns = N * quadrature.degree();
-        let points = vec![SVector::zeros(); quadrature.degree() + 1];
+        let increments = vec![SVector::zeros(); quadrature.degree()];
         let options = NewtonOptions::default();
         Ok(Self {
             discrete: DiscreteLagrangian::new(system, quadrature, h),
             newton: Newton::new(unknowns, options),
             legendre: Newton::new(N, options),
             state: None,
+            start: 0.0,
             steps: 0,
-            points,
+            increments,
             unknowns: DVector::zeros(unknowns),
             previous: None,
             report: None,
@@ -115,7 +143,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         self.check_finite("initial velocity", &v0)?;
         let p0 = legendre::momentum(self.system(), &q0, &v0);
         self.check_finite("initial momentum", &p0)?;
-        self.reset(State { t: 0.0, q: q0, p: p0, v: v0 });
+        self.reset(State::new(0.0, q0, p0, v0));
         Ok(())
     }
 
@@ -129,11 +157,12 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         self.check_finite("initial momentum", &p0)?;
         let v0 = legendre::velocity(self.discrete.system(), &mut self.legendre, &q0, &p0, &SVector::zeros())
             .map_err(|f| self.failure(LEGENDRE, f, N))?;
-        self.reset(State { t: 0.0, q: q0, p: p0, v: v0 });
+        self.reset(State::new(0.0, q0, p0, v0));
         Ok(())
     }
 
     fn reset(&mut self, state: State<N>) {
+        self.start = state.t;
         self.state = Some(state);
         self.steps = 0;
         self.previous = None;
@@ -145,53 +174,45 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
         let s = self.discrete.quadrature().degree();
         let h = self.discrete.h();
-        // Predictor: the last step's points shifted by its increment, or the path q + c h v.
+        // Predictor: the last step's increments (constant velocity), or the path c h v.
         match &self.previous {
-            Some((solution, increment)) => {
-                for j in 0..s {
-                    let mut block = self.unknowns.rows_mut(j * N, N);
-                    block.copy_from(&(solution.rows(j * N, N) + increment));
-                }
-            }
+            Some(previous) => self.unknowns.copy_from(previous),
             None => {
                 for j in 0..s {
                     let c = (j + 1) as f64 / s as f64;
-                    self.unknowns.rows_mut(j * N, N).copy_from(&(state.q + state.v * (c * h)));
+                    self.unknowns.rows_mut(j * N, N).copy_from(&(state.v * (c * h)));
                 }
             }
         }
-        self.points[0] = state.q;
-        let mut end = SVector::zeros();
-        let (discrete, points) = (&self.discrete, &mut self.points);
-        let result = self.newton.solve(&mut self.unknowns, state.p.amax(), |x, r, jac| {
-            for (j, point) in points.iter_mut().enumerate().skip(1) {
-                point.copy_from(&x.fixed_rows::<N>((j - 1) * N));
+        let mut impulse = SVector::zeros();
+        let (discrete, increments) = (&self.discrete, &mut self.increments);
+        let result = self.newton.solve(&mut self.unknowns, |x, r, jac| {
+            for (j, z) in increments.iter_mut().enumerate() {
+                z.copy_from(&x.fixed_rows::<N>(j * N));
             }
-            end = discrete.euler_lagrange(points, &state.p, r, jac);
+            let equations = discrete.euler_lagrange(&state.q, increments, &state.p, r, jac);
+            impulse = equations.impulse;
+            equations.scale
         });
         let report = result.map_err(|f| self.failure(EULER_LAGRANGE, f, N * s))?;
-        let q = self.unknowns.fixed_rows::<N>((s - 1) * N).into_owned();
-        self.check_finite("new position", &q)?;
-        self.check_finite("new momentum", &end)?;
+        let step = self.unknowns.fixed_rows::<N>((s - 1) * N).into_owned();
+        let mut next = state;
+        compensated_add(&mut next.q, &mut next.q_carry, &step);
+        compensated_add(&mut next.p, &mut next.p_carry, &impulse);
+        self.check_finite("new position", &next.q)?;
+        self.check_finite("new momentum", &next.p)?;
         // Velocity at the new state: exact Legendre inverse, seeded with the step's mean velocity.
-        let v = legendre::velocity(self.discrete.system(), &mut self.legendre, &q, &end, &((q - state.q) / h))
+        next.v = legendre::velocity(self.discrete.system(), &mut self.legendre, &next.q, &next.p, &(step / h))
             .map_err(|f| self.failure(LEGENDRE, f, N))?;
         match &mut self.previous {
-            Some((solution, increment)) => {
-                solution.copy_from(&self.unknowns);
-                *increment = q - state.q;
-            }
-            None => self.previous = Some((self.unknowns.clone(), q - state.q)),
+            Some(previous) => previous.copy_from(&self.unknowns),
+            None => self.previous = Some(self.unknowns.clone()),
         }
         self.steps += 1;
-        let t = self.start_time() + self.steps as f64 * h;
-        self.state = Some(State { t, q, p: end, v });
+        next.t = self.start + self.steps as f64 * h;
+        self.state = Some(next);
         self.report = Some(report);
         Ok(())
-    }
-
-    fn start_time(&self) -> f64 {
-        self.state.map_or(0.0, |s| s.t - self.steps as f64 * self.discrete.h())
     }
 
     /// Runs `steps` steps and returns the trajectory, starting with the current state.

@@ -1,0 +1,91 @@
+//! The model as the attribute describes it, before validation.
+
+use proc_macro2::{Span, TokenStream};
+use syn::parse::{Parse, ParseStream};
+use syn::punctuated::Punctuated;
+use syn::{Expr, Ident, Token, bracketed};
+
+/// Length of a coordinate array: a literal or the name of a constant (or const parameter).
+#[derive(Clone)]
+pub enum Length {
+    Literal(usize, Span),
+    Named(Ident),
+}
+
+impl Length {
+    /// The length as an expression.
+    pub fn tokens(&self) -> TokenStream {
+        match self {
+            Length::Literal(n, span) => quote::quote_spanned!(*span=> #n),
+            Length::Named(ident) => quote::quote!(#ident),
+        }
+    }
+}
+
+/// One entry of `coordinates(...)`: `x` or `theta[8]`.
+#[derive(Clone)]
+pub struct Coordinate {
+    pub name: Ident,
+    pub length: Option<Length>,
+}
+
+impl Parse for Coordinate {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let name: Ident = input.parse()?;
+        if !input.peek(syn::token::Bracket) {
+            return Ok(Self { name, length: None });
+        }
+        let content;
+        bracketed!(content in input);
+        let length = match content.parse::<Expr>()? {
+            Expr::Lit(syn::ExprLit { lit: syn::Lit::Int(lit), .. }) => {
+                Length::Literal(lit.base10_parse()?, lit.span())
+            }
+            Expr::Path(p) if p.path.get_ident().is_some() => {
+                Length::Named(p.path.get_ident().cloned().expect("checked above"))
+            }
+            other => {
+                return Err(syn::Error::new_spanned(
+                    other,
+                    "an array length must be an integer literal or the name of a constant",
+                ));
+            }
+        };
+        Ok(Self { name, length: Some(length) })
+    }
+}
+
+/// The attribute's arguments, each kept with its key for error reporting.
+pub struct Arguments {
+    pub entries: Vec<syn::Meta>,
+}
+
+impl Parse for Arguments {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let entries = Punctuated::<syn::Meta, Token![,]>::parse_terminated(input)?;
+        Ok(Self { entries: entries.into_iter().collect() })
+    }
+}
+
+/// How the Lagrangian is given.
+pub enum Lagrangian {
+    /// An expression over coordinates, `dot(...)` velocities and parameters.
+    Expression(Expr),
+    /// A generic function `fn(&Self, &SVector<D, N>, &SVector<D, N>) -> D`.
+    Function(syn::Path),
+}
+
+/// A parameter field of the struct: `f64` or `[f64; K]`.
+pub struct Parameter {
+    pub name: Ident,
+    pub array: bool,
+}
+
+/// Everything `expand` needs, validated.
+pub struct Model {
+    pub item: syn::ItemStruct,
+    pub coordinates: Vec<Coordinate>,
+    pub lagrangian: Lagrangian,
+    pub quadrature: TokenStream,
+    pub parameters: Vec<Parameter>,
+}

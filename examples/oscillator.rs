@@ -1,0 +1,13 @@
+//! The oscillator scene with every tour quadrature: `cargo run --release --example oscillator`.
+//! Prints the table and writes one CSV trajectory per quadrature to `output/`.
+
+mod scenes;
+
+fn main() -> Result<(), dirac::DiracError> {
+    let reports = scenes::quadratures()
+        .into_iter()
+        .map(scenes::oscillator::report)
+        .collect::<Result<Vec<_>, _>>()?;
+    scenes::print_table(&reports);
+    Ok(())
+}

@@ -1,0 +1,13 @@
+//! The pendulum scene with every tour quadrature: `cargo run --release --example pendulum`.
+//! Prints the table and writes one CSV trajectory per quadrature to `output/`.
+
+mod scenes;
+
+fn main() -> Result<(), dirac::DiracError> {
+    let reports = scenes::quadratures()
+        .into_iter()
+        .map(scenes::pendulum::report)
+        .collect::<Result<Vec<_>, _>>()?;
+    scenes::print_table(&reports);
+    Ok(())
+}

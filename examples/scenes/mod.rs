@@ -1,0 +1,88 @@
+//! The scenes with known answers (DESIGN.md), shared by the examples, the tour, the tests and the
+//! benches so that each model is written once.
+#![allow(dead_code)]
+
+pub mod chain;
+pub mod double_pendulum;
+pub mod hand_written;
+pub mod kepler;
+pub mod oscillator;
+pub mod pendulum;
+
+use std::time::{Duration, Instant};
+
+use dirac::prelude::*;
+
+/// One row of the tour's table.
+#[derive(Debug, Clone)]
+pub struct Report {
+    pub scene: &'static str,
+    pub quadrature: String,
+    pub h: f64,
+    pub steps: usize,
+    pub max_energy_error: f64,
+    pub wall: Duration,
+    /// What this scene checks against its known answer, e.g. `|q(5) − q_exact| = 3e-9`.
+    pub check: String,
+}
+
+/// Runs `stepper` for `steps` steps, recording every `every`-th state, and times it.
+pub fn timed<S: DiracSystem<N>, const N: usize>(
+    stepper: &mut Stepper<S, N>,
+    steps: usize,
+    every: usize,
+) -> Result<(Trajectory<N>, Duration), DiracError> {
+    let mut trajectory = Trajectory::new(stepper.coordinate_names());
+    let start = Instant::now();
+    stepper.record(&mut trajectory, steps, every)?;
+    Ok((trajectory, start.elapsed()))
+}
+
+/// The quadratures every scene is run with in the tour: two second-order rules and the Gauss
+/// Galerkin methods of order 4 and 6.
+pub fn quadratures() -> Vec<Quadrature> {
+    vec![
+        Quadrature::midpoint(),
+        Quadrature::trapezoid(),
+        Quadrature::gauss(2).expect("degree 2 is valid"),
+        Quadrature::gauss(3).expect("degree 3 is valid"),
+    ]
+}
+
+/// Prints reports as an aligned table.
+pub fn print_table(reports: &[Report]) {
+    println!(
+        "{:<16} {:<32} {:>7} {:>8} {:>12} {:>10}  {}",
+        "scene", "quadrature", "h", "steps", "max |ΔE|", "wall", "check"
+    );
+    for r in reports {
+        println!(
+            "{:<16} {:<32} {:>7} {:>8} {:>12.3e} {:>10.2?}  {}",
+            r.scene, r.quadrature, r.h, r.steps, r.max_energy_error, r.wall, r.check
+        );
+    }
+}
+
+/// Writes reports as CSV.
+pub fn save_table(reports: &[Report], path: &str) -> std::io::Result<()> {
+    use std::io::Write;
+    if let Some(dir) = std::path::Path::new(path).parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(f, "scene,quadrature,h,steps,max_energy_error,wall_seconds,check")?;
+    for r in reports {
+        writeln!(
+            f,
+            "{},\"{}\",{},{},{:e},{},\"{}\"",
+            r.scene,
+            r.quadrature,
+            r.h,
+            r.steps,
+            r.max_energy_error,
+            r.wall.as_secs_f64(),
+            r.check
+        )?;
+    }
+    Ok(())
+}
