@@ -1,1 +1,58 @@
-fn main() {}
+//! One step of the generated stepper against the hand-written limit, and how the cost grows.
+//!
+//! `cargo bench --bench step`. Compare figures within one run only: the ratio generated / hand is
+//! what the README reports.
+
+#[path = "../examples/scenes/mod.rs"]
+mod scenes;
+
+use std::hint::black_box;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use dirac::prelude::*;
+use scenes::{chain, double_pendulum, hand_written::HandMidpoint};
+
+/// Double pendulum, midpoint, h = 0.01: generated stepper vs analytic derivatives, same Newton.
+fn generated_vs_hand(c: &mut Criterion) {
+    let mut group = c.benchmark_group("double_pendulum_midpoint_step");
+    let h = 0.01;
+    let mut generated = double_pendulum::stepper(Quadrature::midpoint(), h).expect("valid scene");
+    group.bench_function("generated", |b| b.iter(|| black_box(generated.step()).expect("step")));
+    let mut hand =
+        HandMidpoint::new(double_pendulum::SCENE, h, double_pendulum::q0(), double_pendulum::v0());
+    group.bench_function("hand_written", |b| b.iter(|| black_box(hand.step()).expect("step")));
+    group.finish();
+}
+
+/// Double pendulum, h = 0.01, one step with each tour quadrature.
+fn quadratures(c: &mut Criterion) {
+    let mut group = c.benchmark_group("double_pendulum_step_by_quadrature");
+    for quadrature in scenes::quadratures() {
+        let name = quadrature.name();
+        let mut stepper = double_pendulum::stepper(quadrature, 0.01).expect("valid scene");
+        group.bench_function(name, |b| b.iter(|| black_box(stepper.step()).expect("step")));
+    }
+    group.finish();
+}
+
+fn chain_step<const L: usize>(group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>) {
+    let system = chain::Chain::<L> { m: 1.0, l: 1.0, g: 9.81 };
+    let mut stepper = Stepper::new(system, Quadrature::midpoint(), 0.005).expect("valid scene");
+    stepper.start_from_velocity(chain::initial(), SVector::zeros()).expect("finite start");
+    group.bench_with_input(BenchmarkId::from_parameter(L), &L, |b, _| {
+        b.iter(|| black_box(stepper.step()).expect("step"))
+    });
+}
+
+/// n-link chain, midpoint, h = 0.005, n = 2, 4, 8, 16.
+fn chain_growth(c: &mut Criterion) {
+    let mut group = c.benchmark_group("chain_midpoint_step");
+    chain_step::<2>(&mut group);
+    chain_step::<4>(&mut group);
+    chain_step::<8>(&mut group);
+    chain_step::<16>(&mut group);
+    group.finish();
+}
+
+criterion_group!(benches, generated_vs_hand, quadratures, chain_growth);
+criterion_main!(benches);

@@ -90,11 +90,8 @@ fn expand(model: &Model) -> TokenStream {
         Lagrangian::Expression(expr) => {
             let parameters = model.parameters.iter().map(|p| {
                 let name = &p.name;
-                if p.array {
-                    quote_spanned!(name.span()=> let #name = self.#name.map(<__D as ::core::convert::From<f64>>::from);)
-                } else {
-                    quote_spanned!(name.span()=> let #name = <__D as ::core::convert::From<f64>>::from(self.#name);)
-                }
+                // Parameters stay f64: constant subexpressions cost no dual arithmetic.
+                quote_spanned!(name.span()=> let #name = self.#name;)
             });
             let coordinates =
                 model.coordinates.iter().zip(&offsets).map(|(c, o)| bind_coordinate(c, o));

@@ -125,7 +125,7 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
 
 /// A bare path naming no coordinate or parameter is a function; anything else an expression.
 fn lagrangian_of(
-    mut expr: Expr,
+    expr: Expr,
     coordinates: &[Coordinate],
     parameters: &[Parameter],
     errors: &mut Errors,
@@ -138,12 +138,13 @@ fn lagrangian_of(
             return Some(Lagrangian::Function(p.path.clone()));
         }
     }
-    let found = expression::rewrite(&mut expr, coordinates);
-    if found.is_empty() {
-        Some(Lagrangian::Expression(expr))
-    } else {
-        errors.extend(found);
-        None
+    let names: Vec<_> = parameters.iter().map(|p| p.name.clone()).collect();
+    match expression::rewrite(&expr, coordinates, &names) {
+        Ok(expr) => Some(Lagrangian::Expression(expr)),
+        Err(found) => {
+            errors.extend(found);
+            None
+        }
     }
 }
 

@@ -26,16 +26,17 @@ struct State<const N: usize> {
     t: f64,
     q: SVector<f64, N>,
     p: SVector<f64, N>,
-    /// Velocity at `(q, p)` by the Legendre transform: first-step predictor and energy.
-    v: SVector<f64, N>,
+    /// A velocity near the one at `(q, p)`: the initial velocity, then the last step's mean
+    /// velocity. It seeds the first predictor and the Legendre inversion.
+    v_hint: SVector<f64, N>,
     /// Round-off left out of `q` and `p` by the compensated (Kahan) updates.
     q_carry: SVector<f64, N>,
     p_carry: SVector<f64, N>,
 }
 
 impl<const N: usize> State<N> {
-    fn new(t: f64, q: SVector<f64, N>, p: SVector<f64, N>, v: SVector<f64, N>) -> Self {
-        Self { t, q, p, v, q_carry: SVector::zeros(), p_carry: SVector::zeros() }
+    fn new(t: f64, q: SVector<f64, N>, p: SVector<f64, N>, v_hint: SVector<f64, N>) -> Self {
+        Self { t, q, p, v_hint, q_carry: SVector::zeros(), p_carry: SVector::zeros() }
     }
 }
 
@@ -79,7 +80,6 @@ fn compensated_add<const N: usize>(sum: &mut SVector<f64, N>, carry: &mut SVecto
 pub struct Stepper<S, const N: usize> {
     discrete: DiscreteLagrangian<S, N>,
     newton: Newton,
-    legendre: Newton,
     state: Option<State<N>>,
     /// Time of the initial state.
     start: f64,
@@ -109,7 +109,6 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         Ok(Self {
             discrete: DiscreteLagrangian::new(system, quadrature, h),
             newton: Newton::new(unknowns, options),
-            legendre: Newton::new(N, options),
             state: None,
             start: 0.0,
             steps: 0,
@@ -129,7 +128,6 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     /// Replaces the Newton options (tolerances, iteration cap).
     pub fn with_newton_options(mut self, options: NewtonOptions) -> Self {
         self.newton = Newton::new(self.unknowns.len(), options);
-        self.legendre = Newton::new(N, options);
         self
     }
 
@@ -155,7 +153,8 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     ) -> Result<(), DiracError> {
         self.check_finite("initial position", &q0)?;
         self.check_finite("initial momentum", &p0)?;
-        let v0 = legendre::velocity(self.discrete.system(), &mut self.legendre, &q0, &p0, &SVector::zeros())
+        let mut newton = Newton::new(N, *self.newton.options());
+        let v0 = legendre::velocity(self.system(), &mut newton, &q0, &p0, &SVector::zeros())
             .map_err(|f| self.failure(LEGENDRE, f, N))?;
         self.reset(State::new(0.0, q0, p0, v0));
         Ok(())
@@ -180,7 +179,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             None => {
                 for j in 0..s {
                     let c = (j + 1) as f64 / s as f64;
-                    self.unknowns.rows_mut(j * N, N).copy_from(&(state.v * (c * h)));
+                    self.unknowns.rows_mut(j * N, N).copy_from(&(state.v_hint * (c * h)));
                 }
             }
         }
@@ -201,9 +200,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         compensated_add(&mut next.p, &mut next.p_carry, &impulse);
         self.check_finite("new position", &next.q)?;
         self.check_finite("new momentum", &next.p)?;
-        // Velocity at the new state: exact Legendre inverse, seeded with the step's mean velocity.
-        next.v = legendre::velocity(self.discrete.system(), &mut self.legendre, &next.q, &next.p, &(step / h))
-            .map_err(|f| self.failure(LEGENDRE, f, N))?;
+        next.v_hint = step / h;
         match &mut self.previous {
             Some(previous) => previous.copy_from(&self.unknowns),
             None => self.previous = Some(self.unknowns.clone()),
@@ -282,15 +279,19 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         self.state.map_or(SVector::zeros(), |s| s.p)
     }
 
-    /// Current velocity, the Legendre inverse of the momentum (zeros before the start).
-    pub fn v(&self) -> SVector<f64, N> {
-        self.state.map_or(SVector::zeros(), |s| s.v)
+    /// Current velocity: the solution `v` of `∂L/∂v(q, v) = p` (Newton's method with the exact
+    /// Hessian, seeded with the last step's mean velocity).
+    pub fn v(&self) -> Result<SVector<f64, N>, DiracError> {
+        let state = self.state.ok_or(DiracError::NotStarted)?;
+        let mut newton = Newton::new(N, *self.newton.options());
+        legendre::velocity(self.system(), &mut newton, &state.q, &state.p, &state.v_hint)
+            .map_err(|f| self.failure(LEGENDRE, f, N))
     }
 
-    /// Energy `⟨p, v⟩ − L(q, v)` of the current state.
+    /// Energy `⟨p, v⟩ − L(q, v)` of the current state, with `v` from [`v`](Self::v).
     pub fn energy(&self) -> Result<f64, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
-        Ok(legendre::energy(self.system(), &state.q, &state.v))
+        Ok(legendre::energy(self.system(), &state.q, &self.v()?))
     }
 
     /// How Newton's method went on the last step.

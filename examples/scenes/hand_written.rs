@@ -39,6 +39,8 @@ pub struct HandMidpoint {
     increment: SVector<f64, 2>,
     newton: Newton,
     x: DVector<f64>,
+    /// Newton iterations of the last step.
+    pub last_iterations: usize,
 }
 
 impl HandMidpoint {
@@ -53,6 +55,7 @@ impl HandMidpoint {
             increment: v0 * h,
             newton: Newton::new(2, NewtonOptions::default()),
             x: DVector::zeros(2),
+            last_iterations: 0,
         }
     }
 
@@ -62,7 +65,7 @@ impl HandMidpoint {
         let (q0, p0, h, system) = (self.q, self.p, self.h, &self.system);
         self.x.copy_from(&(q0 + self.increment));
         let mut p1 = SVector::zeros();
-        self.newton.solve(&mut self.x, |x, r, j| {
+        let report = self.newton.solve(&mut self.x, |x, r, j| {
             let q1 = SVector::<f64, 2>::new(x[0], x[1]);
             let (lq, lv, lqq, lqv, lvv) = derivatives(system, &((q0 + q1) * 0.5), &((q1 - q0) / h));
             r.copy_from(&(p0 + lq * (0.5 * h) - lv));
@@ -70,6 +73,7 @@ impl HandMidpoint {
             p1 = lq * (0.5 * h) + lv;
             p0.abs().sup(&lv.abs()).amax()
         })?;
+        self.last_iterations = report.iterations;
         let q1 = SVector::<f64, 2>::new(self.x[0], self.x[1]);
         self.increment = q1 - q0;
         self.q = q1;
