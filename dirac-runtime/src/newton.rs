@@ -126,14 +126,20 @@ impl Newton {
                 return Err(NewtonFailure::NonFinite);
             }
             let settled = last_update <= self.options.step_tolerance * (1.0 + x.amax());
-            if residual <= tolerance && (settled || residual == 0.0) {
+            let converged = residual <= tolerance && (settled || residual == 0.0);
+            if converged && iteration > 1 {
                 return Ok(NewtonReport { iterations: iteration, residual });
             }
             if self.jacobian.iter().any(|v| !v.is_finite()) {
                 return Err(NewtonFailure::NonFinite);
             }
+            // Factorised even when the initial guess already solves the equations: a solution
+            // is only accepted where the Jacobian shows it is unique.
             lu::factorise(&mut self.jacobian, &mut self.pivots, self.options.singular_tolerance)
                 .map_err(NewtonFailure::Singular)?;
+            if converged {
+                return Ok(NewtonReport { iterations: iteration, residual });
+            }
             lu::solve(&self.jacobian, &self.pivots, &mut self.residual);
             *x -= &self.residual;
             last_update = self.residual.amax();

@@ -1,0 +1,68 @@
+//! Orders of accuracy, measured as least-squares slopes of log(error) against log(h) over four
+//! step sizes halving each time, for every quadrature, on the pendulum (against its golden values)
+//! and the double pendulum (against an order-8 reference).
+//!
+//! Tolerance on a slope: ±0.3. Over a factor 8 in h, a pre-asymptotic term of relative size
+//! O(h) moves the fitted slope by well under that, while a wrong order moves it by ≥ 1.
+
+#[path = "../examples/scenes/mod.rs"]
+mod scenes;
+
+use dirac::prelude::*;
+use scenes::{double_pendulum, pendulum};
+
+/// Least-squares slope of ln(error) against ln(h).
+fn slope(hs: &[f64], errors: &[f64]) -> f64 {
+    let x: Vec<f64> = hs.iter().map(|h| h.ln()).collect();
+    let y: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx).powi(2)).sum();
+    sxy / sxx
+}
+
+/// (quadrature, expected order, coarsest pendulum step count over T = 5).
+fn cases() -> Vec<(Quadrature, f64, usize)> {
+    vec![
+        (Quadrature::midpoint(), 2.0, 50),
+        (Quadrature::trapezoid(), 2.0, 50),
+        (Quadrature::gauss(2).unwrap(), 4.0, 10),
+        (Quadrature::gauss(3).unwrap(), 6.0, 10),
+        (Quadrature::galerkin(2, Rule::GaussLobatto(3)).unwrap(), 4.0, 10),
+        (Quadrature::galerkin(3, Rule::GaussLobatto(4)).unwrap(), 6.0, 10),
+    ]
+}
+
+#[test]
+fn pendulum_orders_match_theory() {
+    for (quadrature, order, coarsest) in cases() {
+        let hs: Vec<f64> = (0..4).map(|k| 5.0 / (coarsest << k) as f64).collect();
+        let errors: Vec<f64> =
+            hs.iter().map(|&h| pendulum::error_at_5(quadrature.clone(), h).unwrap()).collect();
+        let measured = slope(&hs, &errors);
+        println!("pendulum {:<32} order {measured:.2} errors {errors:?}", quadrature.name());
+        assert!((measured - order).abs() < 0.3, "{}: slope {measured}", quadrature.name());
+    }
+}
+
+#[test]
+fn double_pendulum_orders_match_theory() {
+    let t = 1.0;
+    let reference = double_pendulum::state_at(Quadrature::gauss(4).unwrap(), 1.0 / 400.0, t).unwrap();
+    for (quadrature, order, _) in cases() {
+        let coarsest = match order as usize {
+            2 => 100,
+            4 => 20,
+            _ => 20,
+        };
+        let hs: Vec<f64> = (0..4).map(|k| t / (coarsest << k) as f64).collect();
+        let errors: Vec<f64> = hs
+            .iter()
+            .map(|&h| (double_pendulum::state_at(quadrature.clone(), h, t).unwrap() - reference).amax())
+            .collect();
+        let measured = slope(&hs, &errors);
+        println!("double pendulum {:<32} order {measured:.2} errors {errors:?}", quadrature.name());
+        assert!((measured - order).abs() < 0.3, "{}: slope {measured}", quadrature.name());
+    }
+}
