@@ -17,10 +17,18 @@ fn generated_vs_hand(c: &mut Criterion) {
     let mut group = c.benchmark_group("double_pendulum_midpoint_step");
     let h = 0.01;
     let mut generated = double_pendulum::stepper(Quadrature::midpoint(), h).expect("valid scene");
-    group.bench_function("generated", |b| b.iter(|| black_box(generated.step()).expect("step")));
-    let mut hand =
-        HandMidpoint::new(double_pendulum::SCENE, h, double_pendulum::q0(), double_pendulum::v0());
-    group.bench_function("hand_written", |b| b.iter(|| black_box(hand.step()).expect("step")));
+    group.bench_function("generated", |b| {
+        b.iter(|| black_box(generated.step()).expect("step"))
+    });
+    let mut hand = HandMidpoint::new(
+        double_pendulum::SCENE,
+        h,
+        double_pendulum::q0(),
+        double_pendulum::v0(),
+    );
+    group.bench_function("hand_written", |b| {
+        b.iter(|| black_box(hand.step()).expect("step"))
+    });
     group.finish();
 }
 
@@ -30,15 +38,25 @@ fn quadratures(c: &mut Criterion) {
     for quadrature in scenes::quadratures() {
         let name = quadrature.name();
         let mut stepper = double_pendulum::stepper(quadrature, 0.01).expect("valid scene");
-        group.bench_function(name, |b| b.iter(|| black_box(stepper.step()).expect("step")));
+        group.bench_function(name, |b| {
+            b.iter(|| black_box(stepper.step()).expect("step"))
+        });
     }
     group.finish();
 }
 
-fn chain_step<const L: usize>(group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>) {
-    let system = chain::Chain::<L> { m: 1.0, l: 1.0, g: 9.81 };
+fn chain_step<const L: usize>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+) {
+    let system = chain::Chain::<L> {
+        m: 1.0,
+        l: 1.0,
+        g: 9.81,
+    };
     let mut stepper = Stepper::new(system, Quadrature::midpoint(), 0.005).expect("valid scene");
-    stepper.start_from_velocity(chain::initial(), SVector::zeros()).expect("finite start");
+    stepper
+        .start_from_velocity(chain::initial(), SVector::zeros())
+        .expect("finite start");
     group.bench_with_input(BenchmarkId::from_parameter(L), &L, |b, _| {
         b.iter(|| black_box(stepper.step()).expect("step"))
     });

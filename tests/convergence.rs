@@ -29,8 +29,16 @@ fn cases() -> Vec<(Quadrature, f64, usize)> {
         (Quadrature::trapezoid(), 2.0, 50),
         (Quadrature::gauss(2).unwrap(), 4.0, 10),
         (Quadrature::gauss(3).unwrap(), 6.0, 10),
-        (Quadrature::galerkin(2, Rule::GaussLobatto(3)).unwrap(), 4.0, 10),
-        (Quadrature::galerkin(3, Rule::GaussLobatto(4)).unwrap(), 6.0, 10),
+        (
+            Quadrature::galerkin(2, Rule::GaussLobatto(3)).unwrap(),
+            4.0,
+            10,
+        ),
+        (
+            Quadrature::galerkin(3, Rule::GaussLobatto(4)).unwrap(),
+            6.0,
+            10,
+        ),
     ]
 }
 
@@ -38,18 +46,28 @@ fn cases() -> Vec<(Quadrature, f64, usize)> {
 fn pendulum_orders_match_theory() {
     for (quadrature, order, coarsest) in cases() {
         let hs: Vec<f64> = (0..4).map(|k| 5.0 / (coarsest << k) as f64).collect();
-        let errors: Vec<f64> =
-            hs.iter().map(|&h| pendulum::error_at_5(quadrature.clone(), h).unwrap()).collect();
+        let errors: Vec<f64> = hs
+            .iter()
+            .map(|&h| pendulum::error_at_5(quadrature.clone(), h).unwrap())
+            .collect();
         let measured = slope(&hs, &errors);
-        println!("pendulum {:<32} order {measured:.2} errors {errors:?}", quadrature.name());
-        assert!((measured - order).abs() < 0.3, "{}: slope {measured}", quadrature.name());
+        println!(
+            "pendulum {:<32} order {measured:.2} errors {errors:?}",
+            quadrature.name()
+        );
+        assert!(
+            (measured - order).abs() < 0.3,
+            "{}: slope {measured}",
+            quadrature.name()
+        );
     }
 }
 
 #[test]
 fn double_pendulum_orders_match_theory() {
     let t = 1.0;
-    let reference = double_pendulum::state_at(Quadrature::gauss(4).unwrap(), 1.0 / 400.0, t).unwrap();
+    let reference =
+        double_pendulum::state_at(Quadrature::gauss(4).unwrap(), 1.0 / 400.0, t).unwrap();
     for (quadrature, order, _) in cases() {
         let coarsest = match order as usize {
             2 => 100,
@@ -59,10 +77,19 @@ fn double_pendulum_orders_match_theory() {
         let hs: Vec<f64> = (0..4).map(|k| t / (coarsest << k) as f64).collect();
         let errors: Vec<f64> = hs
             .iter()
-            .map(|&h| (double_pendulum::state_at(quadrature.clone(), h, t).unwrap() - reference).amax())
+            .map(|&h| {
+                (double_pendulum::state_at(quadrature.clone(), h, t).unwrap() - reference).amax()
+            })
             .collect();
         let measured = slope(&hs, &errors);
-        println!("double pendulum {:<32} order {measured:.2} errors {errors:?}", quadrature.name());
-        assert!((measured - order).abs() < 0.3, "{}: slope {measured}", quadrature.name());
+        println!(
+            "double pendulum {:<32} order {measured:.2} errors {errors:?}",
+            quadrature.name()
+        );
+        assert!(
+            (measured - order).abs() < 0.3,
+            "{}: slope {measured}",
+            quadrature.name()
+        );
     }
 }

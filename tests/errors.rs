@@ -16,29 +16,57 @@ fn non_positive_or_non_finite_steps_are_rejected() {
 
 #[test]
 fn non_finite_parameters_and_initial_values_are_named() {
-    let err = Stepper::new(Pendulum { g: f64::NAN, ..SCENE }, Quadrature::midpoint(), 0.1).unwrap_err();
+    let err = Stepper::new(
+        Pendulum {
+            g: f64::NAN,
+            ..SCENE
+        },
+        Quadrature::midpoint(),
+        0.1,
+    )
+    .unwrap_err();
     assert!(err.to_string().contains("parameter g"), "{err}");
     let mut stepper = Stepper::new(SCENE, Quadrature::midpoint(), 0.1).unwrap();
-    let err = stepper.start_from_velocity(vector![1.0], vector![f64::INFINITY]).unwrap_err();
-    assert!(err.to_string().contains("initial velocity of theta"), "{err}");
+    let err = stepper
+        .start_from_velocity(vector![1.0], vector![f64::INFINITY])
+        .unwrap_err();
+    assert!(
+        err.to_string().contains("initial velocity of theta"),
+        "{err}"
+    );
     assert_eq!(stepper.step(), Err(DiracError::NotStarted));
 }
 
 #[test]
 fn a_step_that_does_not_converge_leaves_the_state_unchanged() {
-    let options = NewtonOptions { max_iterations: 2, ..Default::default() };
-    let mut stepper = Stepper::new(SCENE, Quadrature::gauss(2).unwrap(), 0.5).unwrap().with_newton_options(options);
-    stepper.start_from_momentum(vector![1.0], vector![0.0]).unwrap();
+    let options = NewtonOptions {
+        max_iterations: 2,
+        ..Default::default()
+    };
+    let mut stepper = Stepper::new(SCENE, Quadrature::gauss(2).unwrap(), 0.5)
+        .unwrap()
+        .with_newton_options(options);
+    stepper
+        .start_from_momentum(vector![1.0], vector![0.0])
+        .unwrap();
     let before = (stepper.t(), stepper.q(), stepper.p(), stepper.steps());
     let err = stepper.step().unwrap_err();
     match &err {
-        DiracError::NoConvergence { step, iterations, residual, .. } => {
+        DiracError::NoConvergence {
+            step,
+            iterations,
+            residual,
+            ..
+        } => {
             assert_eq!((*step, *iterations), (0, 2));
             assert!(*residual > 0.0);
         }
         other => panic!("expected NoConvergence, got {other}"),
     }
-    assert_eq!(before, (stepper.t(), stepper.q(), stepper.p(), stepper.steps()));
+    assert_eq!(
+        before,
+        (stepper.t(), stepper.q(), stepper.p(), stepper.steps())
+    );
     // With the default cap the same step succeeds.
     let mut stepper = stepper.with_newton_options(NewtonOptions::default());
     stepper.step().unwrap();
@@ -56,10 +84,14 @@ fn a_singular_jacobian_names_the_undetermined_coordinate() {
     // solution is not unique and is refused all the same.
     for x0 in [0.5, 0.0] {
         let mut stepper = Stepper::new(Degenerate, Quadrature::trapezoid(), 0.1).unwrap();
-        stepper.start_from_velocity(vector![x0, 0.0], vector![0.0, 1.0]).unwrap();
+        stepper
+            .start_from_velocity(vector![x0, 0.0], vector![0.0, 1.0])
+            .unwrap();
         let err = stepper.step().unwrap_err();
         match &err {
-            DiracError::SingularJacobian { unknowns, step: 0, .. } => {
+            DiracError::SingularJacobian {
+                unknowns, step: 0, ..
+            } => {
                 assert!(unknowns.starts_with("x "), "{unknowns}")
             }
             other => panic!("expected SingularJacobian, got {other}"),
@@ -69,16 +101,23 @@ fn a_singular_jacobian_names_the_undetermined_coordinate() {
     }
     // The midpoint rule couples x_k and x_{k+1}: the same model is well posed there.
     let mut stepper = Stepper::new(Degenerate, Quadrature::midpoint(), 0.1).unwrap();
-    stepper.start_from_velocity(vector![0.5, 0.0], vector![0.0, 1.0]).unwrap();
+    stepper
+        .start_from_velocity(vector![0.5, 0.0], vector![0.0, 1.0])
+        .unwrap();
     stepper.step().unwrap();
     // The velocity cannot be recovered from the momentum either: an error, not NaN.
-    assert!(matches!(stepper.energy(), Err(DiracError::SingularJacobian { .. })));
+    assert!(matches!(
+        stepper.energy(),
+        Err(DiracError::SingularJacobian { .. })
+    ));
 }
 
 #[test]
 fn trajectories_write_csv_with_named_columns() {
     let mut stepper = Stepper::new(SCENE, Quadrature::midpoint(), 0.1).unwrap();
-    stepper.start_from_momentum(vector![1.0], vector![0.0]).unwrap();
+    stepper
+        .start_from_momentum(vector![1.0], vector![0.0])
+        .unwrap();
     let trajectory = stepper.run(3).unwrap();
     let mut csv = Vec::new();
     trajectory.write_csv(&mut csv).unwrap();

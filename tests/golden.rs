@@ -19,7 +19,11 @@ fn oscillator_error_bounds() {
     ];
     for (quadrature, bound) in bounds {
         let error = oscillator::max_error(quadrature.clone(), 0.1).unwrap();
-        assert!(error < bound, "{}: {error:e} ≥ {bound:e}", quadrature.name());
+        assert!(
+            error < bound,
+            "{}: {error:e} ≥ {bound:e}",
+            quadrature.name()
+        );
     }
 }
 
@@ -27,9 +31,15 @@ fn oscillator_error_bounds() {
 #[test]
 fn midpoint_keeps_the_oscillator_energy_exactly() {
     let mut stepper = Stepper::new(oscillator::SCENE, Quadrature::midpoint(), 0.1).unwrap();
-    stepper.start_from_momentum(vector![0.5], vector![0.0]).unwrap();
+    stepper
+        .start_from_momentum(vector![0.5], vector![0.0])
+        .unwrap();
     let trajectory = stepper.run(1000).unwrap();
-    assert!(trajectory.max_energy_error() < 1e-15, "{}", trajectory.max_energy_error());
+    assert!(
+        trajectory.max_energy_error() < 1e-15,
+        "{}",
+        trajectory.max_energy_error()
+    );
     // and the exact energy k q0²/2.
     assert!((trajectory.energy()[0] - 0.0625).abs() < 1e-16);
 }
@@ -50,13 +60,22 @@ fn pendulum_golden_values() {
 fn generated_stepper_matches_the_hand_written_one() {
     let h = 0.01;
     let mut generated = double_pendulum::stepper(Quadrature::midpoint(), h).unwrap();
-    let mut hand = HandMidpoint::new(double_pendulum::SCENE, h, double_pendulum::q0(), double_pendulum::v0());
+    let mut hand = HandMidpoint::new(
+        double_pendulum::SCENE,
+        h,
+        double_pendulum::q0(),
+        double_pendulum::v0(),
+    );
     assert!((generated.p() - hand.p).amax() < 1e-14);
     for _ in 0..200 {
         generated.step().unwrap();
         hand.step().unwrap();
     }
-    assert!((generated.q() - hand.q).amax() < 1e-10, "{}", (generated.q() - hand.q).amax());
+    assert!(
+        (generated.q() - hand.q).amax() < 1e-10,
+        "{}",
+        (generated.q() - hand.q).amax()
+    );
     assert!((generated.p() - hand.p).amax() < 1e-9);
 }
 
@@ -68,5 +87,11 @@ fn quadratures_are_values_of_one_stepper_type() {
         .map(|q| Stepper::new(pendulum::SCENE, q, 0.1).unwrap())
         .collect();
     assert_eq!(steppers.len(), 4);
-    assert_eq!(Stepper::from_system(oscillator::SCENE, 0.1).unwrap().quadrature().name(), "midpoint");
+    assert_eq!(
+        Stepper::from_system(oscillator::SCENE, 0.1)
+            .unwrap()
+            .quadrature()
+            .name(),
+        "midpoint"
+    );
 }

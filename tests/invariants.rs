@@ -15,15 +15,23 @@ use scenes::{double_pendulum, kepler, pendulum};
 #[test]
 fn energy_error_is_bounded_without_drift_over_a_million_steps() {
     let mut stepper = Stepper::new(pendulum::SCENE, Quadrature::midpoint(), 0.1).unwrap();
-    stepper.start_from_momentum(vector![1.0], vector![0.0]).unwrap();
+    stepper
+        .start_from_momentum(vector![1.0], vector![0.0])
+        .unwrap();
     let mut trajectory = Trajectory::new(stepper.coordinate_names());
     stepper.record(&mut trajectory, 1_000_000, 37).unwrap();
     let e0 = trajectory.energy()[0];
     let errors: Vec<f64> = trajectory.energy().iter().map(|e| (e - e0).abs()).collect();
     let tenth = errors.len() / 10;
     let first = errors[..tenth].iter().cloned().fold(0.0, f64::max);
-    let last = errors[errors.len() - tenth..].iter().cloned().fold(0.0, f64::max);
-    assert!(last <= 1.1 * first, "drift: first tenth {first:e}, last tenth {last:e}");
+    let last = errors[errors.len() - tenth..]
+        .iter()
+        .cloned()
+        .fold(0.0, f64::max);
+    assert!(
+        last <= 1.1 * first,
+        "drift: first tenth {first:e}, last tenth {last:e}"
+    );
     assert!(first < 2e-4, "{first:e}");
     assert_eq!(stepper.steps(), 1_000_000);
 }
@@ -35,12 +43,15 @@ fn kepler_angular_momentum_is_conserved_to_round_off() {
     for quadrature in scenes::quadratures() {
         let name = quadrature.name();
         let mut stepper = Stepper::new(kepler::SCENE, quadrature, 0.01).unwrap();
-        stepper.start_from_momentum(kepler::q0(), kepler::p0()).unwrap();
+        stepper
+            .start_from_momentum(kepler::q0(), kepler::p0())
+            .unwrap();
         let l0 = kepler::angular_momentum(&stepper.q(), &stepper.p());
         let mut worst: f64 = 0.0;
         for _ in 0..100_000 {
             stepper.step().unwrap();
-            worst = worst.max(((kepler::angular_momentum(&stepper.q(), &stepper.p()) - l0) / l0).abs());
+            worst =
+                worst.max(((kepler::angular_momentum(&stepper.q(), &stepper.p()) - l0) / l0).abs());
         }
         assert!(worst <= 1e-12, "{name}: relative drift {worst:e}");
     }
@@ -49,7 +60,9 @@ fn kepler_angular_momentum_is_conserved_to_round_off() {
 /// One step of the double pendulum as a map (q, p) ↦ (q', p').
 fn step_map(quadrature: &Quadrature, h: f64, x: SVector<f64, 4>) -> SVector<f64, 4> {
     let mut stepper = Stepper::new(double_pendulum::SCENE, quadrature.clone(), h).unwrap();
-    stepper.start_from_momentum(vector![x[0], x[1]], vector![x[2], x[3]]).unwrap();
+    stepper
+        .start_from_momentum(vector![x[0], x[1]], vector![x[2], x[3]])
+        .unwrap();
     stepper.step().unwrap();
     let (q, p) = (stepper.q(), stepper.p());
     vector![q[0], q[1], p[0], p[1]]
@@ -77,7 +90,11 @@ fn step_map_is_symplectic() {
             (f(-2.0) - f(2.0) + (f(1.0) - f(-1.0)) * 8.0) / (12.0 * eps)
         }));
         let defect = (jacobian.transpose() * omega * jacobian - omega).amax();
-        assert!(defect < 1e-9, "{}: ‖∂Φᵀ Ω ∂Φ − Ω‖ = {defect:e}", quadrature.name());
+        assert!(
+            defect < 1e-9,
+            "{}: ‖∂Φᵀ Ω ∂Φ − Ω‖ = {defect:e}",
+            quadrature.name()
+        );
         // The test can fail: the map is far from the identity here.
         assert!((jacobian - SMatrix::identity()).amax() > 1e-2);
     }

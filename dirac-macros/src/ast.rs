@@ -38,9 +38,10 @@ impl Parse for Coordinate {
         let content;
         bracketed!(content in input);
         let length = match content.parse::<Expr>()? {
-            Expr::Lit(syn::ExprLit { lit: syn::Lit::Int(lit), .. }) => {
-                Length::Literal(lit.base10_parse()?, lit.span())
-            }
+            Expr::Lit(syn::ExprLit {
+                lit: syn::Lit::Int(lit),
+                ..
+            }) => Length::Literal(lit.base10_parse()?, lit.span()),
             Expr::Path(p) if p.path.get_ident().is_some() => {
                 Length::Named(p.path.get_ident().cloned().expect("checked above"))
             }
@@ -51,7 +52,10 @@ impl Parse for Coordinate {
                 ));
             }
         };
-        Ok(Self { name, length: Some(length) })
+        Ok(Self {
+            name,
+            length: Some(length),
+        })
     }
 }
 
@@ -63,7 +67,9 @@ pub struct Arguments {
 impl Parse for Arguments {
     fn parse(input: ParseStream) -> syn::Result<Self> {
         let entries = Punctuated::<syn::Meta, Token![,]>::parse_terminated(input)?;
-        Ok(Self { entries: entries.into_iter().collect() })
+        Ok(Self {
+            entries: entries.into_iter().collect(),
+        })
     }
 }
 

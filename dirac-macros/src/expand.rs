@@ -30,9 +30,14 @@ pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
     };
     match validate::model(arguments, item.clone()) {
         Outcome::Valid(model) => expand(&model),
-        Outcome::Invalid { errors, coordinates } => {
+        Outcome::Invalid {
+            errors,
+            coordinates,
+        } => {
             let errors = errors.to_compile_errors();
-            let stub = coordinates.filter(|c| !c.is_empty()).map(|c| stub(&item, &c));
+            let stub = coordinates
+                .filter(|c| !c.is_empty())
+                .map(|c| stub(&item, &c));
             quote!(#errors #item #stub)
         }
     }
@@ -50,7 +55,11 @@ fn dimension(coordinates: &[Coordinate]) -> TokenStream {
         .sum();
     match (literal, coordinates) {
         (Some(n), _) => quote!(#n),
-        (None, [single]) => single.length.as_ref().map(Length::tokens).unwrap_or_default(),
+        (None, [single]) => single
+            .length
+            .as_ref()
+            .map(Length::tokens)
+            .unwrap_or_default(),
         (None, _) => {
             let terms = coordinates
                 .iter()
@@ -93,8 +102,11 @@ fn expand(model: &Model) -> TokenStream {
                 // Parameters stay f64: constant subexpressions cost no dual arithmetic.
                 quote_spanned!(name.span()=> let #name = self.#name;)
             });
-            let coordinates =
-                model.coordinates.iter().zip(&offsets).map(|(c, o)| bind_coordinate(c, o));
+            let coordinates = model
+                .coordinates
+                .iter()
+                .zip(&offsets)
+                .map(|(c, o)| bind_coordinate(c, o));
             let result = quote_spanned!(expr.span()=> let __lagrangian: __D = #expr;);
             quote! {
                 #(#parameters)*

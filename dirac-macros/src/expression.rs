@@ -20,8 +20,12 @@ pub const UNARY: &[&str] = &[
 
 /// Functions of two arguments: (name, method, whether the second argument is a scalar of the
 /// Lagrangian (`true`) or kept as written (an `i32` or `f64` constant, `false`)).
-pub const BINARY: &[(&str, &str, bool)] =
-    &[("powi", "powi", false), ("powf", "powf", false), ("pow", "powd", true), ("atan2", "atan2", true)];
+pub const BINARY: &[(&str, &str, bool)] = &[
+    ("powi", "powi", false),
+    ("powf", "powf", false),
+    ("pow", "powd", true),
+    ("atan2", "atan2", true),
+];
 
 /// The identifier bound to the velocity of coordinate `name`.
 pub fn velocity_ident(name: &Ident) -> Ident {
@@ -42,10 +46,18 @@ pub fn rewrite(
     coordinates: &[Coordinate],
     parameters: &[Ident],
 ) -> Result<Expr, Vec<syn::Error>> {
-    let mut rewriter = Rewriter { coordinates, parameters, errors: Vec::new() };
+    let mut rewriter = Rewriter {
+        coordinates,
+        parameters,
+        errors: Vec::new(),
+    };
     let (expr, class) = rewriter.expr(expr);
     let expr = lift(expr, class);
-    if rewriter.errors.is_empty() { Ok(expr) } else { Err(rewriter.errors) }
+    if rewriter.errors.is_empty() {
+        Ok(expr)
+    } else {
+        Err(rewriter.errors)
+    }
 }
 
 struct Rewriter<'a> {
@@ -71,10 +83,19 @@ impl Rewriter<'_> {
     }
 
     fn names(&self) -> String {
-        self.coordinates.iter().map(|c| format!("`{}`", c.name)).collect::<Vec<_>>().join(", ")
+        self.coordinates
+            .iter()
+            .map(|c| format!("`{}`", c.name))
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 
-    fn error(&mut self, span: Span, message: impl std::fmt::Display, original: &Expr) -> (Expr, Class) {
+    fn error(
+        &mut self,
+        span: Span,
+        message: impl std::fmt::Display,
+        original: &Expr,
+    ) -> (Expr, Class) {
         self.errors.push(syn::Error::new(span, message));
         (original.clone(), Class::Dual)
     }
@@ -99,16 +120,22 @@ impl Rewriter<'_> {
             return self.error(arg.span(), message, original);
         };
         let Some(coordinate) = self.coordinate(ident) else {
-            let message =
-                format!("`{ident}` is not a coordinate; the coordinates are {}", self.names());
+            let message = format!(
+                "`{ident}` is not a coordinate; the coordinates are {}",
+                self.names()
+            );
             return self.error(ident.span(), message, original);
         };
         let velocity = Ident::new(&velocity_ident(&coordinate.name).to_string(), ident.span());
         match (index, coordinate.length.is_some()) {
-            (Some(index), true) => {
-                (syn::parse_quote_spanned!(arg.span()=> #velocity[#index]), Class::Dual)
-            }
-            (None, _) => (syn::parse_quote_spanned!(arg.span()=> #velocity), Class::Dual),
+            (Some(index), true) => (
+                syn::parse_quote_spanned!(arg.span()=> #velocity[#index]),
+                Class::Dual,
+            ),
+            (None, _) => (
+                syn::parse_quote_spanned!(arg.span()=> #velocity),
+                Class::Dual,
+            ),
             (Some(_), false) => {
                 let message = format!("`{ident}` is a single coordinate, not an array");
                 self.error(arg.span(), message, original)
@@ -140,16 +167,29 @@ impl Rewriter<'_> {
         if !scalar {
             // powi(x, n), powf(x, c): the exponent is an integer or a real constant, as written.
             let exponent = &call.args[1];
-            return (syn::parse_quote_spanned!(span=> (#base).#method(#exponent)), base_class);
+            return (
+                syn::parse_quote_spanned!(span=> (#base).#method(#exponent)),
+                base_class,
+            );
         }
         let (other, other_class) = self.expr(&call.args[1]);
         if (base_class, other_class) == (Class::Constant, Class::Constant) {
             // Both constant: the f64 method (`pow` is `powf` on f64).
-            let method = if name == "pow" { Ident::new("powf", span) } else { method };
-            return (syn::parse_quote_spanned!(span=> (#base).#method(#other)), Class::Constant);
+            let method = if name == "pow" {
+                Ident::new("powf", span)
+            } else {
+                method
+            };
+            return (
+                syn::parse_quote_spanned!(span=> (#base).#method(#other)),
+                Class::Constant,
+            );
         }
         let (base, other) = (lift(base, base_class), lift(other, other_class));
-        (syn::parse_quote_spanned!(span=> (#base).#method(#other)), Class::Dual)
+        (
+            syn::parse_quote_spanned!(span=> (#base).#method(#other)),
+            Class::Dual,
+        )
     }
 
     /// `a op b` with constants kept in `f64` and every dual–constant pair written with the dual
@@ -159,21 +199,28 @@ impl Rewriter<'_> {
         let (right, rc) = self.expr(&b.right);
         let op = &b.op;
         let span = b.op.span();
-        let arithmetic = matches!(op, BinOp::Add(_) | BinOp::Sub(_) | BinOp::Mul(_) | BinOp::Div(_));
+        let arithmetic = matches!(
+            op,
+            BinOp::Add(_) | BinOp::Sub(_) | BinOp::Mul(_) | BinOp::Div(_)
+        );
         if matches!(op, BinOp::BitXor(_)) {
             let message = "`^` is exclusive or in Rust; write powers as powi(x, 2) or x.powi(2)";
             return self.error(span, message, original);
         }
         match (lc, rc) {
-            (Class::Constant, Class::Constant) => {
-                (syn::parse_quote_spanned!(span=> #left #op #right), Class::Constant)
-            }
-            (Class::Dual, Class::Constant) if arithmetic => {
-                (syn::parse_quote_spanned!(span=> #left #op #right), Class::Dual)
-            }
+            (Class::Constant, Class::Constant) => (
+                syn::parse_quote_spanned!(span=> #left #op #right),
+                Class::Constant,
+            ),
+            (Class::Dual, Class::Constant) if arithmetic => (
+                syn::parse_quote_spanned!(span=> #left #op #right),
+                Class::Dual,
+            ),
             (Class::Constant, Class::Dual) if arithmetic => {
                 let expr = match op {
-                    BinOp::Add(_) | BinOp::Mul(_) => syn::parse_quote_spanned!(span=> #right #op #left),
+                    BinOp::Add(_) | BinOp::Mul(_) => {
+                        syn::parse_quote_spanned!(span=> #right #op #left)
+                    }
                     BinOp::Sub(_) => syn::parse_quote_spanned!(span=> -(#right) + #left),
                     _ => syn::parse_quote_spanned!(span=> (#right).recip() * #left),
                 };
@@ -181,7 +228,10 @@ impl Rewriter<'_> {
             }
             _ => {
                 let (left, right) = (lift(left, lc), lift(right, rc));
-                (syn::parse_quote_spanned!(span=> #left #op #right), Class::Dual)
+                (
+                    syn::parse_quote_spanned!(span=> #left #op #right),
+                    Class::Dual,
+                )
             }
         }
     }
@@ -198,8 +248,18 @@ impl Rewriter<'_> {
                 None => (expr.clone(), Class::Dual),
             },
             Expr::Path(p) => {
-                let constant = p.path.get_ident().is_some_and(|i| self.parameters.contains(i));
-                (expr.clone(), if constant { Class::Constant } else { Class::Dual })
+                let constant = p
+                    .path
+                    .get_ident()
+                    .is_some_and(|i| self.parameters.contains(i));
+                (
+                    expr.clone(),
+                    if constant {
+                        Class::Constant
+                    } else {
+                        Class::Dual
+                    },
+                )
             }
             Expr::Paren(p) => {
                 let (inner, class) = self.expr(&p.expr);

@@ -24,7 +24,10 @@ pub fn parse(expr: &Expr) -> syn::Result<TokenStream> {
             Ok(quote_spanned!(span=> ::dirac::Quadrature::trapezoid()))
         }
         Expr::Call(call) if callee(call).as_deref() == Some("galerkin") => galerkin(call),
-        _ => Err(syn::Error::new(span, format!("unknown quadrature; {EXPECTED}"))),
+        _ => Err(syn::Error::new(
+            span,
+            format!("unknown quadrature; {EXPECTED}"),
+        )),
     }
 }
 
@@ -38,8 +41,13 @@ pub fn callee(call: &ExprCall) -> Option<String> {
 
 fn count(expr: &Expr, what: &str) -> syn::Result<usize> {
     match expr {
-        Expr::Lit(ExprLit { lit: Lit::Int(lit), .. }) => lit.base10_parse(),
-        _ => Err(syn::Error::new(expr.span(), format!("the {what} must be an integer literal"))),
+        Expr::Lit(ExprLit {
+            lit: Lit::Int(lit), ..
+        }) => lit.base10_parse(),
+        _ => Err(syn::Error::new(
+            expr.span(),
+            format!("the {what} must be an integer literal"),
+        )),
     }
 }
 
@@ -61,13 +69,23 @@ fn galerkin(call: &ExprCall) -> syn::Result<TokenStream> {
     let (lobatto, nodes, rule_span) = match args.get(1) {
         None => (false, degree, call.span()),
         Some(Expr::Call(rule))
-            if matches!(callee(rule).as_deref(), Some("gauss_legendre" | "gauss_lobatto")) =>
+            if matches!(
+                callee(rule).as_deref(),
+                Some("gauss_legendre" | "gauss_lobatto")
+            ) =>
         {
             if rule.args.len() != 1 {
-                return Err(syn::Error::new(rule.span(), "a rule takes its number of nodes: gauss_legendre(r)"));
+                return Err(syn::Error::new(
+                    rule.span(),
+                    "a rule takes its number of nodes: gauss_legendre(r)",
+                ));
             }
             let nodes = count(&rule.args[0], "number of nodes")?;
-            (callee(rule).as_deref() == Some("gauss_lobatto"), nodes, rule.span())
+            (
+                callee(rule).as_deref() == Some("gauss_lobatto"),
+                nodes,
+                rule.span(),
+            )
         }
         Some(other) => {
             return Err(syn::Error::new(

@@ -38,8 +38,11 @@ impl Errors {
 /// What validation produced: a model, or errors plus the coordinates when they were readable
 /// (so a stub implementation can stop the errors from cascading into the user's code).
 pub enum Outcome {
-    Valid(Model),
-    Invalid { errors: Errors, coordinates: Option<Vec<Coordinate>> },
+    Valid(Box<Model>),
+    Invalid {
+        errors: Errors,
+        coordinates: Option<Vec<Coordinate>>,
+    },
 }
 
 /// Validates the arguments against the struct.
@@ -49,7 +52,11 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
     let mut lagrangian: Option<(Span, Expr)> = None;
     let mut quadrature_expr: Option<(Span, Expr)> = None;
     for entry in arguments.entries {
-        let key = entry.path().get_ident().map(|i| i.to_string()).unwrap_or_default();
+        let key = entry
+            .path()
+            .get_ident()
+            .map(|i| i.to_string())
+            .unwrap_or_default();
         let span = entry.path().span();
         let duplicate = match key.as_str() {
             "coordinates" => coordinates.is_some(),
@@ -91,7 +98,10 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
             Some(list)
         }
         None => {
-            errors.push(Span::call_site(), "missing `coordinates(...)`: name the coordinates, e.g. coordinates(x, theta[4])");
+            errors.push(
+                Span::call_site(),
+                "missing `coordinates(...)`: name the coordinates, e.g. coordinates(x, theta[4])",
+            );
             None
         }
     };
@@ -117,9 +127,18 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
     };
     match (coordinates, lagrangian, quadrature) {
         (Some(coordinates), Some(lagrangian), Some(quadrature)) if errors.is_empty() => {
-            Outcome::Valid(Model { item, coordinates, lagrangian, quadrature, parameters })
+            Outcome::Valid(Box::new(Model {
+                item,
+                coordinates,
+                lagrangian,
+                quadrature,
+                parameters,
+            }))
         }
-        (coordinates, ..) => Outcome::Invalid { errors, coordinates },
+        (coordinates, ..) => Outcome::Invalid {
+            errors,
+            coordinates,
+        },
     }
 }
 
@@ -166,7 +185,10 @@ fn check_coordinates(
         if parameters.iter().any(|p| p.name == c.name) {
             errors.push(
                 c.name.span(),
-                format!("`{}` is both a coordinate and a parameter field; rename one", c.name),
+                format!(
+                    "`{}` is both a coordinate and a parameter field; rename one",
+                    c.name
+                ),
             );
         }
         if let Some(Length::Literal(0, span)) = &c.length {
@@ -212,11 +234,15 @@ fn parameters(item: &syn::ItemStruct, errors: &mut Errors) -> Vec<Parameter> {
         Fields::Named(named) => &named.named,
         Fields::Unit => return Vec::new(),
         Fields::Unnamed(f) => {
-            errors.push(f.span(), "parameters need names: use a struct with named fields");
+            errors.push(
+                f.span(),
+                "parameters need names: use a struct with named fields",
+            );
             return Vec::new();
         }
     };
-    let is_f64 = |ty: &Type| matches!(ty, Type::Path(p) if p.qself.is_none() && p.path.is_ident("f64"));
+    let is_f64 =
+        |ty: &Type| matches!(ty, Type::Path(p) if p.qself.is_none() && p.path.is_ident("f64"));
     fields
         .iter()
         .filter_map(|field| {

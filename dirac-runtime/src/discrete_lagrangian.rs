@@ -24,9 +24,18 @@ pub(crate) struct Seed {
 }
 
 impl Seed {
-    pub const POSITION: Seed = Seed { position: 1.0, velocity: 0.0 };
-    pub const VELOCITY: Seed = Seed { position: 0.0, velocity: 1.0 };
-    pub const NONE: Seed = Seed { position: 0.0, velocity: 0.0 };
+    pub const POSITION: Seed = Seed {
+        position: 1.0,
+        velocity: 0.0,
+    };
+    pub const VELOCITY: Seed = Seed {
+        position: 0.0,
+        velocity: 1.0,
+    };
+    pub const NONE: Seed = Seed {
+        position: 0.0,
+        velocity: 0.0,
+    };
 }
 
 /// `L` with its gradients along two seeded directions and the mixed second derivative.
@@ -54,17 +63,24 @@ pub(crate) fn seeded<S: DiracSystem<N>, const N: usize>(
             let eps1 = if wx == 0.0 {
                 Derivative::none()
             } else {
-                Derivative::some(SVector::<f64, N>::from_fn(|i, _| if i == c { wx } else { 0.0 }))
+                Derivative::some(SVector::<f64, N>::from_fn(
+                    |i, _| if i == c { wx } else { 0.0 },
+                ))
             };
             let eps2 = if wy == 0.0 {
                 Derivative::none()
             } else {
-                Derivative::some(SMatrix::<f64, 1, N>::from_fn(|_, i| if i == c { wy } else { 0.0 }))
+                Derivative::some(SMatrix::<f64, 1, N>::from_fn(
+                    |_, i| if i == c { wy } else { 0.0 },
+                ))
             };
             H::<N>::new(value[c], eps1, eps2, Derivative::none())
         })
     };
-    let l = system.lagrangian(&lift(q, x.position, y.position), &lift(v, x.velocity, y.velocity));
+    let l = system.lagrangian(
+        &lift(q, x.position, y.position),
+        &lift(v, x.velocity, y.velocity),
+    );
     Seeded {
         value: l.re,
         first: l.eps1.unwrap_generic(Const::<N>, U1),
@@ -98,7 +114,11 @@ pub struct DiscreteLagrangian<S, const N: usize> {
 impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
     /// `L_d` for step `h`.
     pub fn new(system: S, quadrature: Quadrature, h: f64) -> Self {
-        Self { system, quadrature, h }
+        Self {
+            system,
+            quadrature,
+            h,
+        }
     }
 
     /// The continuous system.
@@ -139,7 +159,11 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
     /// # Panics
     /// If `points.len()` is not the quadrature's degree plus one.
     pub fn value(&self, points: &[SVector<f64, N>]) -> f64 {
-        assert_eq!(points.len(), self.quadrature.degree() + 1, "L_d takes degree + 1 points");
+        assert_eq!(
+            points.len(),
+            self.quadrature.degree() + 1,
+            "L_d takes degree + 1 points"
+        );
         let increments: Vec<_> = points[1..].iter().map(|q| q - points[0]).collect();
         (0..self.quadrature.nodes().len())
             .map(|i| {
@@ -181,8 +205,14 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
                     &self.system,
                     &q,
                     &v,
-                    Seed { position: a(0), velocity: d(0) },
-                    Seed { position: a(1), velocity: d(1) },
+                    Seed {
+                        position: a(0),
+                        velocity: d(0),
+                    },
+                    Seed {
+                        position: a(1),
+                        velocity: d(1),
+                    },
                 );
                 let mut r = residual.rows_mut(0, N);
                 r += l.first * w;
@@ -217,7 +247,10 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
                 }
             }
         }
-        StepEquations { impulse, scale: magnitude.amax() }
+        StepEquations {
+            impulse,
+            scale: magnitude.amax(),
+        }
     }
 }
 
@@ -264,15 +297,18 @@ mod tests {
     fn check(quadrature: Quadrature) {
         let s = quadrature.degree();
         let ld = DiscreteLagrangian::new(Coupled, quadrature, 0.1);
-        let points: Vec<_> =
-            (0..=s).map(|j| vector![0.3 + 0.05 * j as f64, -0.2 + 0.03 * (j * j) as f64]).collect();
+        let points: Vec<_> = (0..=s)
+            .map(|j| vector![0.3 + 0.05 * j as f64, -0.2 + 0.03 * (j * j) as f64])
+            .collect();
         let p = vector![0.7, -0.4];
         let mut r = DVector::zeros(2 * s);
         let mut jac = DMatrix::zeros(2 * s, 2 * s);
         let increments = |points: &[SVector<f64, 2>]| -> Vec<SVector<f64, 2>> {
             points[1..].iter().map(|q| q - points[0]).collect()
         };
-        let impulse = ld.euler_lagrange(&points[0], &increments(&points), &p, &mut r, &mut jac).impulse;
+        let impulse = ld
+            .euler_lagrange(&points[0], &increments(&points), &p, &mut r, &mut jac)
+            .impulse;
         for c in 0..2 {
             assert!((r[c] - p[c] - fd(&ld, &points, 0, c)).abs() < 1e-8);
             for j in 1..s {

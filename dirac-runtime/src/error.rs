@@ -24,7 +24,9 @@ pub enum DiracError {
     #[error("invalid quadrature: {0}")]
     InvalidQuadrature(String),
     /// [`Stepper::step`](crate::Stepper::step) was called before the initial state was set.
-    #[error("the stepper has no initial state: call start_from_velocity or start_from_momentum first")]
+    #[error(
+        "the stepper has no initial state: call start_from_velocity or start_from_momentum first"
+    )]
     NotStarted,
     /// Newton's method did not reach the tolerance within its iteration cap.
     #[error(

@@ -49,8 +49,8 @@ pub(crate) fn factorise(
 /// Solves `A x = b` in place of `b` with the factors from [`factorise`].
 pub(crate) fn solve(lu: &DMatrix<f64>, pivots: &[usize], b: &mut DVector<f64>) {
     let n = lu.nrows();
-    for k in 0..n {
-        b.swap_rows(k, pivots[k]);
+    for (k, &p) in pivots.iter().enumerate().take(n) {
+        b.swap_rows(k, p);
     }
     for i in 0..n {
         let mut s = b[i];

@@ -109,7 +109,11 @@ impl Newton {
 
     /// Solves `F(x) = 0` from the initial guess in `x`; `x` holds the solution on success and an
     /// unspecified iterate on failure.
-    pub fn solve<F>(&mut self, x: &mut DVector<f64>, mut evaluate: F) -> Result<NewtonReport, NewtonFailure>
+    pub fn solve<F>(
+        &mut self,
+        x: &mut DVector<f64>,
+        mut evaluate: F,
+    ) -> Result<NewtonReport, NewtonFailure>
     where
         F: FnMut(&DVector<f64>, &mut DVector<f64>, &mut DMatrix<f64>) -> f64,
     {
@@ -128,29 +132,44 @@ impl Newton {
             let settled = last_update <= self.options.step_tolerance * (1.0 + x.amax());
             let converged = residual <= tolerance && (settled || residual == 0.0);
             if converged && iteration > 1 {
-                return Ok(NewtonReport { iterations: iteration, residual });
+                return Ok(NewtonReport {
+                    iterations: iteration,
+                    residual,
+                });
             }
             if self.jacobian.iter().any(|v| !v.is_finite()) {
                 return Err(NewtonFailure::NonFinite);
             }
             // Factorised even when the initial guess already solves the equations: a solution
             // is only accepted where the Jacobian shows it is unique.
-            lu::factorise(&mut self.jacobian, &mut self.pivots, self.options.singular_tolerance)
-                .map_err(NewtonFailure::Singular)?;
+            lu::factorise(
+                &mut self.jacobian,
+                &mut self.pivots,
+                self.options.singular_tolerance,
+            )
+            .map_err(NewtonFailure::Singular)?;
             if converged {
-                return Ok(NewtonReport { iterations: iteration, residual });
+                return Ok(NewtonReport {
+                    iterations: iteration,
+                    residual,
+                });
             }
             lu::solve(&self.jacobian, &self.pivots, &mut self.residual);
             *x -= &self.residual;
             last_update = self.residual.amax();
         }
-        Err(NewtonFailure::NoConvergence { residual, iterations: self.options.max_iterations })
+        Err(NewtonFailure::NoConvergence {
+            residual,
+            iterations: self.options.max_iterations,
+        })
     }
 }
 
 /// `‖A‖∞`, the largest absolute row sum.
 fn row_sum_norm(a: &DMatrix<f64>) -> f64 {
-    a.row_iter().map(|row| row.iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max)
+    a.row_iter()
+        .map(|row| row.iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
 }
 
 #[cfg(test)]
@@ -176,7 +195,13 @@ mod tests {
 
     #[test]
     fn reports_no_convergence_and_singularity() {
-        let mut newton = Newton::new(1, NewtonOptions { max_iterations: 3, ..Default::default() });
+        let mut newton = Newton::new(
+            1,
+            NewtonOptions {
+                max_iterations: 3,
+                ..Default::default()
+            },
+        );
         let mut x = DVector::from_element(1, 0.3);
         // x² + 1 = 0 has no real root.
         let err = newton.solve(&mut x, |x, r, j| {
@@ -184,13 +209,19 @@ mod tests {
             j[(0, 0)] = 2.0 * x[0];
             1.0
         });
-        assert!(matches!(err, Err(NewtonFailure::NoConvergence { iterations: 3, .. })));
+        assert!(matches!(
+            err,
+            Err(NewtonFailure::NoConvergence { iterations: 3, .. })
+        ));
         let mut x = DVector::from_element(1, 0.0);
         let err = newton.solve(&mut x, |x, r, j| {
             r[0] = x[0] * x[0] + 1.0;
             j[(0, 0)] = 2.0 * x[0];
             1.0
         });
-        assert_eq!(err, Err(NewtonFailure::Singular(SingularPivot { column: 0 })));
+        assert_eq!(
+            err,
+            Err(NewtonFailure::Singular(SingularPivot { column: 0 }))
+        );
     }
 }

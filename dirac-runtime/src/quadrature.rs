@@ -86,14 +86,18 @@ impl Quadrature {
     pub fn galerkin(degree: usize, rule: Rule) -> Result<Self, DiracError> {
         let invalid = |msg: String| Err(DiracError::InvalidQuadrature(msg));
         if degree == 0 || degree > MAX_DEGREE {
-            return invalid(format!("the degree must be between 1 and {MAX_DEGREE}, got {degree}"));
+            return invalid(format!(
+                "the degree must be between 1 and {MAX_DEGREE}, got {degree}"
+            ));
         }
         let (nodes, needed) = match rule {
             Rule::GaussLegendre(r) => (r, degree),
             Rule::GaussLobatto(r) => (r, degree + 1),
         };
         if nodes > MAX_NODES {
-            return invalid(format!("at most {MAX_NODES} nodes are supported, got {nodes}"));
+            return invalid(format!(
+                "at most {MAX_NODES} nodes are supported, got {nodes}"
+            ));
         }
         if nodes < needed {
             return invalid(format!(
@@ -137,7 +141,14 @@ impl Quadrature {
                 basis_derivative.push(lagrange_derivative(&points, j, c));
             }
         }
-        Self { degree, rule, nodes, weights, basis, basis_derivative }
+        Self {
+            degree,
+            rule,
+            nodes,
+            weights,
+            basis,
+            basis_derivative,
+        }
     }
 
     /// Interpolation degree `s`: the path on a step is a polynomial of this degree.
@@ -286,7 +297,11 @@ mod tests {
 
     /// Integrates `t^k` on [0, 1] with the rule.
     fn integrate(q: &Quadrature, k: i32) -> f64 {
-        q.nodes().iter().zip(q.weights()).map(|(c, w)| w * c.powi(k)).sum()
+        q.nodes()
+            .iter()
+            .zip(q.weights())
+            .map(|(c, w)| w * c.powi(k))
+            .sum()
     }
 
     #[test]
@@ -327,7 +342,9 @@ mod tests {
         let dp = |t: f64| 2.0 - 3.0 * t * t;
         for (i, &c) in q.nodes().iter().enumerate() {
             let value: f64 = (0..=3).map(|j| q.basis(i, j) * p(j as f64 / 3.0)).sum();
-            let slope: f64 = (0..=3).map(|j| q.basis_derivative(i, j) * p(j as f64 / 3.0)).sum();
+            let slope: f64 = (0..=3)
+                .map(|j| q.basis_derivative(i, j) * p(j as f64 / 3.0))
+                .sum();
             assert!((value - p(c)).abs() < 1e-14);
             assert!((slope - dp(c)).abs() < 1e-13);
         }

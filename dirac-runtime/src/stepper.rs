@@ -36,13 +36,24 @@ struct State<const N: usize> {
 
 impl<const N: usize> State<N> {
     fn new(t: f64, q: SVector<f64, N>, p: SVector<f64, N>, v_hint: SVector<f64, N>) -> Self {
-        Self { t, q, p, v_hint, q_carry: SVector::zeros(), p_carry: SVector::zeros() }
+        Self {
+            t,
+            q,
+            p,
+            v_hint,
+            q_carry: SVector::zeros(),
+            p_carry: SVector::zeros(),
+        }
     }
 }
 
 /// `sum += increment` with Kahan compensation: over millions of steps the state then carries
 /// round-off from each increment, not from each sum.
-fn compensated_add<const N: usize>(sum: &mut SVector<f64, N>, carry: &mut SVector<f64, N>, increment: &SVector<f64, N>) {
+fn compensated_add<const N: usize>(
+    sum: &mut SVector<f64, N>,
+    carry: &mut SVector<f64, N>,
+    increment: &SVector<f64, N>,
+) {
     for i in 0..sum.len() {
         let y = increment[i] - carry[i];
         let t = sum[i] + y;
@@ -100,8 +111,15 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         if !(h > 0.0 && h.is_finite()) {
             return Err(DiracError::InvalidStep { h });
         }
-        if let Some((name, value)) = system.parameters().into_iter().find(|(_, v)| !v.is_finite()) {
-            return Err(DiracError::NonFinite { what: format!("parameter {name}"), value });
+        if let Some((name, value)) = system
+            .parameters()
+            .into_iter()
+            .find(|(_, v)| !v.is_finite())
+        {
+            return Err(DiracError::NonFinite {
+                what: format!("parameter {name}"),
+                value,
+            });
         }
         let unknowns = N * quadrature.degree();
         let increments = vec![SVector::zeros(); quadrature.degree()];
@@ -179,7 +197,9 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             None => {
                 for j in 0..s {
                     let c = (j + 1) as f64 / s as f64;
-                    self.unknowns.rows_mut(j * N, N).copy_from(&(state.v_hint * (c * h)));
+                    self.unknowns
+                        .rows_mut(j * N, N)
+                        .copy_from(&(state.v_hint * (c * h)));
                 }
             }
         }
@@ -284,8 +304,14 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     pub fn v(&self) -> Result<SVector<f64, N>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
         let mut newton = Newton::new(N, *self.newton.options());
-        legendre::velocity(self.system(), &mut newton, &state.q, &state.p, &state.v_hint)
-            .map_err(|f| self.failure(LEGENDRE, f, N))
+        legendre::velocity(
+            self.system(),
+            &mut newton,
+            &state.q,
+            &state.p,
+            &state.v_hint,
+        )
+        .map_err(|f| self.failure(LEGENDRE, f, N))
     }
 
     /// Energy `⟨p, v⟩ − L(q, v)` of the current state, with `v` from [`v`](Self::v).
@@ -317,7 +343,10 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     /// Turns a Newton failure into an error naming the step and, if singular, the unknowns.
     fn failure(&self, problem: &'static str, failure: NewtonFailure, size: usize) -> DiracError {
         match failure {
-            NewtonFailure::NoConvergence { residual, iterations } => DiracError::NoConvergence {
+            NewtonFailure::NoConvergence {
+                residual,
+                iterations,
+            } => DiracError::NoConvergence {
                 problem,
                 step: self.steps,
                 residual,
@@ -333,7 +362,11 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                     (false, j) if j == s => "q_{k+1}".to_string(),
                     (false, j) => format!("internal point {j}"),
                 };
-                DiracError::SingularJacobian { problem, step: self.steps, unknowns: format!("{name} ({slot})") }
+                DiracError::SingularJacobian {
+                    problem,
+                    step: self.steps,
+                    unknowns: format!("{name} ({slot})"),
+                }
             }
             NewtonFailure::NonFinite => DiracError::NonFinite {
                 what: format!("the residual of {problem} at step {}", self.steps),

@@ -34,7 +34,13 @@ impl<const N: usize> Trajectory<N> {
     /// An empty trajectory whose coordinates are called `names` (one per coordinate).
     pub fn new(names: Vec<String>) -> Self {
         debug_assert_eq!(names.len(), N);
-        Self { names, t: Vec::new(), q: Vec::new(), p: Vec::new(), energy: Vec::new() }
+        Self {
+            names,
+            t: Vec::new(),
+            q: Vec::new(),
+            p: Vec::new(),
+            energy: Vec::new(),
+        }
     }
 
     /// Appends a sample.
@@ -82,7 +88,9 @@ impl<const N: usize> Trajectory<N> {
 
     /// `max_k |E_k − E_0|`: the largest energy error against the first sample (0 when empty).
     pub fn max_energy_error(&self) -> f64 {
-        let Some(&e0) = self.energy.first() else { return 0.0 };
+        let Some(&e0) = self.energy.first() else {
+            return 0.0;
+        };
         self.energy.iter().fold(0.0, |m, e| m.max((e - e0).abs()))
     }
 
@@ -102,7 +110,8 @@ impl<const N: usize> Trajectory<N> {
             row.extend(self.q[k].iter());
             row.extend(self.p[k].iter());
             row.push(self.energy[k]);
-            w.write_record(row.iter().map(|x| x.to_string())).map_err(io)?;
+            w.write_record(row.iter().map(|x| x.to_string()))
+                .map_err(io)?;
         }
         w.flush().map_err(|e| DiracError::Io(e.to_string()))
     }
@@ -114,6 +123,8 @@ impl<const N: usize> Trajectory<N> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(io)?;
         }
-        self.write_csv(std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?))
+        self.write_csv(std::io::BufWriter::new(
+            std::fs::File::create(path).map_err(io)?,
+        ))
     }
 }

@@ -36,7 +36,11 @@ pub fn initial<const L: usize>() -> SVector<f64, L> {
     SVector::from_fn(|i, _| 0.5 + if i % 2 == 0 { 0.3 } else { -0.3 })
 }
 
-pub const SCENE8: Chain<8> = Chain { m: 1.0, l: 1.0, g: 9.81 };
+pub const SCENE8: Chain<8> = Chain {
+    m: 1.0,
+    l: 1.0,
+    g: 9.81,
+};
 
 pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
     let (h, steps) = (0.005, 2000);
@@ -44,7 +48,10 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
     let mut stepper = Stepper::new(SCENE8, quadrature, h)?;
     stepper.start_from_velocity(initial(), SVector::zeros())?;
     let (trajectory, wall) = timed(&mut stepper, steps, 10)?;
-    trajectory.save_csv(format!("output/chain8_{}.csv", super::oscillator::file_name(&name)))?;
+    trajectory.save_csv(format!(
+        "output/chain8_{}.csv",
+        super::oscillator::file_name(&name)
+    ))?;
     Ok(Report {
         scene: "chain (8 links)",
         quadrature: name,

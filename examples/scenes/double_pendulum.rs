@@ -24,7 +24,13 @@ pub struct DoublePendulum {
     pub g: f64,
 }
 
-pub const SCENE: DoublePendulum = DoublePendulum { m1: 1.0, m2: 2.0, l1: 2.0, l2: 3.0, g: 9.80665 };
+pub const SCENE: DoublePendulum = DoublePendulum {
+    m1: 1.0,
+    m2: 2.0,
+    l1: 2.0,
+    l2: 3.0,
+    g: 9.80665,
+};
 
 pub fn q0() -> SVector<f64, 2> {
     vector![PI / 4.0, PI / 2.0]
@@ -56,7 +62,10 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
     let name = quadrature.name();
     let mut stepper = stepper(quadrature, h)?;
     let (trajectory, wall) = timed(&mut stepper, steps, 1)?;
-    trajectory.save_csv(format!("output/double_pendulum_{}.csv", super::oscillator::file_name(&name)))?;
+    trajectory.save_csv(format!(
+        "output/double_pendulum_{}.csv",
+        super::oscillator::file_name(&name)
+    ))?;
     let newton = stepper.last_report().map_or(0, |r| r.iterations);
     Ok(Report {
         scene: "double pendulum",

@@ -12,7 +12,13 @@ fn derivatives(
     s: &DoublePendulum,
     q: &SVector<f64, 2>,
     v: &SVector<f64, 2>,
-) -> (SVector<f64, 2>, SVector<f64, 2>, SMatrix<f64, 2, 2>, SMatrix<f64, 2, 2>, SMatrix<f64, 2, 2>) {
+) -> (
+    SVector<f64, 2>,
+    SVector<f64, 2>,
+    SMatrix<f64, 2, 2>,
+    SMatrix<f64, 2, 2>,
+    SMatrix<f64, 2, 2>,
+) {
     let a = (s.m1 + s.m2) * s.l1 * s.l1;
     let b = s.m2 * s.l2 * s.l2;
     let c = s.m2 * s.l1 * s.l2;

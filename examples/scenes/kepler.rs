@@ -36,7 +36,10 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
     let mut stepper = Stepper::new(SCENE, quadrature, h)?;
     stepper.start_from_momentum(q0(), p0())?;
     let (trajectory, wall) = timed(&mut stepper, steps, 10)?;
-    trajectory.save_csv(format!("output/kepler_{}.csv", super::oscillator::file_name(&name)))?;
+    trajectory.save_csv(format!(
+        "output/kepler_{}.csv",
+        super::oscillator::file_name(&name)
+    ))?;
     let l0 = angular_momentum(&q0(), &p0());
     let drift = trajectory
         .q()

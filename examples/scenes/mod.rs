@@ -52,8 +52,8 @@ pub fn quadratures() -> Vec<Quadrature> {
 /// Prints reports as an aligned table.
 pub fn print_table(reports: &[Report]) {
     println!(
-        "{:<16} {:<32} {:>7} {:>8} {:>12} {:>10}  {}",
-        "scene", "quadrature", "h", "steps", "max |ΔE|", "wall", "check"
+        "{:<16} {:<32} {:>7} {:>8} {:>12} {:>10}  check",
+        "scene", "quadrature", "h", "steps", "max |ΔE|", "wall"
     );
     for r in reports {
         println!(
@@ -70,7 +70,10 @@ pub fn save_table(reports: &[Report], path: &str) -> std::io::Result<()> {
         std::fs::create_dir_all(dir)?;
     }
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(f, "scene,quadrature,h,steps,max_energy_error,wall_seconds,check")?;
+    writeln!(
+        f,
+        "scene,quadrature,h,steps,max_energy_error,wall_seconds,check"
+    )?;
     for r in reports {
         writeln!(
             f,

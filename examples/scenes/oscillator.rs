@@ -29,7 +29,12 @@ pub fn max_error(quadrature: Quadrature, h: f64) -> Result<f64, DiracError> {
     let mut stepper = Stepper::new(SCENE, quadrature, h)?;
     stepper.start_from_momentum(vector![Q0], vector![0.0])?;
     let trajectory = stepper.run((1.0 / h).round() as usize)?;
-    Ok(trajectory.t().iter().zip(trajectory.q()).map(|(t, q)| (q[0] - exact(*t)).abs()).fold(0.0, f64::max))
+    Ok(trajectory
+        .t()
+        .iter()
+        .zip(trajectory.q())
+        .map(|(t, q)| (q[0] - exact(*t)).abs())
+        .fold(0.0, f64::max))
 }
 
 pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
@@ -46,11 +51,18 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         steps,
         max_energy_error: trajectory.max_energy_error(),
         wall,
-        check: format!("max |q − q_exact| on [0, 1] = {:.2e}", max_error(quadrature, h)?),
+        check: format!(
+            "max |q − q_exact| on [0, 1] = {:.2e}",
+            max_error(quadrature, h)?
+        ),
     })
 }
 
 /// A quadrature's name as a file name.
 pub fn file_name(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect::<String>().trim_end_matches('_').to_string()
+    name.chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect::<String>()
+        .trim_end_matches('_')
+        .to_string()
 }

@@ -17,7 +17,11 @@ pub struct Pendulum {
 }
 
 /// Unit pendulum: q̈ = −sin q.
-pub const SCENE: Pendulum = Pendulum { m: 1.0, l: 1.0, g: 1.0 };
+pub const SCENE: Pendulum = Pendulum {
+    m: 1.0,
+    l: 1.0,
+    g: 1.0,
+};
 pub const Q5: f64 = -0.02395128485293;
 pub const P5: f64 = 0.95855190346756;
 
@@ -37,7 +41,10 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
     let mut stepper = Stepper::new(SCENE, quadrature.clone(), h)?;
     stepper.start_from_momentum(vector![1.0], vector![0.0])?;
     let (trajectory, wall) = timed(&mut stepper, steps, 10)?;
-    trajectory.save_csv(format!("output/pendulum_{}.csv", super::oscillator::file_name(&name)))?;
+    trajectory.save_csv(format!(
+        "output/pendulum_{}.csv",
+        super::oscillator::file_name(&name)
+    ))?;
     Ok(Report {
         scene: "pendulum",
         quadrature: name,

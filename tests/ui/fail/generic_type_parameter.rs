@@ -1,0 +1,8 @@
+use dirac::prelude::*;
+
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2))]
+struct Particle<T> {
+    tag: T,
+}
+
+fn main() {}

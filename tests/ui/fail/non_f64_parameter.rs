@@ -1,0 +1,9 @@
+use dirac::prelude::*;
+
+#[dirac_system(coordinates(x), lagrangian = 0.5 * m * dot(x).powi(2))]
+struct Particle {
+    m: f64,
+    links: usize,
+}
+
+fn main() {}
