@@ -27,10 +27,25 @@
 pub use dirac_macros::dirac_system;
 pub use dirac_runtime::*;
 
+/// A static vector `SVector<T, N>` from its entries, like nalgebra's `vector!` but needing no
+/// direct dependency on nalgebra.
+///
+/// ```
+/// let v: dirac::nalgebra::SVector<f64, 3> = dirac::vector![1.0, 2.0, 3.0];
+/// assert_eq!(v[2], 3.0);
+/// ```
+#[macro_export]
+macro_rules! vector {
+    ($($entry:expr),* $(,)?) => {
+        $crate::nalgebra::SVector::from([$($entry),*])
+    };
+}
+
 /// Everything a model file needs: the attribute, the runtime types and `vector!`/`SVector`.
 pub mod prelude {
+    pub use crate::vector;
     pub use dirac_macros::dirac_system;
-    pub use dirac_runtime::nalgebra::{SMatrix, SVector, vector};
+    pub use dirac_runtime::nalgebra::{SMatrix, SVector};
     pub use dirac_runtime::{
         DiracError, DiracSystem, DiscreteLagrangian, DualNum, NewtonOptions, Quadrature, Rule,
         Scalar, Stepper, Trajectory,

@@ -12,16 +12,42 @@ mod validate;
 
 /// Turns a struct of parameters into a `dirac::DiracSystem`.
 ///
-/// ```ignore
+/// Arguments, in any order:
+/// - `coordinates(x, y, theta[8])`: the coordinates, single or arrays (an array length is a
+///   literal, a constant, or the struct's const parameter);
+/// - `lagrangian = EXPR`: the Lagrangian in the coordinates, their velocities `dot(x)`,
+///   `dot(theta[i])`, and the fields (parameters, `f64` or `[f64; K]`), with `+ - * /`, numeric
+///   literals, `sin cos tan asin acos atan sinh cosh tanh asinh acosh atanh exp exp2 exp_m1 ln
+///   ln_1p log2 log10 sqrt cbrt recip abs` of one argument, `powi(x, n)`, `powf(x, c)`,
+///   `pow(x, y)`, `atan2(y, x)`, and methods of the same names (`dot(x).powi(2)`);
+///   or `lagrangian = path::to::function`, a generic
+///   `fn<D: Scalar>(&Model, &SVector<D, N>, &SVector<D, N>) -> D` for big models;
+/// - `quadrature = midpoint | trapezoid | galerkin(s) | galerkin(s, gauss_legendre(r)) |
+///   galerkin(s, gauss_lobatto(r))`: the default quadrature (`midpoint` if omitted).
+///
+/// Every malformed input is a compile error on the offending tokens.
+///
+/// ```
+/// use dirac::prelude::*;
+///
 /// #[dirac_system(
 ///     coordinates(theta1, theta2),
-///     lagrangian = 0.5 * m * dot(theta1).powi(2) + m * g * l * cos(theta1) + ...,
+///     lagrangian = 0.5 * (m1 + m2) * l1 * l1 * dot(theta1).powi(2)
+///         + 0.5 * m2 * l2 * l2 * dot(theta2).powi(2)
+///         + m2 * l1 * l2 * dot(theta1) * dot(theta2) * cos(theta1 - theta2)
+///         + (m1 + m2) * g * l1 * cos(theta1)
+///         + m2 * g * l2 * cos(theta2),
 ///     quadrature = galerkin(2),
 /// )]
-/// struct DoublePendulum { m: f64, l: f64, g: f64 }
-/// ```
+/// struct DoublePendulum { m1: f64, m2: f64, l1: f64, l2: f64, g: f64 }
 ///
-/// See the `dirac` crate for the full syntax.
+/// let model = DoublePendulum { m1: 1.0, m2: 1.0, l1: 1.0, l2: 1.0, g: 9.81 };
+/// assert_eq!(model.coordinate_name(1), "theta2");
+/// let mut stepper = Stepper::from_system(model, 0.01)?;
+/// stepper.start_from_velocity(vector![0.5, 0.0], vector![0.0, 0.0])?;
+/// stepper.run(100)?;
+/// # Ok::<(), DiracError>(())
+/// ```
 #[proc_macro_attribute]
 pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
     expand::dirac_system(args.into(), item.into()).into()
