@@ -51,3 +51,8 @@ pub mod prelude {
         Scalar, Stepper, Trajectory,
     };
 }
+
+/// The README's examples are compiled and run as doctests, so the front door stays true.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
