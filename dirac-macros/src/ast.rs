@@ -5,6 +5,8 @@ use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
 use syn::{Expr, Ident, Token, bracketed};
 
+pub use crate::one_form::Term;
+
 /// Length of a coordinate array: a literal or the name of a constant (or const parameter).
 #[derive(Clone)]
 pub enum Length {
@@ -87,11 +89,65 @@ pub struct Parameter {
     pub array: bool,
 }
 
-/// Everything `expand` needs, validated.
+/// Everything `expand` needs, validated; expressions already rewritten for the scalar `__D`.
 pub struct Model {
     pub item: syn::ItemStruct,
     pub coordinates: Vec<Coordinate>,
     pub lagrangian: Lagrangian,
     pub quadrature: TokenStream,
     pub parameters: Vec<Parameter>,
+    /// Constraint one-forms, each a list of terms.
+    pub one_forms: Vec<Vec<Term>>,
+    /// Holonomic constraints `g(q)`.
+    pub holonomic: Vec<Expr>,
+    /// Terms of all force one-forms together.
+    pub forces: Vec<Term>,
+    pub inputs: Vec<Ident>,
+    /// `::dirac::ConstraintPoint::...` when `constraint_at` is given.
+    pub constraint_point: Option<TokenStream>,
+}
+
+/// Number of coordinates as a const expression (a literal when every length is one).
+pub fn dimension(coordinates: &[Coordinate]) -> TokenStream {
+    let literal: Option<usize> = coordinates
+        .iter()
+        .map(|c| match &c.length {
+            None => Some(1),
+            Some(Length::Literal(n, _)) => Some(*n),
+            Some(Length::Named(_)) => None,
+        })
+        .sum();
+    match (literal, coordinates) {
+        (Some(n), _) => quote::quote!(#n),
+        (None, [single]) => single
+            .length
+            .as_ref()
+            .map(Length::tokens)
+            .unwrap_or_default(),
+        (None, _) => {
+            let terms = coordinates.iter().map(|c| {
+                c.length
+                    .as_ref()
+                    .map_or(quote::quote!(1usize), Length::tokens)
+            });
+            quote::quote!({ 0usize #(+ #terms)* })
+        }
+    }
+}
+
+/// Offset of each coordinate in `q` (expressions).
+pub fn offsets(coordinates: &[Coordinate]) -> Vec<TokenStream> {
+    let mut offset = quote::quote!(0usize);
+    coordinates
+        .iter()
+        .map(|c| {
+            let this = offset.clone();
+            let length = c
+                .length
+                .as_ref()
+                .map_or(quote::quote!(1usize), Length::tokens);
+            offset = quote::quote!(#offset + #length);
+            this
+        })
+        .collect()
 }

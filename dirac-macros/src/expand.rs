@@ -4,7 +4,7 @@ use proc_macro2::{Span, TokenStream};
 use quote::{quote, quote_spanned};
 use syn::spanned::Spanned;
 
-use crate::ast::{Arguments, Coordinate, Lagrangian, Length, Model};
+use crate::ast::{Arguments, Coordinate, Lagrangian, Model, dimension, offsets};
 use crate::expression::bind_coordinate;
 use crate::validate::{self, Outcome};
 
@@ -43,46 +43,6 @@ pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
     }
 }
 
-/// Number of coordinates as a const expression (a literal when every length is one).
-fn dimension(coordinates: &[Coordinate]) -> TokenStream {
-    let literal: Option<usize> = coordinates
-        .iter()
-        .map(|c| match &c.length {
-            None => Some(1),
-            Some(Length::Literal(n, _)) => Some(*n),
-            Some(Length::Named(_)) => None,
-        })
-        .sum();
-    match (literal, coordinates) {
-        (Some(n), _) => quote!(#n),
-        (None, [single]) => single
-            .length
-            .as_ref()
-            .map(Length::tokens)
-            .unwrap_or_default(),
-        (None, _) => {
-            let terms = coordinates
-                .iter()
-                .map(|c| c.length.as_ref().map_or(quote!(1usize), Length::tokens));
-            quote!({ 0usize #(+ #terms)* })
-        }
-    }
-}
-
-/// Offsets of each coordinate into `q` (expressions).
-fn offsets(coordinates: &[Coordinate]) -> Vec<TokenStream> {
-    let mut offset = quote!(0usize);
-    coordinates
-        .iter()
-        .map(|c| {
-            let this = offset.clone();
-            let length = c.length.as_ref().map_or(quote!(1usize), Length::tokens);
-            offset = quote!(#offset + #length);
-            this
-        })
-        .collect()
-}
-
 fn header(item: &syn::ItemStruct, n: &TokenStream) -> TokenStream {
     let name = &item.ident;
     let (impl_generics, ty_generics, where_clause) = item.generics.split_for_impl();
@@ -94,28 +54,32 @@ fn expand(model: &Model) -> TokenStream {
     let n = dimension(&model.coordinates);
     let header = header(item, &n);
     let offsets = offsets(&model.coordinates);
+    let bindings = |velocities: bool| {
+        // Parameters stay f64: constant subexpressions cost no dual arithmetic.
+        let parameters = model.parameters.iter().map(|p| {
+            let name = &p.name;
+            quote_spanned!(name.span()=> let #name = self.#name;)
+        });
+        let coordinates = model
+            .coordinates
+            .iter()
+            .zip(&offsets)
+            .map(move |(c, o)| bind_coordinate(c, o, velocities));
+        quote!(#(#parameters)* #(#coordinates)*)
+    };
     let body = match &model.lagrangian {
         Lagrangian::Function(path) => quote_spanned!(path.span()=> #path(self, __q, __v)),
         Lagrangian::Expression(expr) => {
-            let parameters = model.parameters.iter().map(|p| {
-                let name = &p.name;
-                // Parameters stay f64: constant subexpressions cost no dual arithmetic.
-                quote_spanned!(name.span()=> let #name = self.#name;)
-            });
-            let coordinates = model
-                .coordinates
-                .iter()
-                .zip(&offsets)
-                .map(|(c, o)| bind_coordinate(c, o));
+            let bindings = bindings(true);
             let result = quote_spanned!(expr.span()=> let __lagrangian: __D = #expr;);
             quote! {
-                #(#parameters)*
-                #(#coordinates)*
+                #bindings
                 #result
                 __lagrangian
             }
         }
     };
+    let dirac = dirac_items(model, &n, &bindings);
     let names = model.coordinates.iter().zip(&offsets).map(|(c, offset)| {
         let name = c.name.to_string();
         match &c.length {
@@ -174,8 +138,127 @@ fn expand(model: &Model) -> TokenStream {
             fn quadrature(&self) -> ::dirac::Quadrature {
                 #quadrature
             }
+
+            #dirac
         }
     }
+}
+
+/// `Σ_k c_k · e_{i_k}` into a vector named `target`.
+fn accumulate(target: &TokenStream, terms: &[crate::ast::Term]) -> TokenStream {
+    let terms = terms.iter().map(|t| {
+        let (index, coefficient) = (&t.index, &t.coefficient);
+        quote_spanned!(coefficient.span()=> #target[#index] += #coefficient;)
+    });
+    quote!(#(#terms)*)
+}
+
+/// The one-forms, holonomic constraints, forces and inputs: only those the model names.
+fn dirac_items(
+    model: &Model,
+    n: &TokenStream,
+    bindings: &dyn Fn(bool) -> TokenStream,
+) -> TokenStream {
+    let mut items = TokenStream::new();
+    let zero = quote!(<__D as ::core::convert::From<f64>>::from(0.0));
+    if !model.one_forms.is_empty() {
+        let count = model.one_forms.len();
+        let positions = bindings(false);
+        let arms = model.one_forms.iter().enumerate().map(|(a, terms)| {
+            let sum = accumulate(&quote!(__w), terms);
+            quote!(#a => { #sum })
+        });
+        items.extend(quote! {
+            const ONE_FORMS: usize = #count;
+
+            #[allow(unused_variables, non_snake_case, clippy::all)]
+            fn one_form<__D: ::dirac::Scalar>(
+                &self,
+                __q: &::dirac::nalgebra::SVector<__D, #n>,
+                __a: usize,
+            ) -> ::dirac::nalgebra::SVector<__D, #n> {
+                #positions
+                let mut __w = ::dirac::nalgebra::SVector::<__D, #n>::from_element(#zero);
+                match __a {
+                    #(#arms)*
+                    _ => {}
+                }
+                __w
+            }
+        });
+    }
+    if !model.holonomic.is_empty() {
+        let count = model.holonomic.len();
+        let positions = bindings(false);
+        let arms = model
+            .holonomic
+            .iter()
+            .enumerate()
+            .map(|(b, g)| quote!(#b => #g,));
+        items.extend(quote! {
+            const HOLONOMIC: usize = #count;
+
+            #[allow(unused_variables, non_snake_case, clippy::all)]
+            fn holonomic<__D: ::dirac::Scalar>(
+                &self,
+                __q: &::dirac::nalgebra::SVector<__D, #n>,
+                __b: usize,
+            ) -> __D {
+                #positions
+                match __b {
+                    #(#arms)*
+                    _ => #zero,
+                }
+            }
+        });
+    }
+    if !model.forces.is_empty() {
+        let state = bindings(true);
+        let inputs = model
+            .inputs
+            .iter()
+            .enumerate()
+            .map(|(i, u)| quote!(let #u: f64 = __inputs[#i];));
+        let sum = accumulate(&quote!(__f), &model.forces);
+        items.extend(quote! {
+            const FORCES: bool = true;
+
+            #[allow(unused_variables, non_snake_case, clippy::all)]
+            fn force<__D: ::dirac::Scalar>(
+                &self,
+                __q: &::dirac::nalgebra::SVector<__D, #n>,
+                __v: &::dirac::nalgebra::SVector<__D, #n>,
+                t: f64,
+                __inputs: &[f64],
+            ) -> ::dirac::nalgebra::SVector<__D, #n> {
+                #state
+                #(#inputs)*
+                let mut __f = ::dirac::nalgebra::SVector::<__D, #n>::from_element(#zero);
+                #sum
+                __f
+            }
+        });
+    }
+    if !model.inputs.is_empty() {
+        let count = model.inputs.len();
+        let names = model.inputs.iter().map(|u| u.to_string());
+        items.extend(quote! {
+            const INPUTS: usize = #count;
+
+            fn input_name(&self, __i: usize) -> ::std::string::String {
+                let __names: [&str; #count] = [#(#names),*];
+                __names.get(__i).map_or_else(|| ::std::format!("u{}", __i), |s| s.to_string())
+            }
+        });
+    }
+    if let Some(point) = &model.constraint_point {
+        items.extend(quote! {
+            fn constraint_point(&self) -> ::dirac::ConstraintPoint {
+                #point
+            }
+        });
+    }
+    items
 }
 
 /// After an error: an implementation with the right dimension, so that the user's code using

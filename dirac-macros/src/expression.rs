@@ -40,15 +40,21 @@ pub enum Class {
     Dual,
 }
 
+/// Where an expression stands: which names are plain `f64` constants (parameters, and for forces
+/// the inputs and `t`) and whether velocities `dot(...)` may appear.
+pub struct Scope<'a> {
+    pub coordinates: &'a [Coordinate],
+    pub constants: &'a [Ident],
+    /// `None` where velocities are allowed, else what to say when `dot(...)` appears.
+    pub no_velocities: Option<&'static str>,
+}
+
 /// Rewrites `expr`; returns the new expression (of type `__D`) or every error found.
-pub fn rewrite(
-    expr: &Expr,
-    coordinates: &[Coordinate],
-    parameters: &[Ident],
-) -> Result<Expr, Vec<syn::Error>> {
+pub fn rewrite(expr: &Expr, scope: &Scope) -> Result<Expr, Vec<syn::Error>> {
     let mut rewriter = Rewriter {
-        coordinates,
-        parameters,
+        coordinates: scope.coordinates,
+        parameters: scope.constants,
+        no_velocities: scope.no_velocities,
         errors: Vec::new(),
     };
     let (expr, class) = rewriter.expr(expr);
@@ -63,6 +69,7 @@ pub fn rewrite(
 struct Rewriter<'a> {
     coordinates: &'a [Coordinate],
     parameters: &'a [Ident],
+    no_velocities: Option<&'static str>,
     errors: Vec<syn::Error>,
 }
 
@@ -102,6 +109,9 @@ impl Rewriter<'_> {
 
     /// `dot(x)`, `dot(theta)` or `dot(theta[i])`.
     fn velocity(&mut self, call: &ExprCall, original: &Expr) -> (Expr, Class) {
+        if let Some(message) = self.no_velocities {
+            return self.error(call.span(), message, original);
+        }
         if call.args.len() != 1 {
             let message = "dot(...) takes one coordinate, e.g. dot(x) or dot(theta[i])";
             return self.error(call.span(), message, original);
@@ -318,20 +328,29 @@ fn scalar_literal(lit: &Lit) -> Option<Result<Expr, syn::Error>> {
 }
 
 /// Binds a coordinate's position and velocity (`__D`, or `[__D; K]` for an array) from `__q`, `__v`.
-pub fn bind_coordinate(coordinate: &Coordinate, offset: &TokenStream) -> TokenStream {
+/// Without `velocities` only the position is bound (for one-forms and holonomic constraints).
+pub fn bind_coordinate(
+    coordinate: &Coordinate,
+    offset: &TokenStream,
+    velocities: bool,
+) -> TokenStream {
     let name = &coordinate.name;
     let velocity = velocity_ident(name);
     let span = name.span();
-    match &coordinate.length {
-        None => quote_spanned! {span=>
+    match (&coordinate.length, velocities) {
+        (None, true) => quote_spanned! {span=>
             let #name: __D = __q[#offset];
             let #velocity: __D = __v[#offset];
         },
-        Some(length) => {
+        (None, false) => quote_spanned!(span=> let #name: __D = __q[#offset];),
+        (Some(length), velocities) => {
             let length = length.tokens();
+            let velocity = velocities.then(|| quote_spanned! {span=>
+                let #velocity: [__D; #length] = ::core::array::from_fn(|__i| __v[#offset + __i]);
+            });
             quote_spanned! {span=>
                 let #name: [__D; #length] = ::core::array::from_fn(|__i| __q[#offset + __i]);
-                let #velocity: [__D; #length] = ::core::array::from_fn(|__i| __v[#offset + __i]);
+                #velocity
             }
         }
     }

@@ -7,6 +7,7 @@ use proc_macro::TokenStream;
 mod ast;
 mod expand;
 mod expression;
+mod one_form;
 mod quadrature;
 mod validate;
 

@@ -6,12 +6,14 @@ use proc_macro2::{Span, TokenStream};
 use quote::quote;
 use syn::punctuated::Punctuated;
 use syn::spanned::Spanned;
-use syn::{Expr, Fields, GenericParam, Meta, Token, Type};
+use syn::{Expr, Fields, GenericParam, Ident, Meta, Token, Type};
 
-use crate::ast::{Arguments, Coordinate, Lagrangian, Length, Model, Parameter};
-use crate::{expression, quadrature};
+use crate::ast::{Arguments, Coordinate, Lagrangian, Length, Model, Parameter, Term, offsets};
+use crate::expression::Scope;
+use crate::{expression, one_form, quadrature};
 
-const KEYS: &str = "`coordinates(...)`, `lagrangian = ...` and `quadrature = ...`";
+const KEYS: &str = "`coordinates(...)`, `lagrangian = ...`, `quadrature = ...`, \
+     `constraints(...)`, `holonomic(...)`, `forces(...)`, `inputs(...)` and `constraint_at = ...`";
 
 /// Collected errors; reported together.
 #[derive(Default)]
@@ -45,12 +47,39 @@ pub enum Outcome {
     },
 }
 
-/// Validates the arguments against the struct.
-pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
-    let mut errors = Errors::default();
-    let mut coordinates: Option<(Span, Vec<Coordinate>)> = None;
-    let mut lagrangian: Option<(Span, Expr)> = None;
-    let mut quadrature_expr: Option<(Span, Expr)> = None;
+/// The arguments by key, before their contents are checked.
+#[derive(Default)]
+struct Entries {
+    coordinates: Option<(Span, Vec<Coordinate>)>,
+    lagrangian: Option<Expr>,
+    quadrature: Option<Expr>,
+    constraints: Option<Vec<Expr>>,
+    holonomic: Option<Vec<Expr>>,
+    forces: Option<Vec<Expr>>,
+    inputs: Option<Vec<Ident>>,
+    constraint_at: Option<Expr>,
+}
+
+fn list<T: syn::parse::Parse>(list: &syn::MetaList, errors: &mut Errors) -> Option<Vec<T>> {
+    match list.parse_args_with(Punctuated::<T, Token![,]>::parse_terminated) {
+        Ok(items) if items.is_empty() => {
+            errors.push(
+                list.span(),
+                "the list is empty; leave the argument out instead",
+            );
+            None
+        }
+        Ok(items) => Some(items.into_iter().collect()),
+        Err(e) => {
+            errors.0.push(e);
+            None
+        }
+    }
+}
+
+fn entries(arguments: Arguments, errors: &mut Errors) -> Entries {
+    let mut e = Entries::default();
+    let mut seen = HashSet::new();
     for entry in arguments.entries {
         let key = entry
             .path()
@@ -58,30 +87,29 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
             .map(|i| i.to_string())
             .unwrap_or_default();
         let span = entry.path().span();
-        let duplicate = match key.as_str() {
-            "coordinates" => coordinates.is_some(),
-            "lagrangian" => lagrangian.is_some(),
-            "quadrature" => quadrature_expr.is_some(),
-            _ => false,
-        };
-        if duplicate {
+        if !seen.insert(key.clone()) {
             errors.push(span, format!("`{key}` is given twice"));
             continue;
         }
         match (key.as_str(), entry) {
-            ("coordinates", Meta::List(list)) => {
-                match list.parse_args_with(Punctuated::<Coordinate, Token![,]>::parse_terminated) {
-                    Ok(list) => coordinates = Some((span, list.into_iter().collect())),
-                    Err(e) => errors.0.push(e),
-                }
+            ("coordinates", Meta::List(l)) => {
+                e.coordinates = list(&l, errors)
+                    .map(|c| (span, c))
+                    .or(Some((span, Vec::new())))
             }
-            ("lagrangian", Meta::NameValue(nv)) => lagrangian = Some((span, nv.value)),
-            ("quadrature", Meta::NameValue(nv)) => quadrature_expr = Some((span, nv.value)),
-            ("coordinates", other) => errors.push(
-                other.span(),
-                "write the coordinates as a list: coordinates(x, y, theta[8])",
-            ),
-            ("lagrangian" | "quadrature", other) => {
+            ("constraints", Meta::List(l)) => e.constraints = list(&l, errors),
+            ("holonomic", Meta::List(l)) => e.holonomic = list(&l, errors),
+            ("forces", Meta::List(l)) => e.forces = list(&l, errors),
+            ("inputs", Meta::List(l)) => e.inputs = list(&l, errors),
+            ("lagrangian", Meta::NameValue(nv)) => e.lagrangian = Some(nv.value),
+            ("quadrature", Meta::NameValue(nv)) => e.quadrature = Some(nv.value),
+            ("constraint_at", Meta::NameValue(nv)) => e.constraint_at = Some(nv.value),
+            ("coordinates" | "constraints" | "holonomic" | "forces" | "inputs", other) => errors
+                .push(
+                    other.span(),
+                    format!("write `{key}` as a list: {key}(a, b, ...)"),
+                ),
+            ("lagrangian" | "quadrature" | "constraint_at", other) => {
                 errors.push(other.span(), format!("write `{key} = ...`"))
             }
             (_, other) => errors.push(
@@ -90,9 +118,15 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
             ),
         }
     }
+    e
+}
 
+/// Validates the arguments against the struct.
+pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
+    let mut errors = Errors::default();
+    let e = entries(arguments, &mut errors);
     let parameters = parameters(&item, &mut errors);
-    let coordinates = match coordinates {
+    let coordinates = match e.coordinates {
         Some((span, list)) => {
             check_coordinates(span, &list, &parameters, &item, &mut errors);
             Some(list)
@@ -105,25 +139,87 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
             None
         }
     };
-    let lagrangian = match (lagrangian, &coordinates) {
+    let inputs = e.inputs.unwrap_or_default();
+    check_inputs(
+        &inputs,
+        coordinates.as_deref().unwrap_or_default(),
+        &parameters,
+        &mut errors,
+    );
+    let lagrangian = match (e.lagrangian, &coordinates) {
         (None, _) => {
             errors.push(Span::call_site(), "missing `lagrangian = ...`: an expression in the coordinates, dot(coordinate) and the parameters, or the path of a generic function");
             None
         }
-        (Some((_, expr)), Some(coordinates)) => {
+        (Some(expr), Some(coordinates)) => {
             lagrangian_of(expr, coordinates, &parameters, &mut errors)
         }
         (Some(_), None) => None,
     };
-    let quadrature = match quadrature_expr {
+    let quadrature = match e.quadrature {
         None => Some(quote!(::dirac::Quadrature::midpoint())),
-        Some((_, expr)) => match quadrature::parse(&expr) {
+        Some(expr) => match quadrature::parse(&expr) {
             Ok(tokens) => Some(tokens),
-            Err(e) => {
-                errors.0.push(e);
+            Err(err) => {
+                errors.0.push(err);
                 None
             }
         },
+    };
+    let constraint_point = e.constraint_at.and_then(|expr| match &expr {
+        Expr::Path(p) if p.path.is_ident("start") => Some(quote!(::dirac::ConstraintPoint::Start)),
+        Expr::Path(p) if p.path.is_ident("midpoint") => {
+            Some(quote!(::dirac::ConstraintPoint::Midpoint))
+        }
+        Expr::Path(p) if p.path.is_ident("end") => Some(quote!(::dirac::ConstraintPoint::End)),
+        other => {
+            errors.push(
+                other.span(),
+                "expected `start` (q_k), `midpoint` or `end` (q_{k+1})",
+            );
+            None
+        }
+    });
+    let (one_forms, holonomic, forces) = match &coordinates {
+        Some(coordinates) => {
+            let names: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
+            let mut force_names = names.clone();
+            force_names.extend(inputs.iter().cloned());
+            force_names.push(Ident::new("t", Span::call_site()));
+            let positions = Scope {
+                coordinates,
+                constants: &names,
+                no_velocities: Some(
+                    "constraints depend on positions only: dot(...) cannot appear here",
+                ),
+            };
+            let one_forms = e
+                .constraints
+                .unwrap_or_default()
+                .iter()
+                .filter_map(|form| split(form, &positions, &mut errors))
+                .collect();
+            let holonomic = e
+                .holonomic
+                .unwrap_or_default()
+                .iter()
+                .filter_map(|g| holonomic_of(g, &positions, &mut errors))
+                .collect();
+            let scope = Scope {
+                coordinates,
+                constants: &force_names,
+                no_velocities: None,
+            };
+            let forces = e
+                .forces
+                .unwrap_or_default()
+                .iter()
+                .filter_map(|form| split(form, &scope, &mut errors))
+                .flatten()
+                .collect();
+            (one_forms, holonomic, forces)
+        }
+        None => Default::default(),
     };
     match (coordinates, lagrangian, quadrature) {
         (Some(coordinates), Some(lagrangian), Some(quadrature)) if errors.is_empty() => {
@@ -133,12 +229,84 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
                 lagrangian,
                 quadrature,
                 parameters,
+                one_forms,
+                holonomic,
+                forces,
+                inputs,
+                constraint_point,
             }))
         }
         (coordinates, ..) => Outcome::Invalid {
             errors,
             coordinates,
         },
+    }
+}
+
+/// A one-form split into terms with rewritten coefficients.
+fn split(form: &Expr, scope: &Scope, errors: &mut Errors) -> Option<Vec<Term>> {
+    let offsets = offsets(scope.coordinates);
+    let terms = match one_form::terms(form, scope.coordinates, &offsets) {
+        Ok(terms) => terms,
+        Err(e) => {
+            errors.0.push(e);
+            return None;
+        }
+    };
+    let mut rewritten = Vec::with_capacity(terms.len());
+    for term in terms {
+        match expression::rewrite(&term.coefficient, scope) {
+            Ok(coefficient) => rewritten.push(Term {
+                index: term.index,
+                coefficient,
+            }),
+            Err(found) => errors.extend(found),
+        }
+    }
+    Some(rewritten)
+}
+
+/// A holonomic constraint `g(q)`: an expression of the positions, not a one-form.
+fn holonomic_of(g: &Expr, scope: &Scope, errors: &mut Errors) -> Option<Expr> {
+    let offsets = offsets(scope.coordinates);
+    if one_form::terms(g, scope.coordinates, &offsets).is_ok() {
+        errors.push(
+            g.span(),
+            "holonomic constraints are functions g(q) = 0 of the coordinates; write one-forms in constraints(...)",
+        );
+        return None;
+    }
+    match expression::rewrite(g, scope) {
+        Ok(g) => Some(g),
+        Err(found) => {
+            errors.extend(found);
+            None
+        }
+    }
+}
+
+fn check_inputs(
+    inputs: &[Ident],
+    coordinates: &[Coordinate],
+    parameters: &[Parameter],
+    errors: &mut Errors,
+) {
+    let mut seen = HashSet::new();
+    for input in inputs {
+        if !seen.insert(input.to_string()) {
+            errors.push(input.span(), format!("duplicate input `{input}`"));
+        }
+        let clash = coordinates.iter().any(|c| c.name == *input)
+            || parameters.iter().any(|p| p.name == *input)
+            || input == "t";
+        if clash {
+            errors.push(
+                input.span(),
+                format!(
+                    "input `{input}` has the name of a coordinate, a parameter or the time `t`"
+                ),
+            );
+        }
     }
 }
 
@@ -158,7 +326,12 @@ fn lagrangian_of(
         }
     }
     let names: Vec<_> = parameters.iter().map(|p| p.name.clone()).collect();
-    match expression::rewrite(&expr, coordinates, &names) {
+    let scope = Scope {
+        coordinates,
+        constants: &names,
+        no_velocities: None,
+    };
+    match expression::rewrite(&expr, &scope) {
         Ok(expr) => Some(Lagrangian::Expression(expr)),
         Err(found) => {
             errors.extend(found);

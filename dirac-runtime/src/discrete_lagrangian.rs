@@ -139,7 +139,7 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
     /// Position and velocity at node `i` of the path from `base = Q_0` with increments
     /// `Z_j = Q_j − Q_0` (`j = 1..=s`). The velocity is summed from the increments, not from the
     /// points, so it carries no cancellation of the large `Q_0` terms.
-    fn node(
+    pub(crate) fn node(
         &self,
         i: usize,
         base: &SVector<f64, N>,

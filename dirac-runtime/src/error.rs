@@ -58,6 +58,12 @@ pub enum DiracError {
         /// The unknowns the elimination could not pivot on, by coordinate name.
         unknowns: String,
     },
+    /// The initial state violates a constraint (possibly a hidden one).
+    #[error("inconsistent initial state: {0}")]
+    InconsistentInitialState(String),
+    /// An input name that the system does not have, or the wrong number of input values.
+    #[error("{0}")]
+    UnknownInput(String),
     /// Writing a trajectory failed.
     #[error("could not write the trajectory: {0}")]
     Io(String),

@@ -2,12 +2,16 @@
 //! derivatives by dual numbers, Newton's method, the stepper and trajectories.
 //!
 //! The path from a model to a step is visible in the modules: [`system`] (the continuous
-//! Lagrangian) → [`quadrature`] → [`discrete_lagrangian`] (slot derivatives) → [`newton`] →
-//! [`stepper`] → [`trajectory`].
+//! Lagrangian, one-forms, forces) → [`quadrature`] → [`discrete_lagrangian`] (slot derivatives),
+//! `force` (discrete Lagrange–d'Alembert forces) and [`constraint`] (multiplier rows) →
+//! [`newton`] → [`stepper`] → [`trajectory`].
 #![warn(missing_docs)]
 
+pub mod constraint;
 pub mod discrete_lagrangian;
 pub mod error;
+mod force;
+mod initial_state;
 pub mod legendre;
 mod lu;
 pub mod newton;
@@ -17,6 +21,7 @@ pub mod stepper;
 pub mod system;
 pub mod trajectory;
 
+pub use constraint::ConstraintPoint;
 pub use discrete_lagrangian::DiscreteLagrangian;
 pub use error::DiracError;
 pub use lu::SingularPivot;

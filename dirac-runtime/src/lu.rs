@@ -3,11 +3,14 @@
 
 use nalgebra::{DMatrix, DVector};
 
-/// Why a factorisation failed: the column whose pivot vanished.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Why a factorisation failed: the column whose pivot vanished, and the unknowns that a null
+/// vector of the matrix moves (the directions the equations do not determine).
+#[derive(Debug, Clone, PartialEq)]
 pub struct SingularPivot {
     /// Column (unknown) that could not be eliminated.
     pub column: usize,
+    /// Unknowns with a nonzero entry in a null vector of the columns up to `column`.
+    pub involved: Vec<usize>,
 }
 
 /// Factorises `a` in place (`P a = L U`, unit lower `L` below the diagonal) and records the row
@@ -29,7 +32,10 @@ pub(crate) fn factorise(
         }
         pivots[k] = p;
         if best <= threshold || !best.is_finite() {
-            return Err(SingularPivot { column: k });
+            return Err(SingularPivot {
+                column: k,
+                involved: null_vector_support(a, k),
+            });
         }
         if p != k {
             a.swap_rows(k, p);
@@ -44,6 +50,19 @@ pub(crate) fn factorise(
         }
     }
     Ok(())
+}
+
+/// After elimination stopped at column `k`, column `k` is a combination of columns `0..k`:
+/// `x = (−U₀₀⁻¹ u, 1, 0, …)` solves `A x = 0` there. Returns the indices where `x` is not small.
+fn null_vector_support(lu: &DMatrix<f64>, k: usize) -> Vec<usize> {
+    let mut x = vec![0.0; k + 1];
+    x[k] = 1.0;
+    for i in (0..k).rev() {
+        let s: f64 = (i + 1..=k).map(|j| lu[(i, j)] * x[j]).sum();
+        x[i] = -s / lu[(i, i)];
+    }
+    let largest = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    (0..=k).filter(|&i| x[i].abs() > 1e-8 * largest).collect()
 }
 
 /// Solves `A x = b` in place of `b` with the factors from [`factorise`].
@@ -90,5 +109,7 @@ mod tests {
         let mut pivots = [0; 3];
         let err = factorise(&mut a, &mut pivots, 1e-14).unwrap_err();
         assert_eq!(err.column, 2);
+        // The columns are dependent: col0 + col1 − col2 = 0.
+        assert_eq!(err.involved, vec![0, 1, 2]);
     }
 }

@@ -49,7 +49,7 @@ pub struct NewtonReport {
 }
 
 /// Why a solve failed.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum NewtonFailure {
     /// The tolerance was not met within the cap.
     NoConvergence {

@@ -9,14 +9,18 @@
 
 use nalgebra::{DVector, SVector};
 
+use crate::constraint::{self, ConstraintPoint};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
+use crate::initial_state;
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
 use crate::trajectory::Trajectory;
 
+/// Zero multipliers, reported before the first step.
+const ZEROS: [f64; 64] = [0.0; 64];
 const EULER_LAGRANGE: &str = "the discrete Euler–Lagrange equations";
 const LEGENDRE: &str = "the Legendre transform (velocity from momentum)";
 
@@ -99,14 +103,21 @@ pub struct Stepper<S, const N: usize> {
     increments: Vec<SVector<f64, N>>,
     /// Newton unknowns: the increments stacked (the iterate).
     unknowns: DVector<f64>,
-    /// The increments of the last accepted step: the next step's predictor.
+    /// The unknowns of the last accepted step (increments and multipliers): the next predictor.
     previous: Option<DVector<f64>>,
     report: Option<NewtonReport>,
+    /// Where the constraint one-forms are evaluated on a step.
+    point: ConstraintPoint,
+    /// Current values of the system's inputs.
+    inputs: Vec<f64>,
+    /// Constraint violation of the last step.
+    violation: f64,
 }
 
 impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     /// A stepper for `system` with `quadrature` and step `h`. Fails on a non-positive or
-    /// non-finite step, or a non-finite parameter.
+    /// non-finite step, a non-finite parameter, or a constrained system with a quadrature of
+    /// degree above 1 (constraints are imposed on the step's end points only).
     pub fn new(system: S, quadrature: Quadrature, h: f64) -> Result<Self, DiracError> {
         if !(h > 0.0 && h.is_finite()) {
             return Err(DiracError::InvalidStep { h });
@@ -121,10 +132,21 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 value,
             });
         }
-        let unknowns = N * quadrature.degree();
+        if S::ONE_FORMS + S::HOLONOMIC > 0 && quadrature.degree() > 1 {
+            return Err(DiracError::InvalidQuadrature(format!(
+                "{} has internal points, but constraints are imposed on a step's end points only; \
+                 use a degree-1 quadrature (midpoint or trapezoid) for a constrained system",
+                quadrature.name()
+            )));
+        }
+        let unknowns = N * quadrature.degree() + S::ONE_FORMS + S::HOLONOMIC;
         let increments = vec![SVector::zeros(); quadrature.degree()];
         let options = NewtonOptions::default();
+        let point = system.constraint_point();
         Ok(Self {
+            point,
+            inputs: vec![0.0; S::INPUTS],
+            violation: 0.0,
             discrete: DiscreteLagrangian::new(system, quadrature, h),
             newton: Newton::new(unknowns, options),
             state: None,
@@ -149,7 +171,15 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         self
     }
 
+    /// Evaluates the constraint one-forms at `point` of each step instead of the system's default.
+    pub fn with_constraint_point(mut self, point: ConstraintPoint) -> Self {
+        self.point = point;
+        self
+    }
+
     /// Starts from position `q0` and velocity `v0` at `t = 0`, with `p0 = ∂L/∂v(q0, v0)`.
+    /// Fails if `(q0, v0)` violates a constraint, including the hidden constraints of
+    /// coordinates without kinetic energy.
     pub fn start_from_velocity(
         &mut self,
         q0: SVector<f64, N>,
@@ -159,6 +189,8 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         self.check_finite("initial velocity", &v0)?;
         let p0 = legendre::momentum(self.system(), &q0, &v0);
         self.check_finite("initial momentum", &p0)?;
+        initial_state::check(self.system(), &q0, &v0, &self.inputs)
+            .map_err(DiracError::InconsistentInitialState)?;
         self.reset(State::new(0.0, q0, p0, v0));
         Ok(())
     }
@@ -174,11 +206,14 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         let mut newton = Newton::new(N, *self.newton.options());
         let v0 = legendre::velocity(self.system(), &mut newton, &q0, &p0, &SVector::zeros())
             .map_err(|f| self.failure(LEGENDRE, f, N))?;
+        initial_state::check(self.system(), &q0, &v0, &self.inputs)
+            .map_err(DiracError::InconsistentInitialState)?;
         self.reset(State::new(0.0, q0, p0, v0));
         Ok(())
     }
 
     fn reset(&mut self, state: State<N>) {
+        self.violation = 0.0;
         self.start = state.t;
         self.state = Some(state);
         self.steps = 0;
@@ -191,10 +226,12 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
         let s = self.discrete.quadrature().degree();
         let h = self.discrete.h();
-        // Predictor: the last step's increments (constant velocity), or the path c h v.
+        // Predictor: the last step's increments (constant velocity) and multipliers, or the
+        // path c h v with zero multipliers.
         match &self.previous {
             Some(previous) => self.unknowns.copy_from(previous),
             None => {
+                self.unknowns.fill(0.0);
                 for j in 0..s {
                     let c = (j + 1) as f64 / s as f64;
                     self.unknowns
@@ -204,14 +241,29 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             }
         }
         let mut impulse = SVector::zeros();
-        let (discrete, increments) = (&self.discrete, &mut self.increments);
+        let (discrete, increments, point) = (&self.discrete, &mut self.increments, self.point);
+        let (t, inputs) = (state.t, &self.inputs);
         let result = self.newton.solve(&mut self.unknowns, |x, r, jac| {
             for (j, z) in increments.iter_mut().enumerate() {
                 z.copy_from(&x.fixed_rows::<N>(j * N));
             }
             let equations = discrete.euler_lagrange(&state.q, increments, &state.p, r, jac);
             impulse = equations.impulse;
-            equations.scale
+            let mut scale = equations.scale;
+            if S::FORCES {
+                let (forces, size) = discrete.add_forces(&state.q, increments, t, inputs, r, jac);
+                impulse += forces;
+                scale = scale.max(size);
+            }
+            if S::ONE_FORMS + S::HOLONOMIC > 0 {
+                let system = discrete.system();
+                let rows = N * s;
+                let (constraints, size) =
+                    constraint::add_constraints(system, point, &state.q, x, rows, r, jac);
+                impulse += constraints;
+                scale = scale.max(size);
+            }
+            scale
         });
         let report = result.map_err(|f| self.failure(EULER_LAGRANGE, f, N * s))?;
         let step = self.unknowns.fixed_rows::<N>((s - 1) * N).into_owned();
@@ -221,6 +273,9 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         self.check_finite("new position", &next.q)?;
         self.check_finite("new momentum", &next.p)?;
         next.v_hint = step / h;
+        if S::ONE_FORMS + S::HOLONOMIC > 0 {
+            self.violation = constraint::violation(self.system(), self.point, &state.q, &next.q);
+        }
         match &mut self.previous {
             Some(previous) => previous.copy_from(&self.unknowns),
             None => self.previous = Some(self.unknowns.clone()),
@@ -234,7 +289,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
 
     /// Runs `steps` steps and returns the trajectory, starting with the current state.
     pub fn run(&mut self, steps: usize) -> Result<Trajectory<N>, DiracError> {
-        let mut trajectory = Trajectory::new(self.coordinate_names());
+        let mut trajectory = self.trajectory();
         self.record(&mut trajectory, steps, 1)?;
         Ok(trajectory)
     }
@@ -260,8 +315,88 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
 
     fn push_to(&self, trajectory: &mut Trajectory<N>) -> Result<(), DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
-        trajectory.push(state.t, state.q, state.p, self.energy()?);
+        let energy = self.energy()?;
+        if S::ONE_FORMS + S::HOLONOMIC > 0 {
+            trajectory.push_constrained(
+                state.t,
+                state.q,
+                state.p,
+                energy,
+                self.violation,
+                self.multipliers(),
+            );
+        } else {
+            trajectory.push(state.t, state.q, state.p, energy);
+        }
         Ok(())
+    }
+
+    /// Multipliers of the last step: one per constraint one-form, then one per holonomic
+    /// constraint. `A(q_c)ᵀ μ + dg(q_k)ᵀ λ` is the constraint impulse over the step (the
+    /// constraint force times `h`). Empty for an unconstrained system; zeros before the first step.
+    pub fn multipliers(&self) -> &[f64] {
+        let count = S::ONE_FORMS + S::HOLONOMIC;
+        match &self.previous {
+            Some(previous) => &previous.as_slice()[previous.len() - count..],
+            None => &ZEROS[..count.min(ZEROS.len())],
+        }
+    }
+
+    /// Largest constraint violation of the last step: `|A(q_c)(q_{k+1} − q_k)|` over the
+    /// one-forms and `|g(q_{k+1})|` over the holonomic constraints (0 before the first step).
+    pub fn constraint_violation(&self) -> f64 {
+        self.violation
+    }
+
+    /// Where the constraint one-forms are evaluated on a step.
+    pub fn constraint_point(&self) -> ConstraintPoint {
+        self.point
+    }
+
+    /// Sets the input called `name` (held constant over the following steps until set again).
+    pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), DiracError> {
+        let index = (0..S::INPUTS)
+            .find(|&i| self.system().input_name(i) == name)
+            .ok_or_else(|| {
+                let names: Vec<String> = (0..S::INPUTS)
+                    .map(|i| self.system().input_name(i))
+                    .collect();
+                DiracError::UnknownInput(format!(
+                    "no input called `{name}`; the inputs are {names:?}"
+                ))
+            })?;
+        if !value.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: format!("input {name}"),
+                value,
+            });
+        }
+        self.inputs[index] = value;
+        Ok(())
+    }
+
+    /// Sets every input at once, in the order of the system's `inputs(...)`.
+    pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
+        if values.len() != S::INPUTS {
+            return Err(DiracError::UnknownInput(format!(
+                "the system has {} input(s), got {} value(s)",
+                S::INPUTS,
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(DiracError::NonFinite {
+                what: format!("input {}", self.system().input_name(i)),
+                value: values[i],
+            });
+        }
+        self.inputs.copy_from_slice(values);
+        Ok(())
+    }
+
+    /// Current input values.
+    pub fn inputs(&self) -> &[f64] {
+        &self.inputs
     }
 
     /// The system.
@@ -325,6 +460,20 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         self.report
     }
 
+    /// An empty trajectory with this system's coordinate (and multiplier) columns.
+    pub fn trajectory(&self) -> Trajectory<N> {
+        let names = self.coordinate_names();
+        if S::ONE_FORMS + S::HOLONOMIC > 0 {
+            let multipliers = (0..S::ONE_FORMS)
+                .map(|a| format!("mu_{a}"))
+                .chain((0..S::HOLONOMIC).map(|b| format!("lambda_{b}")))
+                .collect();
+            Trajectory::with_multipliers(names, multipliers)
+        } else {
+            Trajectory::new(names)
+        }
+    }
+
     /// Coordinate names, from the system.
     pub fn coordinate_names(&self) -> Vec<String> {
         (0..N).map(|i| self.system().coordinate_name(i)).collect()
@@ -338,6 +487,29 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 value: x[i],
             }),
         }
+    }
+
+    /// The name of Newton unknown `column`: a coordinate of a point of the step, or a multiplier.
+    fn unknown_name(&self, legendre: bool, column: usize, s: usize) -> String {
+        if legendre {
+            return format!("{} (velocity)", self.system().coordinate_name(column));
+        }
+        if column >= N * s {
+            let c = column - N * s;
+            return if c < S::ONE_FORMS {
+                format!("the multiplier of one-form {c}")
+            } else {
+                format!(
+                    "the multiplier of holonomic constraint {}",
+                    c - S::ONE_FORMS
+                )
+            };
+        }
+        let slot = match column / N + 1 {
+            j if j == s => "q_{k+1}".to_string(),
+            j => format!("internal point {j}"),
+        };
+        format!("{} ({slot})", self.system().coordinate_name(column % N))
     }
 
     /// Turns a Newton failure into an error naming the step and, if singular, the unknowns.
@@ -354,18 +526,17 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 tolerance: self.newton.options().residual_tolerance,
             },
             NewtonFailure::Singular(pivot) => {
-                let s = size / N;
-                let column = pivot.column;
-                let name = self.system().coordinate_name(column % N);
-                let slot = match (problem == LEGENDRE, column / N + 1) {
-                    (true, _) => "velocity".to_string(),
-                    (false, j) if j == s => "q_{k+1}".to_string(),
-                    (false, j) => format!("internal point {j}"),
-                };
+                let s = self.quadrature().degree();
+                let unknowns: Vec<String> = pivot
+                    .involved
+                    .iter()
+                    .map(|&column| self.unknown_name(problem == LEGENDRE, column, s))
+                    .collect();
+                let _ = size;
                 DiracError::SingularJacobian {
                     problem,
                     step: self.steps,
-                    unknowns: format!("{name} ({slot})"),
+                    unknowns: unknowns.join(", "),
                 }
             }
             NewtonFailure::NonFinite => DiracError::NonFinite {

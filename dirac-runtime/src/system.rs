@@ -2,14 +2,19 @@
 
 use nalgebra::SVector;
 
+use crate::constraint::ConstraintPoint;
 use crate::quadrature::Quadrature;
 use crate::scalar::Scalar;
 
-/// A mechanical or electrical model on `Q = R^N`, described by its continuous Lagrangian `L(q, v)`.
+/// A mechanical or electrical model on `Q = R^N`: its continuous Lagrangian `L(q, v)` and, where
+/// it has them, constraint one-forms `A(q) v = 0`, holonomic constraints `g(q) = 0`, forces
+/// `F(q, v, t, u)` and named inputs `u`.
 ///
 /// `#[dirac_system(...)]` implements this trait; writing the `impl` by hand works the same way.
-/// Only [`lagrangian`](Self::lagrangian) is required; it must be generic over the [`Scalar`] so the
-/// runtime can differentiate it exactly with dual numbers.
+/// Only [`lagrangian`](Self::lagrangian) is required; everything else defaults to "none", and a
+/// model without constraints or forces pays nothing for them (the stepper branches on the
+/// associated constants, which are known at compile time). Every function is generic over the
+/// [`Scalar`] so the runtime can differentiate it exactly with dual numbers.
 ///
 /// ```
 /// use dirac_runtime::{DiracSystem, Scalar, Quadrature, Stepper};
@@ -31,8 +36,53 @@ use crate::scalar::Scalar;
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
 pub trait DiracSystem<const N: usize> {
+    /// Number of constraint one-forms `w^a(q)` (rows of `A(q)`).
+    const ONE_FORMS: usize = 0;
+    /// Number of holonomic constraints `g_b(q) = 0`.
+    const HOLONOMIC: usize = 0;
+    /// Whether [`force`](Self::force) is nonzero.
+    const FORCES: bool = false;
+    /// Number of named inputs the forces read.
+    const INPUTS: usize = 0;
+
     /// The continuous Lagrangian `L(q, v)` at position `q` and velocity `v`.
     fn lagrangian<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D;
+
+    /// Constraint one-form `a` (`0 <= a < ONE_FORMS`) at `q`: the row `A_a(q)` of `A(q) v = 0`.
+    fn one_form<D: Scalar>(&self, q: &SVector<D, N>, a: usize) -> SVector<D, N> {
+        let _ = (q, a);
+        SVector::zeros()
+    }
+
+    /// Holonomic constraint `b` (`0 <= b < HOLONOMIC`): the value `g_b(q)`, zero on the
+    /// constraint set. Its one-form `dg_b` is derived by dual numbers.
+    fn holonomic<D: Scalar>(&self, q: &SVector<D, N>, b: usize) -> D {
+        let _ = (q, b);
+        D::zero()
+    }
+
+    /// The force one-form `F(q, v, t, u)` (generalised forces, e.g. `−r q̇_l dq_l` for a
+    /// resistor), with the inputs' current values in `inputs`.
+    fn force<D: Scalar>(
+        &self,
+        q: &SVector<D, N>,
+        v: &SVector<D, N>,
+        t: f64,
+        inputs: &[f64],
+    ) -> SVector<D, N> {
+        let _ = (q, v, t, inputs);
+        SVector::zeros()
+    }
+
+    /// The name of input `i`, used by [`Stepper::set_input`](crate::Stepper::set_input).
+    fn input_name(&self, i: usize) -> String {
+        format!("u{i}")
+    }
+
+    /// Where the constraint one-forms are evaluated on a step (default: the midpoint).
+    fn constraint_point(&self) -> ConstraintPoint {
+        ConstraintPoint::Midpoint
+    }
 
     /// The name of coordinate `i` (`0 <= i < N`), used in CSV headers and error messages.
     fn coordinate_name(&self, i: usize) -> String {

@@ -28,11 +28,21 @@ pub struct Trajectory<const N: usize> {
     q: Vec<SVector<f64, N>>,
     p: Vec<SVector<f64, N>>,
     energy: Vec<f64>,
+    /// Names of the multipliers (empty for an unconstrained system).
+    multiplier_names: Vec<String>,
+    multipliers: Vec<Vec<f64>>,
+    violation: Vec<f64>,
 }
 
 impl<const N: usize> Trajectory<N> {
     /// An empty trajectory whose coordinates are called `names` (one per coordinate).
     pub fn new(names: Vec<String>) -> Self {
+        Self::with_multipliers(names, Vec::new())
+    }
+
+    /// An empty trajectory of a constrained system, which also records the constraint
+    /// violation and the multipliers (named `multiplier_names`) at every sample.
+    pub fn with_multipliers(names: Vec<String>, multiplier_names: Vec<String>) -> Self {
         debug_assert_eq!(names.len(), N);
         Self {
             names,
@@ -40,7 +50,40 @@ impl<const N: usize> Trajectory<N> {
             q: Vec::new(),
             p: Vec::new(),
             energy: Vec::new(),
+            multiplier_names,
+            multipliers: Vec::new(),
+            violation: Vec::new(),
         }
+    }
+
+    /// Appends a sample of a constrained system.
+    pub fn push_constrained(
+        &mut self,
+        t: f64,
+        q: SVector<f64, N>,
+        p: SVector<f64, N>,
+        energy: f64,
+        violation: f64,
+        multipliers: &[f64],
+    ) {
+        self.push(t, q, p, energy);
+        self.violation.push(violation);
+        self.multipliers.push(multipliers.to_vec());
+    }
+
+    /// Constraint violation of the step that ended at each sample (empty when unconstrained).
+    pub fn constraint_violation(&self) -> &[f64] {
+        &self.violation
+    }
+
+    /// Multipliers of the step that ended at each sample (empty when unconstrained).
+    pub fn multipliers(&self) -> &[Vec<f64>] {
+        &self.multipliers
+    }
+
+    /// The largest constraint violation over the trajectory.
+    pub fn max_constraint_violation(&self) -> f64 {
+        self.violation.iter().cloned().fold(0.0, f64::max)
     }
 
     /// Appends a sample.
@@ -101,7 +144,18 @@ impl<const N: usize> Trajectory<N> {
         let header = std::iter::once("t".to_string())
             .chain(self.names.iter().cloned())
             .chain(self.names.iter().map(|n| format!("p_{n}")))
-            .chain(std::iter::once("energy".to_string()));
+            .chain(std::iter::once("energy".to_string()))
+            .chain(
+                self.violation
+                    .first()
+                    .map(|_| "constraint_violation".to_string()),
+            )
+            .chain((0..self.multipliers.first().map_or(0, Vec::len)).map(|i| {
+                self.multiplier_names
+                    .get(i)
+                    .cloned()
+                    .unwrap_or_else(|| format!("mu_{i}"))
+            }));
         w.write_record(header).map_err(io)?;
         let mut row = Vec::with_capacity(2 * N + 2);
         for k in 0..self.len() {
@@ -110,6 +164,10 @@ impl<const N: usize> Trajectory<N> {
             row.extend(self.q[k].iter());
             row.extend(self.p[k].iter());
             row.push(self.energy[k]);
+            if let (Some(v), Some(m)) = (self.violation.get(k), self.multipliers.get(k)) {
+                row.push(*v);
+                row.extend(m.iter());
+            }
             w.write_record(row.iter().map(|x| x.to_string()))
                 .map_err(io)?;
         }

@@ -2,12 +2,16 @@
 //! benches so that each model is written once.
 #![allow(dead_code)]
 
+pub mod cartesian_pendulum;
 pub mod chain;
+pub mod circuit;
 pub mod double_pendulum;
 pub mod hand_written;
 pub mod kepler;
+pub mod knife_edge;
 pub mod oscillator;
 pub mod pendulum;
+pub mod port;
 
 use std::time::{Duration, Instant};
 
@@ -32,7 +36,7 @@ pub fn timed<S: DiracSystem<N>, const N: usize>(
     steps: usize,
     every: usize,
 ) -> Result<(Trajectory<N>, Duration), DiracError> {
-    let mut trajectory = Trajectory::new(stepper.coordinate_names());
+    let mut trajectory = stepper.trajectory();
     let start = Instant::now();
     stepper.record(&mut trajectory, steps, every)?;
     Ok((trajectory, start.elapsed()))

@@ -1,0 +1,141 @@
+//! The seed's LC circuit: an inductor in series with C2 and (C1 ∥ C3), currents constrained by
+//! Kirchhoff's current law as one-forms; the capacitor charges carry no kinetic energy.
+//! The RLC variant adds a resistor and a voltage source on the inductor branch.
+
+use dirac::prelude::*;
+
+use super::{Report, timed};
+
+/// q = (q_l, q_c1, q_c2, q_c3); L = (l/2) q̇_l² − Σ q_ci² / (2 c_i).
+#[dirac_system(
+    coordinates(q_l, q_c1, q_c2, q_c3),
+    lagrangian = 0.5 * l * dot(q_l).powi(2)
+        - q_c1.powi(2) / (2.0 * c1) - q_c2.powi(2) / (2.0 * c2) - q_c3.powi(2) / (2.0 * c3),
+    constraints(-dq_l + dq_c2, -dq_c1 + dq_c2 - dq_c3),
+)]
+#[derive(Debug, Clone, Copy)]
+pub struct LcCircuit {
+    pub l: f64,
+    pub c1: f64,
+    pub c2: f64,
+    pub c3: f64,
+}
+
+/// The same circuit with a resistor `r` and a voltage source `u` on the inductor branch.
+#[dirac_system(
+    coordinates(q_l, q_c1, q_c2, q_c3),
+    lagrangian = 0.5 * l * dot(q_l).powi(2)
+        - q_c1.powi(2) / (2.0 * c1) - q_c2.powi(2) / (2.0 * c2) - q_c3.powi(2) / (2.0 * c3),
+    constraints(-dq_l + dq_c2, -dq_c1 + dq_c2 - dq_c3),
+    forces((u - r * dot(q_l)) * dq_l),
+    inputs(u),
+)]
+#[derive(Debug, Clone, Copy)]
+pub struct RlcCircuit {
+    pub l: f64,
+    pub c1: f64,
+    pub c2: f64,
+    pub c3: f64,
+    pub r: f64,
+}
+
+pub const LC: LcCircuit = LcCircuit {
+    l: 1.0,
+    c1: 1.0,
+    c2: 1.0,
+    c3: 1.0,
+};
+pub const RLC: RlcCircuit = RlcCircuit {
+    l: 1.0,
+    c1: 1.0,
+    c2: 1.0,
+    c3: 1.0,
+    r: 0.5,
+};
+
+/// Charge 1 on C2, no current.
+pub fn q0() -> SVector<f64, 4> {
+    vector![0.0, 0.0, 1.0, 0.0]
+}
+
+/// q(10) of the LC circuit and the inductor current there.
+pub const LC_Q10: [f64; 4] = [
+    -0.033617333041,
+    -0.016808666520,
+    0.966382666959,
+    -0.016808666520,
+];
+pub const LC_CURRENT10: f64 = 0.256006793778;
+/// q(10) of the RLC circuit (R = 0.5, no source) and its current.
+pub const RLC_Q10: [f64; 4] = [
+    -0.627019297018,
+    -0.313509648509,
+    0.372980702982,
+    -0.313509648509,
+];
+pub const RLC_CURRENT10: f64 = 0.037335786163;
+
+/// Closed form of the LC circuit: q_c2(t) = 1/3 + (2/3) cos(√1.5 t).
+pub fn lc_q_c2(t: f64) -> f64 {
+    1.0 / 3.0 + 2.0 / 3.0 * (1.5f64.sqrt() * t).cos()
+}
+
+/// The LC circuit with step `h` to T = 10: the state there.
+pub fn lc_at_10(
+    quadrature: Quadrature,
+    h: f64,
+) -> Result<(SVector<f64, 4>, SVector<f64, 4>), DiracError> {
+    let mut stepper = Stepper::new(LC, quadrature, h)?;
+    stepper.start_from_velocity(q0(), SVector::zeros())?;
+    for _ in 0..(10.0 / h).round() as usize {
+        stepper.step()?;
+    }
+    Ok((stepper.q(), stepper.p()))
+}
+
+pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
+    let (h, steps) = (0.01, 1000);
+    let name = quadrature.name();
+    let mut stepper = Stepper::new(LC, quadrature.clone(), h)?;
+    stepper.start_from_velocity(q0(), SVector::zeros())?;
+    let (trajectory, wall) = timed(&mut stepper, steps, 1)?;
+    trajectory.save_csv(format!(
+        "output/lc_circuit_{}.csv",
+        super::oscillator::file_name(&name)
+    ))?;
+    let error = (stepper.q() - SVector::from(LC_Q10)).amax();
+    Ok(Report {
+        scene: "LC circuit",
+        quadrature: name,
+        h,
+        steps,
+        max_energy_error: trajectory.max_energy_error(),
+        wall,
+        check: format!(
+            "|q(10) − exact| = {error:.2e}, KCL residual ≤ {:.1e}",
+            trajectory.max_constraint_violation()
+        ),
+    })
+}
+
+pub fn rlc_report(quadrature: Quadrature) -> Result<Report, DiracError> {
+    let (h, steps) = (0.01, 1000);
+    let name = quadrature.name();
+    let mut stepper = Stepper::new(RLC, quadrature, h)?;
+    stepper.start_from_velocity(q0(), SVector::zeros())?;
+    let (trajectory, wall) = timed(&mut stepper, steps, 1)?;
+    trajectory.save_csv(format!(
+        "output/rlc_circuit_{}.csv",
+        super::oscillator::file_name(&name)
+    ))?;
+    let error = (stepper.q() - SVector::from(RLC_Q10)).amax();
+    Ok(Report {
+        scene: "RLC circuit",
+        quadrature: name,
+        h,
+        steps,
+        max_energy_error: trajectory.max_energy_error(),
+        wall,
+        check: format!("|q(10) − exact| = {error:.2e} (energy decays through R)"),
+    })
+}
