@@ -101,7 +101,43 @@ impl Splitter<'_> {
         }
     }
 
+    /// An identifier `d…` in `expr` that is not the differential of a coordinate.
+    fn stray_differential(&self, expr: &Expr) -> Option<Ident> {
+        match expr {
+            Expr::Path(p) => p
+                .path
+                .get_ident()
+                .filter(|i| {
+                    let name = i.to_string();
+                    name.len() > 1 && name.starts_with('d') && self.differential(i).is_none()
+                })
+                .cloned(),
+            Expr::Paren(p) => self.stray_differential(&p.expr),
+            Expr::Group(g) => self.stray_differential(&g.expr),
+            Expr::Unary(u) => self.stray_differential(&u.expr),
+            Expr::Binary(b) => self
+                .stray_differential(&b.left)
+                .or_else(|| self.stray_differential(&b.right)),
+            Expr::Index(ix) => self.stray_differential(&ix.expr),
+            _ => None,
+        }
+    }
+
     fn no_differential(&self, expr: &Expr) -> syn::Error {
+        if let Some(stray) = self.stray_differential(expr) {
+            let names: Vec<String> = self
+                .coordinates
+                .iter()
+                .map(|c| format!("`{}`", c.name))
+                .collect();
+            return syn::Error::new(
+                stray.span(),
+                format!(
+                    "`{stray}` is not the differential of a coordinate; the coordinates are {}",
+                    names.join(", ")
+                ),
+            );
+        }
         let names: Vec<String> = self
             .coordinates
             .iter()

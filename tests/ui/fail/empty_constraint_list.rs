@@ -1,0 +1,6 @@
+use dirac::prelude::*;
+
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), constraints())]
+struct Particle;
+
+fn main() {}
