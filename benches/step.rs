@@ -72,5 +72,36 @@ fn chain_growth(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, generated_vs_hand, quadratures, chain_growth);
+/// Constrained steps (midpoint, h = 0.01) beside the unconstrained double pendulum: the LC circuit
+/// (4 coordinates, 2 constant one-forms, KKT 6×6) and the knife edge (3 coordinates, one
+/// configuration-dependent one-form, KKT 4×4).
+fn constrained(c: &mut Criterion) {
+    let mut group = c.benchmark_group("constrained_midpoint_step");
+    let mut unconstrained =
+        double_pendulum::stepper(Quadrature::midpoint(), 0.01).expect("valid scene");
+    group.bench_function("double_pendulum", |b| {
+        b.iter(|| black_box(unconstrained.step()).expect("step"))
+    });
+    let mut lc =
+        Stepper::new(scenes::circuit::LC, Quadrature::midpoint(), 0.01).expect("valid scene");
+    lc.start_from_velocity(scenes::circuit::q0(), SVector::zeros())
+        .expect("consistent start");
+    group.bench_function("lc_circuit", |b| {
+        b.iter(|| black_box(lc.step()).expect("step"))
+    });
+    let mut knife =
+        scenes::knife_edge::stepper(ConstraintPoint::Midpoint, 0.01).expect("valid scene");
+    group.bench_function("knife_edge", |b| {
+        b.iter(|| black_box(knife.step()).expect("step"))
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    generated_vs_hand,
+    quadratures,
+    chain_growth,
+    constrained
+);
 criterion_main!(benches);

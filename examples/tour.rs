@@ -1,13 +1,15 @@
-//! Runs every scene with every tour quadrature, prints one table (scene, quadrature, h, steps,
-//! max energy error, wall time, check against the known answer) and writes it to
-//! `output/tour.csv`, beside one CSV trajectory per run.
+//! Runs every scene, prints one table (scene, quadrature, h, steps, max energy error, wall time,
+//! check against the known answer) and writes it to `output/tour.csv`, beside one CSV trajectory
+//! per run. Unconstrained scenes run with every tour quadrature; constrained ones with the
+//! midpoint rule (the knife edge with each discrete constraint point), and the trapezoid rule's
+//! refusal of the ill-posed LC circuit is shown.
 //!
 //! `cargo run --release --example tour`
 
 mod scenes;
 
-use dirac::{DiracError, Quadrature};
-use scenes::Report;
+use dirac::{ConstraintPoint, DiracError, Quadrature};
+use scenes::{Report, circuit, knife_edge};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     type Scene = fn(Quadrature) -> Result<Report, DiracError>;
@@ -24,8 +26,32 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             reports.push(scene(quadrature)?);
         }
     }
+    type Constrained = fn(Quadrature) -> Result<Report, DiracError>;
+    let constrained: [Constrained; 4] = [
+        circuit::report,
+        circuit::rlc_report,
+        scenes::cartesian_pendulum::report,
+        scenes::port::report,
+    ];
+    for scene in constrained {
+        reports.push(scene(Quadrature::midpoint())?);
+    }
+    reports.push(circuit::driven_report()?);
+    for point in [
+        ConstraintPoint::Start,
+        ConstraintPoint::Midpoint,
+        ConstraintPoint::End,
+    ] {
+        reports.push(knife_edge::report_point(point)?);
+    }
     scenes::print_table(&reports);
     scenes::save_table(&reports, "output/tour.csv")?;
+    match circuit::lc_at_10(Quadrature::trapezoid(), 0.01) {
+        Err(error) => {
+            println!("\nLC circuit with the trapezoid rule is refused, as it must be:\n  {error}")
+        }
+        Ok(_) => println!("\nLC circuit with the trapezoid rule: unexpectedly accepted"),
+    }
     println!("\nwrote output/tour.csv and one trajectory CSV per row to output/");
     Ok(())
 }

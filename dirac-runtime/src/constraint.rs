@@ -79,7 +79,7 @@ fn seeded<const N: usize>(q: &SVector<f64, N>) -> SVector<Dual<N>, N> {
 }
 
 fn gradient<const N: usize>(x: &Dual<N>) -> SVector<f64, N> {
-    x.eps.clone().unwrap_generic(Const::<N>, U1)
+    x.eps.unwrap_generic(Const::<N>, U1)
 }
 
 /// One-form `a` at `q`: the row `A_a(q)` and its derivative `∂A_a,i/∂q_j` (row `i`, column `j`).

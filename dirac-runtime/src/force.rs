@@ -45,7 +45,7 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
                     .force(&lift(&q, a), &lift(&v, d), t + c * h, inputs);
                 let value = f.map(|x| x.re);
                 let derivative = SMatrix::<f64, N, N>::from_fn(|m, l| {
-                    f[m].eps.clone().unwrap_generic(Const::<N>, U1)[l]
+                    f[m].eps.unwrap_generic(Const::<N>, U1)[l]
                 });
                 if k == 1 {
                     impulse += value * w;

@@ -221,7 +221,10 @@ mod tests {
         });
         assert_eq!(
             err,
-            Err(NewtonFailure::Singular(SingularPivot { column: 0 }))
+            Err(NewtonFailure::Singular(SingularPivot {
+                column: 0,
+                involved: vec![0]
+            }))
         );
     }
 }
