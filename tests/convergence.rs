@@ -7,20 +7,11 @@
 
 #[path = "../examples/scenes/mod.rs"]
 mod scenes;
+mod support;
 
 use dirac::prelude::*;
 use scenes::{double_pendulum, pendulum};
-
-/// Least-squares slope of ln(error) against ln(h).
-fn slope(hs: &[f64], errors: &[f64]) -> f64 {
-    let x: Vec<f64> = hs.iter().map(|h| h.ln()).collect();
-    let y: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
-    let n = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: f64 = x.iter().map(|a| (a - mx).powi(2)).sum();
-    sxy / sxx
-}
+use support::slope;
 
 /// (quadrature, expected order, coarsest pendulum step count over T = 5).
 fn cases() -> Vec<(Quadrature, f64, usize)> {

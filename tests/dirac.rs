@@ -3,19 +3,12 @@
 
 #[path = "../examples/scenes/mod.rs"]
 mod scenes;
+mod support;
 
 use dirac::prelude::*;
 use scenes::{cartesian_pendulum, circuit, double_pendulum, knife_edge, pendulum, port};
-
-/// Least-squares slope of ln(error) against ln(h).
-fn slope(hs: &[f64], errors: &[f64]) -> f64 {
-    let x: Vec<f64> = hs.iter().map(|h| h.ln()).collect();
-    let y: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
-    let n = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
-    sxy / x.iter().map(|a| (a - mx).powi(2)).sum::<f64>()
-}
+use support::energy_error_first_and_last_tenth;
+use support::slope;
 
 const HS: [f64; 4] = [0.1, 0.05, 0.025, 0.0125];
 
@@ -151,14 +144,7 @@ fn cartesian_pendulum_keeps_its_length_and_matches_the_angle_pendulum() {
         worst = worst.max(stepper.constraint_violation());
     }
     assert!(trajectory.max_constraint_violation() <= 1e-12 && worst <= 1e-12);
-    let e0 = trajectory.energy()[0];
-    let errors: Vec<f64> = trajectory.energy().iter().map(|e| (e - e0).abs()).collect();
-    let tenth = errors.len() / 10;
-    let first = errors[..tenth].iter().cloned().fold(0.0, f64::max);
-    let last = errors[errors.len() - tenth..]
-        .iter()
-        .cloned()
-        .fold(0.0, f64::max);
+    let (first, last) = energy_error_first_and_last_tenth(trajectory.energy());
     assert!(
         last <= 1.1 * first && first < 2e-3,
         "first tenth {first:e}, last tenth {last:e}"

@@ -3,10 +3,12 @@
 
 #[path = "../examples/scenes/mod.rs"]
 mod scenes;
+mod support;
 
 use dirac::nalgebra::{SMatrix, SVector};
 use dirac::prelude::*;
 use scenes::{double_pendulum, kepler, pendulum};
+use support::energy_error_first_and_last_tenth;
 
 /// 10⁶ midpoint steps of the pendulum (h = 0.1, T = 10⁵, ~16 000 periods). A symplectic method's
 /// energy error oscillates: the largest error in the last tenth of the run is no larger than in
@@ -20,14 +22,7 @@ fn energy_error_is_bounded_without_drift_over_a_million_steps() {
         .unwrap();
     let mut trajectory = Trajectory::new(stepper.coordinate_names());
     stepper.record(&mut trajectory, 1_000_000, 37).unwrap();
-    let e0 = trajectory.energy()[0];
-    let errors: Vec<f64> = trajectory.energy().iter().map(|e| (e - e0).abs()).collect();
-    let tenth = errors.len() / 10;
-    let first = errors[..tenth].iter().cloned().fold(0.0, f64::max);
-    let last = errors[errors.len() - tenth..]
-        .iter()
-        .cloned()
-        .fold(0.0, f64::max);
+    let (first, last) = energy_error_first_and_last_tenth(trajectory.energy());
     assert!(
         last <= 1.1 * first,
         "drift: first tenth {first:e}, last tenth {last:e}"
