@@ -66,15 +66,12 @@ impl ConstraintPoint {
 
 type Dual<const N: usize> = DualSVec64<N>;
 
-/// `q` with every component seeded: functions of it return their value and gradient.
-fn seeded<const N: usize>(q: &SVector<f64, N>) -> SVector<Dual<N>, N> {
+/// `x` as first-order duals whose component `i` moves with `weight` along direction `i`:
+/// functions of it return their value and their derivative along `weight · δx`.
+pub(crate) fn lift<const N: usize>(x: &SVector<f64, N>, weight: f64) -> SVector<Dual<N>, N> {
     SVector::from_fn(|i, _| {
-        Dual::<N>::new(
-            q[i],
-            Derivative::some(SVector::<f64, N>::from_fn(
-                |j, _| if i == j { 1.0 } else { 0.0 },
-            )),
-        )
+        let eps = SVector::<f64, N>::from_fn(|j, _| if i == j { weight } else { 0.0 });
+        Dual::<N>::new(x[i], Derivative::some(eps))
     })
 }
 
@@ -88,7 +85,7 @@ pub(crate) fn one_form<S: DiracSystem<N>, const N: usize>(
     q: &SVector<f64, N>,
     a: usize,
 ) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
-    let row = system.one_form(&seeded(q), a);
+    let row = system.one_form(&lift(q, 1.0), a);
     let value = row.map(|x| x.re);
     let derivative = SMatrix::<f64, N, N>::from_fn(|i, j| gradient(&row[i])[j]);
     (value, derivative)
@@ -100,7 +97,7 @@ pub(crate) fn holonomic<S: DiracSystem<N>, const N: usize>(
     q: &SVector<f64, N>,
     b: usize,
 ) -> (f64, SVector<f64, N>) {
-    let g = system.holonomic(&seeded(q), b);
+    let g = system.holonomic(&lift(q, 1.0), b);
     (g.re, gradient(&g))
 }
 

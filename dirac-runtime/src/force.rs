@@ -3,12 +3,10 @@
 //! `f_j = h Σ_i b_i ℓ_j(c_i) F_i` (for the midpoint rule `f^- = f^+ = (h/2) F(q̄, Δq/h)`).
 
 use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
-use num_dual::{Derivative, DualSVec64};
 
+use crate::constraint::lift;
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::system::DiracSystem;
-
-type Dual<const N: usize> = DualSVec64<N>;
 
 impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
     /// Adds `f_j` to the residual rows of points `j = 0..s−1` and their derivatives in the
@@ -33,13 +31,6 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
             for k in 1..=s {
                 // F along the direction of the unknown Z_k: value and ∂F/∂Z_k.
                 let (a, d) = (quad.basis(i, k), quad.basis_derivative(i, k) / h);
-                let lift = |x: &SVector<f64, N>, weight: f64| {
-                    SVector::<Dual<N>, N>::from_fn(|m, _| {
-                        let eps =
-                            SVector::<f64, N>::from_fn(|l, _| if l == m { weight } else { 0.0 });
-                        Dual::<N>::new(x[m], Derivative::some(eps))
-                    })
-                };
                 let f = self
                     .system()
                     .force(&lift(&q, a), &lift(&v, d), t + c * h, inputs);

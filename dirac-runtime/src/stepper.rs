@@ -19,8 +19,6 @@ use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
 use crate::trajectory::Trajectory;
 
-/// Zero multipliers, reported before the first step.
-const ZEROS: [f64; 64] = [0.0; 64];
 const EULER_LAGRANGE: &str = "the discrete Euler–Lagrange equations";
 const LEGENDRE: &str = "the Legendre transform (velocity from momentum)";
 
@@ -112,6 +110,8 @@ pub struct Stepper<S, const N: usize> {
     inputs: Vec<f64>,
     /// Constraint violation of the last step.
     violation: f64,
+    /// Multipliers of the last step (zeros before the first).
+    multipliers: Vec<f64>,
 }
 
 impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
@@ -147,6 +147,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             point,
             inputs: vec![0.0; S::INPUTS],
             violation: 0.0,
+            multipliers: vec![0.0; S::ONE_FORMS + S::HOLONOMIC],
             discrete: DiscreteLagrangian::new(system, quadrature, h),
             newton: Newton::new(unknowns, options),
             state: None,
@@ -205,7 +206,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         self.check_finite("initial momentum", &p0)?;
         let mut newton = Newton::new(N, *self.newton.options());
         let v0 = legendre::velocity(self.system(), &mut newton, &q0, &p0, &SVector::zeros())
-            .map_err(|f| self.failure(LEGENDRE, f, N))?;
+            .map_err(|f| self.failure(LEGENDRE, f))?;
         initial_state::check(self.system(), &q0, &v0, &self.inputs)
             .map_err(DiracError::InconsistentInitialState)?;
         self.reset(State::new(0.0, q0, p0, v0));
@@ -214,6 +215,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
 
     fn reset(&mut self, state: State<N>) {
         self.violation = 0.0;
+        self.multipliers.fill(0.0);
         self.start = state.t;
         self.state = Some(state);
         self.steps = 0;
@@ -265,7 +267,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             }
             scale
         });
-        let report = result.map_err(|f| self.failure(EULER_LAGRANGE, f, N * s))?;
+        let report = result.map_err(|f| self.failure(EULER_LAGRANGE, f))?;
         let step = self.unknowns.fixed_rows::<N>((s - 1) * N).into_owned();
         let mut next = state;
         compensated_add(&mut next.q, &mut next.q_carry, &step);
@@ -275,6 +277,9 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         next.v_hint = step / h;
         if S::ONE_FORMS + S::HOLONOMIC > 0 {
             self.violation = constraint::violation(self.system(), self.point, &state.q, &next.q);
+            let count = self.multipliers.len();
+            self.multipliers
+                .copy_from_slice(&self.unknowns.as_slice()[N * s..N * s + count]);
         }
         match &mut self.previous {
             Some(previous) => previous.copy_from(&self.unknowns),
@@ -335,11 +340,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     /// constraint. `A(q_c)ᵀ μ + dg(q_k)ᵀ λ` is the constraint impulse over the step (the
     /// constraint force times `h`). Empty for an unconstrained system; zeros before the first step.
     pub fn multipliers(&self) -> &[f64] {
-        let count = S::ONE_FORMS + S::HOLONOMIC;
-        match &self.previous {
-            Some(previous) => &previous.as_slice()[previous.len() - count..],
-            None => &ZEROS[..count.min(ZEROS.len())],
-        }
+        &self.multipliers
     }
 
     /// Largest constraint violation of the last step: `|A(q_c)(q_{k+1} − q_k)|` over the
@@ -446,7 +447,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             &state.p,
             &state.v_hint,
         )
-        .map_err(|f| self.failure(LEGENDRE, f, N))
+        .map_err(|f| self.failure(LEGENDRE, f))
     }
 
     /// Energy `⟨p, v⟩ − L(q, v)` of the current state, with `v` from [`v`](Self::v).
@@ -513,7 +514,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     }
 
     /// Turns a Newton failure into an error naming the step and, if singular, the unknowns.
-    fn failure(&self, problem: &'static str, failure: NewtonFailure, size: usize) -> DiracError {
+    fn failure(&self, problem: &'static str, failure: NewtonFailure) -> DiracError {
         match failure {
             NewtonFailure::NoConvergence {
                 residual,
@@ -532,7 +533,6 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                     .iter()
                     .map(|&column| self.unknown_name(problem == LEGENDRE, column, s))
                     .collect();
-                let _ = size;
                 DiracError::SingularJacobian {
                     problem,
                     step: self.steps,
