@@ -2,7 +2,8 @@
 //! check against the known answer) and writes it to `output/tour.csv`, beside one CSV trajectory
 //! per run. Unconstrained scenes run with every tour quadrature; constrained ones with the
 //! midpoint rule (the knife edge with each discrete constraint point), and the trapezoid rule's
-//! refusal of the ill-posed LC circuit is shown.
+//! refusal of the ill-posed LC circuit is shown. Pictures: `output/convergence.png`,
+//! `output/energy_error.png`, `output/knife_edge.png`, `output/lc_circuit.png`.
 //!
 //! `cargo run --release --example tour`
 
@@ -53,5 +54,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Ok(_) => println!("\nLC circuit with the trapezoid rule: unexpectedly accepted"),
     }
     println!("\nwrote output/tour.csv and one trajectory CSV per row to output/");
+    for figure in scenes::figures::draw_all()? {
+        println!("wrote {figure}");
+    }
     Ok(())
 }

@@ -6,11 +6,13 @@ pub mod cartesian_pendulum;
 pub mod chain;
 pub mod circuit;
 pub mod double_pendulum;
+pub mod figures;
 pub mod hand_written;
 pub mod kepler;
 pub mod knife_edge;
 pub mod oscillator;
 pub mod pendulum;
+pub mod plot;
 pub mod port;
 
 use std::time::{Duration, Instant};

@@ -1,0 +1,150 @@
+//! The tour's pictures: orders of convergence, energy errors over time, the knife edge's paths
+//! under the three discrete constraints, and the LC circuit against its closed form.
+
+use std::error::Error;
+
+use dirac::prelude::*;
+
+use super::plot::{Series, line_chart};
+use super::{circuit, double_pendulum, knife_edge, pendulum};
+
+/// Writes every figure to `output/` and returns their paths.
+pub fn draw_all() -> Result<Vec<&'static str>, Box<dyn Error>> {
+    super::plot::register_font()?;
+    Ok(vec![
+        convergence()?,
+        energy()?,
+        knife_edge_paths()?,
+        lc_circuit()?,
+    ])
+}
+
+/// log10 |error at T = 5| against log10 h for the pendulum, every quadrature.
+fn convergence() -> Result<&'static str, Box<dyn Error>> {
+    let path = "output/convergence.png";
+    let quadratures = [
+        Quadrature::midpoint(),
+        Quadrature::trapezoid(),
+        Quadrature::gauss(2)?,
+        Quadrature::gauss(3)?,
+        Quadrature::galerkin(2, Rule::GaussLobatto(3))?,
+        Quadrature::galerkin(3, Rule::GaussLobatto(4))?,
+    ];
+    let mut series = Vec::new();
+    for quadrature in quadratures {
+        let mut points = Vec::new();
+        for n in [10, 20, 40, 80, 160] {
+            let h = 5.0 / n as f64;
+            let error = pendulum::error_at_5(quadrature.clone(), h)?;
+            if error > 1e-14 {
+                points.push((h.log10(), error.log10()));
+            }
+        }
+        series.push(Series {
+            label: quadrature.name(),
+            points,
+        });
+    }
+    line_chart(
+        path,
+        "Pendulum: error at T = 5 against step",
+        ("log10 h", "log10 |error|"),
+        &series,
+    )?;
+    Ok(path)
+}
+
+/// log10 |E − E0| over time for the double pendulum, h = 0.01.
+fn energy() -> Result<&'static str, Box<dyn Error>> {
+    let path = "output/energy_error.png";
+    let mut series = Vec::new();
+    for quadrature in super::quadratures() {
+        let name = quadrature.name();
+        let mut stepper = double_pendulum::stepper(quadrature, 0.01)?;
+        let trajectory = stepper.run(2000)?;
+        let e0 = trajectory.energy()[0];
+        let points = trajectory
+            .t()
+            .iter()
+            .zip(trajectory.energy())
+            .skip(1)
+            .map(|(t, e)| (*t, ((e - e0).abs().max(1e-16)).log10()))
+            .collect();
+        series.push(Series {
+            label: name,
+            points,
+        });
+    }
+    line_chart(
+        path,
+        "Double pendulum: energy error, h = 0.01",
+        ("t", "log10 |E − E0|"),
+        &series,
+    )?;
+    Ok(path)
+}
+
+/// The knife edge's path (x, y) for the three constraint points against the closed form.
+fn knife_edge_paths() -> Result<&'static str, Box<dyn Error>> {
+    let path = "output/knife_edge.png";
+    let (h, steps) = (0.05, 200);
+    let exact = (0..=steps)
+        .map(|k| knife_edge::exact(k as f64 * h))
+        .map(|q| (q[1], q[0]))
+        .collect();
+    let mut series = vec![Series {
+        label: "exact".into(),
+        points: exact,
+    }];
+    for point in [
+        ConstraintPoint::Start,
+        ConstraintPoint::Midpoint,
+        ConstraintPoint::End,
+    ] {
+        let mut stepper = knife_edge::stepper(point, h)?;
+        let trajectory = stepper.run(steps)?;
+        let points = trajectory.q().iter().map(|q| (q[1], q[0])).collect();
+        series.push(Series {
+            label: format!("constraint at {point:?}"),
+            points,
+        });
+    }
+    line_chart(
+        path,
+        "Knife edge on an incline, h = 0.05, T = 10",
+        ("y (across the slope)", "x (down the slope)"),
+        &series,
+    )?;
+    Ok(path)
+}
+
+/// q_c2(t) of the LC circuit with the midpoint rule at h = 0.1 against the closed form.
+fn lc_circuit() -> Result<&'static str, Box<dyn Error>> {
+    let path = "output/lc_circuit.png";
+    let h = 0.1;
+    let mut stepper = Stepper::new(circuit::LC, Quadrature::midpoint(), h)?;
+    stepper.start_from_velocity(circuit::q0(), SVector::zeros())?;
+    let trajectory = stepper.run(300)?;
+    let computed = trajectory
+        .t()
+        .iter()
+        .zip(trajectory.q())
+        .map(|(t, q)| (*t, q[2]))
+        .collect();
+    let exact = (0..=3000)
+        .map(|k| k as f64 * 0.01)
+        .map(|t| (t, circuit::lc_q_c2(t)))
+        .collect();
+    let series = [
+        Series {
+            label: "closed form".into(),
+            points: exact,
+        },
+        Series {
+            label: "midpoint, h = 0.1".into(),
+            points: computed,
+        },
+    ];
+    line_chart(path, "LC circuit: charge on C2", ("t", "q_c2"), &series)?;
+    Ok(path)
+}
