@@ -1,6 +1,7 @@
-//! The `#[dirac_system(...)]` attribute. It parses the model ([`ast`]), checks it and collects
-//! every error with its span ([`validate`]), rewrites the Lagrangian into generic scalar code
-//! ([`expression`]) and implements `dirac::DiracSystem` ([`expand`]). It never panics on input.
+//! The `#[dirac_system(...)]` attribute. It parses the model (`ast`), checks it and collects
+//! every error with its span (`validate`), rewrites the Lagrangian and the one-forms into generic
+//! scalar code (`expression`, `one_form`) and implements `dirac::DiracSystem` (`expand`). It never
+//! panics on input.
 
 use proc_macro::TokenStream;
 
