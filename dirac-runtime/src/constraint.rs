@@ -101,65 +101,91 @@ pub(crate) fn holonomic<S: DiracSystem<N>, const N: usize>(
     (g.re, gradient(&g))
 }
 
-/// The constraint rows of one step, appended after the `N s` Euler–Lagrange rows.
-///
-/// `x` holds the unknowns `[Z_1..Z_s, μ (one-forms), λ (holonomic)]`. Adds the constraint forces
-/// to rows `0..N`, writes the constraint residuals, fills the matching Jacobian entries, and
-/// returns the total constraint impulse `A(q_c)ᵀ μ + dg(q_k)ᵀ λ` (what they add to `p_{k+1} − p_k`)
-/// with the size of the terms of the constraint rows.
-pub(crate) fn add_constraints<S: DiracSystem<N>, const N: usize>(
-    system: &S,
-    point: ConstraintPoint,
-    base: &SVector<f64, N>,
-    x: &DVector<f64>,
-    euler_lagrange_rows: usize,
-    residual: &mut DVector<f64>,
-    jacobian: &mut DMatrix<f64>,
-) -> (SVector<f64, N>, f64) {
-    let step_col = euler_lagrange_rows - N;
-    let step = x.fixed_rows::<N>(step_col).into_owned();
-    let (theta, share) = (point.theta(), point.share());
-    let mut impulse = SVector::<f64, N>::zeros();
-    let mut scale = 0.0_f64;
-    let q_c = base + step * theta;
-    for a in 0..S::ONE_FORMS {
-        let (row, derivative) = one_form(system, &q_c, a);
-        let col = euler_lagrange_rows + a;
-        let mu = x[col];
-        impulse += row * mu;
-        for i in 0..N {
-            residual[i] += share * mu * row[i];
-            jacobian[(i, col)] += share * row[i];
+/// What the constraint rows of one step need besides the unknowns: the system, where the
+/// one-forms are evaluated, the start `q_k`, and `dg_b(q_k)` (constant over the step, see
+/// [`holonomic_forms`]).
+pub(crate) struct StepConstraints<'a, S, const N: usize> {
+    pub system: &'a S,
+    pub point: ConstraintPoint,
+    pub base: &'a SVector<f64, N>,
+    pub holonomic_forms: &'a [SVector<f64, N>],
+}
+
+impl<S: DiracSystem<N>, const N: usize> StepConstraints<'_, S, N> {
+    /// The constraint rows, appended after the `N s` Euler–Lagrange rows.
+    ///
+    /// `x` holds the unknowns `[Z_1..Z_s, μ (one-forms), λ (holonomic)]`. Adds the constraint
+    /// forces to rows `0..N`, writes the constraint residuals, fills the matching Jacobian entries,
+    /// and returns the total constraint impulse `A(q_c)ᵀ μ + dg(q_k)ᵀ λ` (what they add to
+    /// `p_{k+1} − p_k`) with the size of the terms of the constraint rows.
+    pub(crate) fn add(
+        &self,
+        x: &DVector<f64>,
+        euler_lagrange_rows: usize,
+        residual: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> (SVector<f64, N>, f64) {
+        let Self {
+            system,
+            point,
+            base,
+            holonomic_forms,
+        } = *self;
+        let step_col = euler_lagrange_rows - N;
+        let step = x.fixed_rows::<N>(step_col).into_owned();
+        let (theta, share) = (point.theta(), point.share());
+        let mut impulse = SVector::<f64, N>::zeros();
+        let mut scale = 0.0_f64;
+        let q_c = base + step * theta;
+        for a in 0..S::ONE_FORMS {
+            let (row, derivative) = one_form(system, &q_c, a);
+            let col = euler_lagrange_rows + a;
+            let mu = x[col];
+            impulse += row * mu;
+            for i in 0..N {
+                residual[i] += share * mu * row[i];
+                jacobian[(i, col)] += share * row[i];
+                for j in 0..N {
+                    jacobian[(i, step_col + j)] += share * theta * mu * derivative[(i, j)];
+                }
+            }
+            // A_a(q_c) · Z_s and its derivative in Z_s (q_c moves with Z_s by θ).
+            residual[col] = row.dot(&step);
+            scale = scale.max(row.abs().dot(&step.abs()));
+            let through_point = derivative.transpose() * step * theta;
             for j in 0..N {
-                jacobian[(i, step_col + j)] += share * theta * mu * derivative[(i, j)];
+                jacobian[(col, step_col + j)] = row[j] + through_point[j];
             }
         }
-        // A_a(q_c) · Z_s and its derivative in Z_s (q_c moves with Z_s by θ).
-        residual[col] = row.dot(&step);
-        scale = scale.max(row.abs().dot(&step.abs()));
-        let through_point = derivative.transpose() * step * theta;
-        for j in 0..N {
-            jacobian[(col, step_col + j)] = row[j] + through_point[j];
+        let end = base + step;
+        for (b, force_form) in holonomic_forms.iter().enumerate() {
+            let col = euler_lagrange_rows + S::ONE_FORMS + b;
+            let lambda = x[col];
+            impulse += force_form * lambda;
+            for i in 0..N {
+                residual[i] += lambda * force_form[i];
+                jacobian[(i, col)] += force_form[i];
+            }
+            let (g, form) = holonomic(system, &end, b);
+            residual[col] = g;
+            scale = scale.max(form.abs().dot(&end.abs()).max(g.abs()));
+            for j in 0..N {
+                jacobian[(col, step_col + j)] = form[j];
+            }
         }
+        (impulse, scale)
     }
-    let end = base + step;
-    for b in 0..S::HOLONOMIC {
-        let col = euler_lagrange_rows + S::ONE_FORMS + b;
-        let lambda = x[col];
-        let (_, force_form) = holonomic(system, base, b);
-        impulse += force_form * lambda;
-        for i in 0..N {
-            residual[i] += lambda * force_form[i];
-            jacobian[(i, col)] += force_form[i];
-        }
-        let (g, form) = holonomic(system, &end, b);
-        residual[col] = g;
-        scale = scale.max(form.abs().dot(&end.abs()).max(g.abs()));
-        for j in 0..N {
-            jacobian[(col, step_col + j)] = form[j];
-        }
+}
+
+/// Fills `forms[b] = dg_b(q)`: the directions of the holonomic constraint forces of a step from `q`.
+pub(crate) fn holonomic_forms<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    forms: &mut [SVector<f64, N>],
+) {
+    for (b, form) in forms.iter_mut().enumerate() {
+        *form = holonomic(system, q, b).1;
     }
-    (impulse, scale)
 }
 
 /// The largest constraint violation of a step from `q0` to `q1`: `|A(q_c)(q1 − q0)|` over the

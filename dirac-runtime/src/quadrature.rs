@@ -120,8 +120,9 @@ impl Quadrature {
         Self::galerkin(degree, Rule::GaussLegendre(degree))
     }
 
-    /// A quadrature whose degree and rule were already checked (by `#[dirac_system]` at compile
-    /// time). Inconsistent arguments fall back to no check: use [`galerkin`](Self::galerkin).
+    /// A quadrature whose degree and rule `#[dirac_system]` already checked at compile time with
+    /// the rules of [`galerkin`](Self::galerkin). Not for direct use: unchecked arguments give
+    /// meaningless tables; call [`galerkin`](Self::galerkin) instead.
     #[doc(hidden)]
     pub fn validated(degree: usize, rule: Rule) -> Self {
         Self::build(degree, rule)

@@ -9,7 +9,7 @@
 
 use nalgebra::{DVector, SVector};
 
-use crate::constraint::{self, ConstraintPoint};
+use crate::constraint::{self, ConstraintPoint, StepConstraints};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
 use crate::initial_state;
@@ -112,6 +112,8 @@ pub struct Stepper<S, const N: usize> {
     violation: f64,
     /// Multipliers of the last step (zeros before the first).
     multipliers: Vec<f64>,
+    /// `dg_b(q_k)` of the step being solved: evaluated once per step, not per Newton iteration.
+    holonomic_forms: Vec<SVector<f64, N>>,
 }
 
 impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
@@ -148,6 +150,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             inputs: vec![0.0; S::INPUTS],
             violation: 0.0,
             multipliers: vec![0.0; S::ONE_FORMS + S::HOLONOMIC],
+            holonomic_forms: vec![SVector::zeros(); S::HOLONOMIC],
             discrete: DiscreteLagrangian::new(system, quadrature, h),
             newton: Newton::new(unknowns, options),
             state: None,
@@ -243,7 +246,15 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             }
         }
         let mut impulse = SVector::zeros();
+        if S::HOLONOMIC > 0 {
+            constraint::holonomic_forms(
+                self.discrete.system(),
+                &state.q,
+                &mut self.holonomic_forms,
+            );
+        }
         let (discrete, increments, point) = (&self.discrete, &mut self.increments, self.point);
+        let holonomic_forms = &self.holonomic_forms;
         let (t, inputs) = (state.t, &self.inputs);
         let result = self.newton.solve(&mut self.unknowns, |x, r, jac| {
             for (j, z) in increments.iter_mut().enumerate() {
@@ -258,10 +269,13 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 scale = scale.max(size);
             }
             if S::ONE_FORMS + S::HOLONOMIC > 0 {
-                let system = discrete.system();
-                let rows = N * s;
-                let (constraints, size) =
-                    constraint::add_constraints(system, point, &state.q, x, rows, r, jac);
+                let constraints = StepConstraints {
+                    system: discrete.system(),
+                    point,
+                    base: &state.q,
+                    holonomic_forms,
+                };
+                let (constraints, size) = constraints.add(x, N * s, r, jac);
                 impulse += constraints;
                 scale = scale.max(size);
             }
