@@ -135,7 +135,7 @@ fn expand(model: &Model) -> TokenStream {
                 __p
             }
 
-            fn quadrature(&self) -> ::dirac::Quadrature {
+            fn quadrature(&self) -> ::core::result::Result<::dirac::Quadrature, ::dirac::DiracError> {
                 #quadrature
             }
 

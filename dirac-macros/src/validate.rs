@@ -157,7 +157,7 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
         (Some(_), None) => None,
     };
     let quadrature = match e.quadrature {
-        None => Some(quote!(::dirac::Quadrature::midpoint())),
+        None => Some(quote!(::core::result::Result::Ok(::dirac::Quadrature::midpoint()))),
         Some(expr) => match quadrature::parse(&expr) {
             Ok(tokens) => Some(tokens),
             Err(err) => {

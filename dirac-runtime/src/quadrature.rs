@@ -120,14 +120,6 @@ impl Quadrature {
         Self::galerkin(degree, Rule::GaussLegendre(degree))
     }
 
-    /// A quadrature whose degree and rule `#[dirac_system]` already checked at compile time with
-    /// the rules of [`galerkin`](Self::galerkin). Not for direct use: unchecked arguments give
-    /// meaningless tables; call [`galerkin`](Self::galerkin) instead.
-    #[doc(hidden)]
-    pub fn validated(degree: usize, rule: Rule) -> Self {
-        Self::build(degree, rule)
-    }
-
     fn build(degree: usize, rule: Rule) -> Self {
         let (nodes, weights) = match rule {
             Rule::GaussLegendre(r) => gauss_legendre(r),

@@ -165,7 +165,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
 
     /// A stepper with the system's own quadrature (the one named in `#[dirac_system]`).
     pub fn from_system(system: S, h: f64) -> Result<Self, DiracError> {
-        let quadrature = system.quadrature();
+        let quadrature = system.quadrature()?;
         Self::new(system, quadrature, h)
     }
 

@@ -3,6 +3,7 @@
 use nalgebra::SVector;
 
 use crate::constraint::ConstraintPoint;
+use crate::error::DiracError;
 use crate::quadrature::Quadrature;
 use crate::scalar::Scalar;
 
@@ -94,8 +95,9 @@ pub trait DiracSystem<const N: usize> {
         Vec::new()
     }
 
-    /// The quadrature a stepper uses when none is named ([`Stepper::from_system`](crate::Stepper::from_system)).
-    fn quadrature(&self) -> Quadrature {
-        Quadrature::midpoint()
+    /// The quadrature a stepper uses when none is named ([`Stepper::from_system`](crate::Stepper::from_system)):
+    /// an `Err` when the model names an invalid one.
+    fn quadrature(&self) -> Result<Quadrature, DiracError> {
+        Ok(Quadrature::midpoint())
     }
 }

@@ -14,7 +14,7 @@ struct Duffing {
 
 fn main() {
     let system = Duffing { m: 2.0, k: 1.0, eps: 0.1 };
-    assert_eq!(system.quadrature().name(), "galerkin(2, gauss_lobatto(3))");
+    assert_eq!(system.quadrature().unwrap().name(), "galerkin(2, gauss_lobatto(3))");
     assert_eq!(system.coordinate_name(0), "x");
     assert_eq!(system.parameters().len(), 3);
     // L at q = 1, v = 2: 4 − 0.5 − 0.025.
