@@ -45,7 +45,8 @@ fn a_step_that_does_not_converge_leaves_the_state_unchanged() {
     };
     let mut stepper = Stepper::new(SCENE, Quadrature::gauss(2).unwrap(), 0.5)
         .unwrap()
-        .with_newton_options(options);
+        .with_newton_options(options)
+        .unwrap();
     stepper
         .start_from_momentum(vector![1.0], vector![0.0])
         .unwrap();
@@ -68,7 +69,7 @@ fn a_step_that_does_not_converge_leaves_the_state_unchanged() {
         (stepper.t(), stepper.q(), stepper.p(), stepper.steps())
     );
     // With the default cap the same step succeeds.
-    let mut stepper = stepper.with_newton_options(NewtonOptions::default());
+    let mut stepper = stepper.with_newton_options(NewtonOptions::default()).unwrap();
     stepper.step().unwrap();
     assert_eq!(stepper.steps(), 1);
 }

@@ -20,7 +20,7 @@ fn energy_error_is_bounded_without_drift_over_a_million_steps() {
     stepper
         .start_from_momentum(vector![1.0], vector![0.0])
         .unwrap();
-    let mut trajectory = Trajectory::new(stepper.coordinate_names());
+    let mut trajectory = Trajectory::new(stepper.coordinate_names()).unwrap();
     stepper.record(&mut trajectory, 1_000_000, 37).unwrap();
     let (first, last) = energy_error_first_and_last_tenth(trajectory.energy());
     assert!(

@@ -12,6 +12,7 @@
 use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
 use num_dual::{Derivative, HyperDualSVec64};
 
+use crate::error::DiracError;
 use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
 
@@ -102,7 +103,9 @@ pub(crate) fn seeded<S: DiracSystem<N>, const N: usize>(
 /// }
 /// // A free particle: L_d = (q1 − q0)² / (2h) for every quadrature.
 /// let ld = DiscreteLagrangian::new(Free, Quadrature::trapezoid(), 0.5);
-/// assert!((ld.value(&[vector![1.0], vector![2.0]]) - 1.0).abs() < 1e-15);
+/// assert!((ld.value(&[vector![1.0], vector![2.0]])? - 1.0).abs() < 1e-15);
+/// assert!(ld.value(&[vector![1.0]]).is_err()); // a step has degree + 1 points
+/// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
 #[derive(Debug, Clone)]
 pub struct DiscreteLagrangian<S, const N: usize> {
@@ -148,29 +151,29 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
         let mut dq = SVector::zeros();
         let mut v = SVector::zeros();
         for (j, z) in increments.iter().enumerate() {
-            dq += z * self.quadrature.basis(i, j + 1);
-            v += z * (self.quadrature.basis_derivative(i, j + 1) / self.h);
+            dq += z * self.quadrature.ell(i, j + 1);
+            v += z * (self.quadrature.ell_prime(i, j + 1) / self.h);
         }
         (base + dq, v)
     }
 
-    /// `L_d(Q_0, …, Q_s)`; `points` holds the `s + 1` points of the step.
-    ///
-    /// # Panics
-    /// If `points.len()` is not the quadrature's degree plus one.
-    pub fn value(&self, points: &[SVector<f64, N>]) -> f64 {
-        assert_eq!(
-            points.len(),
-            self.quadrature.degree() + 1,
-            "L_d takes degree + 1 points"
-        );
+    /// `L_d(Q_0, …, Q_s)`; `points` holds the `s + 1` points of the step (an error otherwise).
+    pub fn value(&self, points: &[SVector<f64, N>]) -> Result<f64, DiracError> {
+        if points.len() != self.quadrature.degree() + 1 {
+            return Err(DiracError::Dimension(format!(
+                "L_d under {} takes {} points, got {}",
+                self.quadrature.name(),
+                self.quadrature.degree() + 1,
+                points.len()
+            )));
+        }
         let increments: Vec<_> = points[1..].iter().map(|q| q - points[0]).collect();
-        (0..self.quadrature.nodes().len())
+        Ok((0..self.quadrature.nodes().len())
             .map(|i| {
                 let (q, v) = self.node(i, &points[0], &increments);
                 self.h * self.quadrature.weights()[i] * self.system.lagrangian(&q, &v)
             })
-            .sum()
+            .sum())
     }
 
     /// The discrete Euler–Lagrange system of one step and the new momentum.
@@ -197,8 +200,8 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
         for (i, &b) in quad.weights().iter().enumerate() {
             let w = h * b;
             let (q, v) = self.node(i, base, increments);
-            let a = |j: usize| quad.basis(i, j);
-            let d = |j: usize| quad.basis_derivative(i, j) / h;
+            let a = |j: usize| quad.ell(i, j);
+            let d = |j: usize| quad.ell_prime(i, j) / h;
             if s == 1 {
                 // One pair of slots: seed the directions of Q_0 and Q_1 themselves.
                 let l = seeded(
@@ -291,7 +294,7 @@ mod tests {
         let mut minus = points.to_vec();
         plus[j][c] += eps;
         minus[j][c] -= eps;
-        (ld.value(&plus) - ld.value(&minus)) / (2.0 * eps)
+        (ld.value(&plus).unwrap() - ld.value(&minus).unwrap()) / (2.0 * eps)
     }
 
     fn check(quadrature: Quadrature) {

@@ -30,7 +30,7 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
             let (q, v) = self.node(i, base, increments);
             for k in 1..=s {
                 // F along the direction of the unknown Z_k: value and ∂F/∂Z_k.
-                let (a, d) = (quad.basis(i, k), quad.basis_derivative(i, k) / h);
+                let (a, d) = (quad.ell(i, k), quad.ell_prime(i, k) / h);
                 let f = self
                     .system()
                     .force(&lift(&q, a), &lift(&v, d), t + c * h, inputs);
@@ -43,7 +43,7 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
                     scale = scale.max(value.amax() * w);
                 }
                 for j in 0..s {
-                    let lj = quad.basis(i, j);
+                    let lj = quad.ell(i, j);
                     if k == 1 {
                         let mut r = residual.rows_mut(j * N, N);
                         r += value * (w * lj);

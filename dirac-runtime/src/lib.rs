@@ -23,7 +23,7 @@ pub mod trajectory;
 
 pub use constraint::ConstraintPoint;
 pub use discrete_lagrangian::DiscreteLagrangian;
-pub use error::DiracError;
+pub use error::{DiracError, Interrupted};
 pub use lu::SingularPivot;
 pub use newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 pub use quadrature::{Quadrature, Rule};

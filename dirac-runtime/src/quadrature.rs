@@ -169,13 +169,35 @@ impl Quadrature {
         &self.weights
     }
 
-    /// `ℓ_j(c_i)`: the weight of point `j` in the position at node `i`.
-    pub fn basis(&self, node: usize, point: usize) -> f64 {
+    /// `ℓ_j(c_i)`: the weight of point `j` (`0..=degree`) in the position at node `i`; `None`
+    /// outside the table.
+    ///
+    /// ```
+    /// let q = dirac_runtime::Quadrature::midpoint();
+    /// assert_eq!(q.basis(0, 1), Some(0.5));
+    /// assert_eq!(q.basis(5, 5), None);
+    /// ```
+    pub fn basis(&self, node: usize, point: usize) -> Option<f64> {
+        self.index(node, point).map(|k| self.basis[k])
+    }
+
+    /// `ℓ'_j(c_i)`: the weight of point `j` in `h` times the velocity at node `i`; `None` outside
+    /// the table.
+    pub fn basis_derivative(&self, node: usize, point: usize) -> Option<f64> {
+        self.index(node, point).map(|k| self.basis_derivative[k])
+    }
+
+    fn index(&self, node: usize, point: usize) -> Option<usize> {
+        (node < self.nodes.len() && point <= self.degree).then(|| node * (self.degree + 1) + point)
+    }
+
+    /// `ℓ_j(c_i)` for indices the caller keeps in range (the step's loops).
+    pub(crate) fn ell(&self, node: usize, point: usize) -> f64 {
         self.basis[node * (self.degree + 1) + point]
     }
 
-    /// `ℓ'_j(c_i)`: the weight of point `j` in `h` times the velocity at node `i`.
-    pub fn basis_derivative(&self, node: usize, point: usize) -> f64 {
+    /// `ℓ'_j(c_i)` for indices the caller keeps in range.
+    pub(crate) fn ell_prime(&self, node: usize, point: usize) -> f64 {
         self.basis_derivative[node * (self.degree + 1) + point]
     }
 
@@ -334,9 +356,9 @@ mod tests {
         let p = |t: f64| 1.0 + 2.0 * t - t.powi(3);
         let dp = |t: f64| 2.0 - 3.0 * t * t;
         for (i, &c) in q.nodes().iter().enumerate() {
-            let value: f64 = (0..=3).map(|j| q.basis(i, j) * p(j as f64 / 3.0)).sum();
+            let value: f64 = (0..=3).map(|j| q.ell(i, j) * p(j as f64 / 3.0)).sum();
             let slope: f64 = (0..=3)
-                .map(|j| q.basis_derivative(i, j) * p(j as f64 / 3.0))
+                .map(|j| q.ell_prime(i, j) * p(j as f64 / 3.0))
                 .sum();
             assert!((value - p(c)).abs() < 1e-14);
             assert!((slope - dp(c)).abs() < 1e-13);
@@ -347,7 +369,7 @@ mod tests {
     fn named_rules_match_their_formulas() {
         let m = Quadrature::midpoint();
         assert_eq!((m.nodes(), m.weights()), (&[0.5][..], &[1.0][..]));
-        assert_eq!((m.basis(0, 0), m.basis_derivative(0, 1)), (0.5, 1.0));
+        assert_eq!((m.basis(0, 0), m.basis_derivative(0, 1)), (Some(0.5), Some(1.0)));
         let t = Quadrature::trapezoid();
         assert_eq!(t.weights(), &[0.5, 0.5]);
         assert_eq!(t.name(), "trapezoid");

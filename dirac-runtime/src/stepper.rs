@@ -11,7 +11,7 @@ use nalgebra::{DVector, SVector};
 
 use crate::constraint::{self, ConstraintPoint, StepConstraints};
 use crate::discrete_lagrangian::DiscreteLagrangian;
-use crate::error::DiracError;
+use crate::error::{DiracError, Interrupted};
 use crate::initial_state;
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
@@ -143,7 +143,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         }
         let unknowns = N * quadrature.degree() + S::ONE_FORMS + S::HOLONOMIC;
         let increments = vec![SVector::zeros(); quadrature.degree()];
-        let options = NewtonOptions::default();
+        let newton = Newton::new(unknowns, NewtonOptions::default())?;
         let point = system.constraint_point();
         Ok(Self {
             point,
@@ -152,7 +152,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             multipliers: vec![0.0; S::ONE_FORMS + S::HOLONOMIC],
             holonomic_forms: vec![SVector::zeros(); S::HOLONOMIC],
             discrete: DiscreteLagrangian::new(system, quadrature, h),
-            newton: Newton::new(unknowns, options),
+            newton,
             state: None,
             start: 0.0,
             steps: 0,
@@ -169,10 +169,11 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         Self::new(system, quadrature, h)
     }
 
-    /// Replaces the Newton options (tolerances, iteration cap).
-    pub fn with_newton_options(mut self, options: NewtonOptions) -> Self {
-        self.newton = Newton::new(self.unknowns.len(), options);
-        self
+    /// Replaces the Newton options (tolerances, iteration cap, root acceptance); fails on
+    /// options out of range.
+    pub fn with_newton_options(mut self, options: NewtonOptions) -> Result<Self, DiracError> {
+        self.newton = Newton::new(self.unknowns.len(), options)?;
+        Ok(self)
     }
 
     /// Evaluates the constraint one-forms at `point` of each step instead of the system's default.
@@ -193,27 +194,79 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         self.check_finite("initial velocity", &v0)?;
         let p0 = legendre::momentum(self.system(), &q0, &v0);
         self.check_finite("initial momentum", &p0)?;
+        self.start(q0, p0, v0)
+    }
+
+    /// Starts from position `q0` and momentum `p0` at `t = 0`. The velocity is found by a
+    /// globalised Newton solve of `∂L/∂v(q0, v) = p0` from `v = 0`; when that fails (several
+    /// velocities share the momentum, or `v = 0` is far from the answer), use
+    /// [`start_from_momentum_near`](Self::start_from_momentum_near).
+    pub fn start_from_momentum(
+        &mut self,
+        q0: SVector<f64, N>,
+        p0: SVector<f64, N>,
+    ) -> Result<(), DiracError> {
+        self.start_from_momentum_near(q0, p0, SVector::zeros())
+    }
+
+    /// Starts from position `q0` and momentum `p0` at `t = 0`, solving for the velocity from
+    /// the guess `v_guess`.
+    pub fn start_from_momentum_near(
+        &mut self,
+        q0: SVector<f64, N>,
+        p0: SVector<f64, N>,
+        v_guess: SVector<f64, N>,
+    ) -> Result<(), DiracError> {
+        self.check_finite("initial position", &q0)?;
+        self.check_finite("initial momentum", &p0)?;
+        self.check_finite("velocity guess", &v_guess)?;
+        let v0 = self.velocity_at(&q0, &p0, &v_guess)?;
+        self.start(q0, p0, v0)
+    }
+
+    /// Checks a consistent, finite initial state and makes it current.
+    fn start(
+        &mut self,
+        q0: SVector<f64, N>,
+        p0: SVector<f64, N>,
+        v0: SVector<f64, N>,
+    ) -> Result<(), DiracError> {
+        let lagrangian = self.system().lagrangian(&q0, &v0);
+        if !lagrangian.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: "the Lagrangian at the initial state (is q0 in its domain?)".into(),
+                value: lagrangian,
+            });
+        }
+        let energy = legendre::energy(self.system(), &q0, &v0);
+        if !energy.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: "the initial energy".into(),
+                value: energy,
+            });
+        }
         initial_state::check(self.system(), &q0, &v0, &self.inputs)
             .map_err(DiracError::InconsistentInitialState)?;
         self.reset(State::new(0.0, q0, p0, v0));
         Ok(())
     }
 
-    /// Starts from position `q0` and momentum `p0` at `t = 0`.
-    pub fn start_from_momentum(
-        &mut self,
-        q0: SVector<f64, N>,
-        p0: SVector<f64, N>,
-    ) -> Result<(), DiracError> {
-        self.check_finite("initial position", &q0)?;
-        self.check_finite("initial momentum", &p0)?;
-        let mut newton = Newton::new(N, *self.newton.options());
-        let v0 = legendre::velocity(self.system(), &mut newton, &q0, &p0, &SVector::zeros())
-            .map_err(|f| self.failure(LEGENDRE, f))?;
-        initial_state::check(self.system(), &q0, &v0, &self.inputs)
-            .map_err(DiracError::InconsistentInitialState)?;
-        self.reset(State::new(0.0, q0, p0, v0));
-        Ok(())
+    /// The velocity at `(q, p)` by the globalised Legendre inversion from `guess`.
+    fn velocity_at(
+        &self,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, DiracError> {
+        let options = NewtonOptions {
+            line_search: true,
+            max_contraction: f64::INFINITY,
+            max_iterations: self.newton.options().max_iterations.max(50),
+            ..*self.newton.options()
+        };
+        let mut newton = Newton::new(N, options)?;
+        legendre::velocity(self.system(), &mut newton, q, p, guess)
+            .map_err(|f| self.failure(LEGENDRE, f))
     }
 
     fn reset(&mut self, state: State<N>) {
@@ -289,6 +342,19 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         self.check_finite("new position", &next.q)?;
         self.check_finite("new momentum", &next.p)?;
         next.v_hint = step / h;
+        // The quadrature may never evaluate L at q_{k+1} (the midpoint rule does not): a step
+        // that leaves the Lagrangian's domain is refused here, not found later as NaN energies.
+        let lagrangian = self.system().lagrangian(&next.q, &next.v_hint);
+        if !lagrangian.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: format!(
+                    "the Lagrangian at the end of step {} (the step leaves its domain; try a \
+                     smaller step)",
+                    self.steps
+                ),
+                value: lagrangian,
+            });
+        }
         if S::ONE_FORMS + S::HOLONOMIC > 0 {
             self.violation = constraint::violation(self.system(), self.point, &state.q, &next.q);
             let count = self.multipliers.len();
@@ -307,10 +373,15 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     }
 
     /// Runs `steps` steps and returns the trajectory, starting with the current state.
-    pub fn run(&mut self, steps: usize) -> Result<Trajectory<N>, DiracError> {
+    ///
+    /// A step that fails ends the run with [`Interrupted`], which keeps the trajectory up to the
+    /// last good step (the stepper stays there too); `?` turns it into its [`DiracError`].
+    pub fn run(&mut self, steps: usize) -> Result<Trajectory<N>, Interrupted<N>> {
         let mut trajectory = self.trajectory();
-        self.record(&mut trajectory, steps, 1)?;
-        Ok(trajectory)
+        match self.record(&mut trajectory, steps, 1) {
+            Ok(()) => Ok(trajectory),
+            Err(error) => Err(Interrupted { trajectory, error }),
+        }
     }
 
     /// Appends the current state and then every `every`-th of the next `steps` states to
@@ -343,7 +414,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 energy,
                 self.violation,
                 self.multipliers(),
-            );
+            )?;
         } else {
             trajectory.push(state.t, state.q, state.p, energy);
         }
@@ -453,21 +524,21 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     /// Hessian, seeded with the last step's mean velocity).
     pub fn v(&self) -> Result<SVector<f64, N>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
-        let mut newton = Newton::new(N, *self.newton.options());
-        legendre::velocity(
-            self.system(),
-            &mut newton,
-            &state.q,
-            &state.p,
-            &state.v_hint,
-        )
-        .map_err(|f| self.failure(LEGENDRE, f))
+        self.velocity_at(&state.q, &state.p, &state.v_hint)
     }
 
-    /// Energy `⟨p, v⟩ − L(q, v)` of the current state, with `v` from [`v`](Self::v).
+    /// Energy `⟨p, v⟩ − L(q, v)` of the current state, with `v` from [`v`](Self::v); an error,
+    /// never NaN, where it is not finite.
     pub fn energy(&self) -> Result<f64, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
-        Ok(legendre::energy(self.system(), &state.q, &self.v()?))
+        let energy = legendre::energy(self.system(), &state.q, &self.v()?);
+        if !energy.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: format!("the energy after step {}", self.steps),
+                value: energy,
+            });
+        }
+        Ok(energy)
     }
 
     /// How Newton's method went on the last step.
@@ -487,6 +558,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         } else {
             Trajectory::new(names)
         }
+        .expect("one name per coordinate, from coordinate_names")
     }
 
     /// Coordinate names, from the system.
@@ -553,10 +625,23 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                     unknowns: unknowns.join(", "),
                 }
             }
+            NewtonFailure::NotContracting { contraction, .. } => DiracError::UntrustedStep {
+                problem,
+                step: self.steps,
+                contraction,
+                max_contraction: self.newton.options().max_contraction,
+            },
             NewtonFailure::NonFinite => DiracError::NonFinite {
-                what: format!("the residual of {problem} at step {}", self.steps),
+                what: format!(
+                    "the residual of {problem} at step {} (the iterate left the Lagrangian's \
+                     domain; try a smaller step)",
+                    self.steps
+                ),
                 value: f64::NAN,
             },
+            NewtonFailure::Dimension { expected, got } => DiracError::Dimension(format!(
+                "{problem}: {got} unknowns where the solver has {expected}"
+            )),
         }
     }
 }

@@ -12,7 +12,8 @@ use crate::error::DiracError;
 /// ```
 /// use dirac_runtime::Trajectory;
 /// use nalgebra::vector;
-/// let mut trajectory = Trajectory::new(vec!["x".into()]);
+/// let mut trajectory = Trajectory::new(vec!["x".into()])?;
+/// assert!(Trajectory::<1>::new(vec![]).is_err()); // one name per coordinate
 /// trajectory.push(0.0, vector![1.0], vector![0.0], 0.5);
 /// trajectory.push(0.1, vector![0.99], vector![-0.1], 0.5001);
 /// let mut csv = Vec::new();
@@ -36,15 +37,23 @@ pub struct Trajectory<const N: usize> {
 
 impl<const N: usize> Trajectory<N> {
     /// An empty trajectory whose coordinates are called `names` (one per coordinate).
-    pub fn new(names: Vec<String>) -> Self {
+    pub fn new(names: Vec<String>) -> Result<Self, DiracError> {
         Self::with_multipliers(names, Vec::new())
     }
 
     /// An empty trajectory of a constrained system, which also records the constraint
     /// violation and the multipliers (named `multiplier_names`) at every sample.
-    pub fn with_multipliers(names: Vec<String>, multiplier_names: Vec<String>) -> Self {
-        debug_assert_eq!(names.len(), N);
-        Self {
+    pub fn with_multipliers(
+        names: Vec<String>,
+        multiplier_names: Vec<String>,
+    ) -> Result<Self, DiracError> {
+        if names.len() != N {
+            return Err(DiracError::Dimension(format!(
+                "a trajectory of {N} coordinates needs {N} names, got {}",
+                names.len()
+            )));
+        }
+        Ok(Self {
             names,
             t: Vec::new(),
             q: Vec::new(),
@@ -53,10 +62,10 @@ impl<const N: usize> Trajectory<N> {
             multiplier_names,
             multipliers: Vec::new(),
             violation: Vec::new(),
-        }
+        })
     }
 
-    /// Appends a sample of a constrained system.
+    /// Appends a sample of a constrained system: one multiplier per name given at construction.
     pub fn push_constrained(
         &mut self,
         t: f64,
@@ -65,10 +74,18 @@ impl<const N: usize> Trajectory<N> {
         energy: f64,
         violation: f64,
         multipliers: &[f64],
-    ) {
+    ) -> Result<(), DiracError> {
+        if multipliers.len() != self.multiplier_names.len() {
+            return Err(DiracError::Dimension(format!(
+                "the trajectory records {} multipliers, got {}",
+                self.multiplier_names.len(),
+                multipliers.len()
+            )));
+        }
         self.push(t, q, p, energy);
         self.violation.push(violation);
         self.multipliers.push(multipliers.to_vec());
+        Ok(())
     }
 
     /// Constraint violation of the step that ended at each sample (empty when unconstrained).

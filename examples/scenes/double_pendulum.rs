@@ -72,7 +72,7 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         quadrature: name,
         h,
         steps,
-        max_energy_error: trajectory.max_energy_error(),
+        max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!("T = 10; Newton iterations on the last step: {newton}"),
     })

@@ -52,7 +52,7 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         quadrature: name,
         h,
         steps,
-        max_energy_error: trajectory.max_energy_error(),
+        max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!("max relative angular momentum error = {drift:.2e}"),
     })

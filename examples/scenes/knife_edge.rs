@@ -67,7 +67,7 @@ pub fn report_point(point: ConstraintPoint) -> Result<Report, DiracError> {
         quadrature: name,
         h,
         steps,
-        max_energy_error: trajectory.max_energy_error(),
+        max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!(
             "|q(10) − exact| = {:.2e}, E(10) − E(0) = {drift:+.2e}",

@@ -26,7 +26,8 @@ pub struct Report {
     pub quadrature: String,
     pub h: f64,
     pub steps: usize,
-    pub max_energy_error: f64,
+    /// `max |E − E0|`; `None` where energy is not conserved by design (a driven system).
+    pub max_energy_error: Option<f64>,
     pub wall: Duration,
     /// What this scene checks against its known answer, e.g. `|q(5) − q_exact| = 3e-9`.
     pub check: String,
@@ -63,8 +64,15 @@ pub fn print_table(reports: &[Report]) {
     );
     for r in reports {
         println!(
-            "{:<16} {:<32} {:>7} {:>8} {:>12.3e} {:>10.2?}  {}",
-            r.scene, r.quadrature, r.h, r.steps, r.max_energy_error, r.wall, r.check
+            "{:<16} {:<32} {:>7} {:>8} {:>12} {:>10.2?}  {}",
+            r.scene,
+            r.quadrature,
+            r.h,
+            r.steps,
+            r.max_energy_error
+                .map_or_else(|| "—".to_string(), |e| format!("{e:.3e}")),
+            r.wall,
+            r.check
         );
     }
 }
@@ -83,12 +91,12 @@ pub fn save_table(reports: &[Report], path: &str) -> std::io::Result<()> {
     for r in reports {
         writeln!(
             f,
-            "{},\"{}\",{},{},{:e},{},\"{}\"",
+            "{},\"{}\",{},{},{},{},\"{}\"",
             r.scene,
             r.quadrature,
             r.h,
             r.steps,
-            r.max_energy_error,
+            r.max_energy_error.map_or(String::new(), |e| format!("{e:e}")),
             r.wall.as_secs_f64(),
             r.check
         )?;

@@ -49,7 +49,7 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         quadrature: name,
         h,
         steps,
-        max_energy_error: trajectory.max_energy_error(),
+        max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!(
             "max |q − q_exact| on [0, 1] = {:.2e}",

@@ -50,7 +50,7 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         quadrature: name,
         h,
         steps,
-        max_energy_error: trajectory.max_energy_error(),
+        max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!("|(q,p)(5) − exact| = {:.2e}", error_at_5(quadrature, h)?),
     })

@@ -61,7 +61,7 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         quadrature: name,
         h,
         steps,
-        max_energy_error: trajectory.max_energy_error(),
+        max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!(
             "|x(20) − exact| = {:.2e}, |y − x1| ≤ {:.1e}",
