@@ -4,7 +4,7 @@
 mod scenes;
 
 use dirac::prelude::*;
-use scenes::pendulum::{Pendulum, SCENE};
+use scenes::pendulum::{self, Pendulum, SCENE};
 
 #[test]
 fn non_positive_or_non_finite_steps_are_rejected() {
@@ -132,4 +132,173 @@ fn trajectories_write_csv_with_named_columns() {
     assert!((last[0] - 0.3).abs() < 1e-15);
     assert_eq!(last[1], trajectory.q()[3][0]);
     assert_eq!(last[2], trajectory.p()[3][0]);
+}
+
+/// L = v²/2 − √(1 − q): defined for q ≤ 1 only; the force pushes q towards the edge.
+#[dirac_system(coordinates(q), lagrangian = 0.5 * dot(q).powi(2) - sqrt(1.0 - q))]
+struct Edge;
+
+#[test]
+fn an_initial_state_outside_the_lagrangians_domain_is_refused() {
+    let mut stepper = Stepper::new(Edge, Quadrature::midpoint(), 0.1).unwrap();
+    let err = stepper
+        .start_from_velocity(vector![2.0], vector![0.0])
+        .unwrap_err();
+    assert!(
+        matches!(&err, DiracError::NonFinite { what, .. } if what.contains("Lagrangian at the initial state")),
+        "{err}"
+    );
+    assert_eq!(stepper.energy(), Err(DiracError::NotStarted));
+    // A velocity so large that the energy overflows.
+    let err = Stepper::new(pendulum::SCENE, Quadrature::midpoint(), 0.1)
+        .unwrap()
+        .start_from_velocity(vector![0.0], vector![1e200])
+        .unwrap_err();
+    assert!(
+        matches!(&err, DiracError::NonFinite { what, .. } if what.contains("initial state")),
+        "{err}"
+    );
+}
+
+/// The midpoint rule evaluates L at step midpoints only; a step whose end leaves the domain is
+/// refused all the same, the state stays at the last good step, and `run` hands back every
+/// sample it recorded, none of them NaN.
+#[test]
+fn a_step_leaving_the_domain_is_refused_and_run_keeps_its_trajectory() {
+    for quadrature in scenes::quadratures() {
+        let name = quadrature.name();
+        let mut stepper = Stepper::new(Edge, quadrature, 0.1).unwrap();
+        stepper
+            .start_from_velocity(vector![0.0], vector![1.0])
+            .unwrap();
+        let interrupted = stepper.run(100).unwrap_err();
+        let steps = stepper.steps() as usize;
+        assert!(steps > 0 && steps < 100, "{name}: {steps} steps");
+        assert_eq!(interrupted.trajectory.len(), steps + 1, "{name}");
+        assert!(
+            matches!(
+                interrupted.error,
+                DiracError::NonFinite { .. }
+                    | DiracError::UntrustedStep { .. }
+                    | DiracError::NoConvergence { .. }
+            ),
+            "{name}: {}",
+            interrupted.error
+        );
+        assert!(stepper.q()[0] <= 1.0, "{name}");
+        assert_eq!(stepper.q(), *interrupted.trajectory.q().last().unwrap());
+        assert!(
+            interrupted.trajectory.energy().iter().all(|e| e.is_finite()),
+            "{name}"
+        );
+        // The energy of the last good state is finite, and `?` still yields a DiracError.
+        assert!(stepper.energy().unwrap().is_finite());
+        let as_error: DiracError = interrupted.into();
+        assert!(!as_error.to_string().is_empty());
+    }
+}
+
+#[test]
+fn newton_options_out_of_range_are_refused() {
+    let stepper = || Stepper::new(pendulum::SCENE, Quadrature::midpoint(), 0.1).unwrap();
+    for options in [
+        NewtonOptions {
+            residual_tolerance: f64::NAN,
+            ..Default::default()
+        },
+        NewtonOptions {
+            step_tolerance: -1.0,
+            ..Default::default()
+        },
+        NewtonOptions {
+            max_iterations: 0,
+            ..Default::default()
+        },
+        NewtonOptions {
+            max_contraction: 0.0,
+            ..Default::default()
+        },
+        NewtonOptions {
+            singular_tolerance: 1.0,
+            ..Default::default()
+        },
+    ] {
+        let err = stepper().with_newton_options(options).unwrap_err();
+        assert!(matches!(err, DiracError::InvalidOptions(_)), "{err}");
+    }
+    assert!(
+        stepper()
+            .with_newton_options(NewtonOptions::default())
+            .is_ok()
+    );
+}
+
+/// A relativistic particle, L = −m c² √(1 − v²/c²) − k q²/2: p = m v / √(1 − v²/c²), so
+/// v = p / √(m² + p²/c²). From v = 0 a full Newton step for p ≥ 2mc lands at |v| ≥ 2c, outside
+/// the Lagrangian's domain; the globalised inversion backtracks into it.
+#[dirac_system(
+    coordinates(x),
+    lagrangian = -m * c * c * sqrt(1.0 - dot(x).powi(2) / (c * c)) - 0.5 * k * x.powi(2)
+)]
+#[derive(Clone)]
+struct Relativistic {
+    m: f64,
+    c: f64,
+    k: f64,
+}
+
+#[test]
+fn momentum_starts_solve_strongly_nonlinear_legendre_transforms() {
+    let particle = Relativistic {
+        m: 1.0,
+        c: 1.0,
+        k: 1.0,
+    };
+    for p in [2.0, 3.0, 10.0, 100.0] {
+        let mut stepper = Stepper::new(particle.clone(), Quadrature::midpoint(), 0.01).unwrap();
+        stepper.start_from_momentum(vector![0.0], vector![p]).unwrap();
+        let exact = p / (1.0 + p * p).sqrt();
+        assert!((stepper.v().unwrap()[0] - exact).abs() < 1e-12, "p = {p}");
+        stepper.step().unwrap();
+        // From a guess near the answer as well.
+        let mut near = Stepper::new(particle.clone(), Quadrature::midpoint(), 0.01).unwrap();
+        near.start_from_momentum_near(vector![0.0], vector![p], vector![0.9])
+            .unwrap();
+        assert!((near.v().unwrap()[0] - exact).abs() < 1e-12, "p = {p}");
+    }
+}
+
+#[test]
+fn out_of_range_queries_are_errors_not_panics() {
+    let midpoint = Quadrature::midpoint();
+    assert_eq!(midpoint.basis(5, 5), None);
+    assert_eq!(midpoint.basis_derivative(0, 2), None);
+    assert_eq!(midpoint.basis(0, 1), Some(0.5));
+    let ld = DiscreteLagrangian::new(pendulum::SCENE, Quadrature::gauss(2).unwrap(), 0.1);
+    assert!(matches!(
+        ld.value(&[vector![0.0], vector![0.1]]),
+        Err(DiracError::Dimension(_))
+    ));
+    assert!(ld.value(&[vector![0.0], vector![0.05], vector![0.1]]).is_ok());
+    assert!(matches!(
+        Trajectory::<2>::new(vec!["x".into()]),
+        Err(DiracError::Dimension(_))
+    ));
+    let mut trajectory =
+        Trajectory::<1>::with_multipliers(vec!["x".into()], vec!["mu".into()]).unwrap();
+    assert!(
+        trajectory
+            .push_constrained(0.0, vector![0.0], vector![0.0], 0.0, 0.0, &[1.0, 2.0])
+            .is_err()
+    );
+    assert!(trajectory.is_empty());
+    let mut newton = dirac::Newton::new(2, NewtonOptions::default()).unwrap();
+    let mut x = dirac::nalgebra::DVector::zeros(3);
+    assert_eq!(
+        newton.solve(&mut x, |_, _, _| 1.0),
+        Err(dirac::NewtonFailure::Dimension {
+            expected: 2,
+            got: 3
+        })
+    );
 }

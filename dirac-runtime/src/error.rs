@@ -32,8 +32,10 @@ pub enum DiracError {
     NotStarted,
     /// Newton's method did not reach the tolerance within its iteration cap.
     #[error(
-        "{problem} did not converge at step {step}: residual {residual:.3e} after {iterations} \
-         iterations (tolerance {tolerance:.1e}); try a smaller step or a larger iteration cap"
+        "{problem} did not converge at step {step}: residual {residual:.3e} and last update \
+         {update:.3e} after {iterations} iterations (relative tolerances {tolerance:.1e} on the \
+         residual, {step_tolerance:.1e} on the update); try a smaller step or a larger \
+         iteration cap"
     )]
     NoConvergence {
         /// What was being solved, e.g. `the discrete Euler–Lagrange equations`.
@@ -42,6 +44,10 @@ pub enum DiracError {
         step: u64,
         /// Infinity norm of the last residual.
         residual: f64,
+        /// Infinity norm of the last Newton update (infinite if none was taken).
+        update: f64,
+        /// The update tolerance that was not met.
+        step_tolerance: f64,
         /// Newton iterations performed.
         iterations: usize,
         /// The residual tolerance that was not met.

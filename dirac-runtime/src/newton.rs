@@ -114,6 +114,8 @@ pub enum NewtonFailure {
     NoConvergence {
         /// Residual norm at the last iterate.
         residual: f64,
+        /// Size of the last update (infinite if none was taken).
+        update: f64,
         /// Iterations performed.
         iterations: usize,
     },
@@ -286,11 +288,18 @@ impl Newton {
                 match at_trial {
                     Some(e) if !options.line_search => break e,
                     None if !options.line_search => return Err(NewtonFailure::NonFinite),
-                    // Armijo: accept a sufficient decrease of the residual's norm.
-                    Some(e) if e.residual <= (1.0 - 1e-4 * length) * at_x.residual => break e,
+                    // Armijo: accept a sufficient decrease of the residual's norm, or a
+                    // residual already within tolerance (round-off admits no decrease there).
+                    Some(e)
+                        if e.residual <= (1.0 - 1e-4 * length) * at_x.residual
+                            || e.residual <= e.tolerance =>
+                    {
+                        break e;
+                    }
                     _ if length < 1e-10 => {
                         return Err(NewtonFailure::NoConvergence {
                             residual: at_x.residual,
+                            update: last_update,
                             iterations: iteration,
                         });
                     }
@@ -302,6 +311,7 @@ impl Newton {
         }
         Err(NewtonFailure::NoConvergence {
             residual: at_x.residual,
+            update: last_update,
             iterations: options.max_iterations,
         })
     }

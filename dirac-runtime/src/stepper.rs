@@ -234,7 +234,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         let lagrangian = self.system().lagrangian(&q0, &v0);
         if !lagrangian.is_finite() {
             return Err(DiracError::NonFinite {
-                what: "the Lagrangian at the initial state (is q0 in its domain?)".into(),
+                what: "the Lagrangian at the initial state (is (q0, v0) in its domain?)".into(),
                 value: lagrangian,
             });
         }
@@ -604,13 +604,16 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         match failure {
             NewtonFailure::NoConvergence {
                 residual,
+                update,
                 iterations,
             } => DiracError::NoConvergence {
                 problem,
                 step: self.steps,
                 residual,
+                update,
                 iterations,
                 tolerance: self.newton.options().residual_tolerance,
+                step_tolerance: self.newton.options().step_tolerance,
             },
             NewtonFailure::Singular(pivot) => {
                 let s = self.quadrature().degree();
