@@ -69,7 +69,9 @@ fn a_step_that_does_not_converge_leaves_the_state_unchanged() {
         (stepper.t(), stepper.q(), stepper.p(), stepper.steps())
     );
     // With the default cap the same step succeeds.
-    let mut stepper = stepper.with_newton_options(NewtonOptions::default()).unwrap();
+    let mut stepper = stepper
+        .with_newton_options(NewtonOptions::default())
+        .unwrap();
     stepper.step().unwrap();
     assert_eq!(stepper.steps(), 1);
 }
@@ -188,7 +190,11 @@ fn a_step_leaving_the_domain_is_refused_and_run_keeps_its_trajectory() {
         assert!(stepper.q()[0] <= 1.0, "{name}");
         assert_eq!(stepper.q(), *interrupted.trajectory.q().last().unwrap());
         assert!(
-            interrupted.trajectory.energy().iter().all(|e| e.is_finite()),
+            interrupted
+                .trajectory
+                .energy()
+                .iter()
+                .all(|e| e.is_finite()),
             "{name}"
         );
         // The energy of the last good state is finite, and `?` still yields a DiracError.
@@ -256,7 +262,9 @@ fn momentum_starts_solve_strongly_nonlinear_legendre_transforms() {
     };
     for p in [2.0, 3.0, 10.0, 100.0] {
         let mut stepper = Stepper::new(particle.clone(), Quadrature::midpoint(), 0.01).unwrap();
-        stepper.start_from_momentum(vector![0.0], vector![p]).unwrap();
+        stepper
+            .start_from_momentum(vector![0.0], vector![p])
+            .unwrap();
         let exact = p / (1.0 + p * p).sqrt();
         assert!((stepper.v().unwrap()[0] - exact).abs() < 1e-12, "p = {p}");
         stepper.step().unwrap();
@@ -279,7 +287,10 @@ fn out_of_range_queries_are_errors_not_panics() {
         ld.value(&[vector![0.0], vector![0.1]]),
         Err(DiracError::Dimension(_))
     ));
-    assert!(ld.value(&[vector![0.0], vector![0.05], vector![0.1]]).is_ok());
+    assert!(
+        ld.value(&[vector![0.0], vector![0.05], vector![0.1]])
+            .is_ok()
+    );
     assert!(matches!(
         Trajectory::<2>::new(vec!["x".into()]),
         Err(DiracError::Dimension(_))

@@ -133,8 +133,8 @@ pub struct Interrupted<const N: usize> {
     pub error: DiracError,
 }
 
-impl<const N: usize> From<Interrupted<N>> for DiracError {
-    fn from(interrupted: Interrupted<N>) -> Self {
+impl<const N: usize> From<Box<Interrupted<N>>> for DiracError {
+    fn from(interrupted: Box<Interrupted<N>>) -> Self {
         interrupted.error
     }
 }

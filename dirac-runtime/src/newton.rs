@@ -80,7 +80,7 @@ impl NewtonOptions {
         unit("residual_tolerance", self.residual_tolerance)?;
         unit("step_tolerance", self.step_tolerance)?;
         unit("singular_tolerance", self.singular_tolerance)?;
-        if !(self.max_contraction > 0.0) {
+        if self.max_contraction.is_nan() || self.max_contraction <= 0.0 {
             return Err(DiracError::InvalidOptions(format!(
                 "max_contraction must be positive (infinity turns the check off), got {}",
                 self.max_contraction
@@ -239,8 +239,8 @@ impl Newton {
         let mut contraction: f64 = 0.0;
         for iteration in 1..=options.max_iterations {
             let noise = options.step_tolerance * (1.0 + x.amax());
-            let converged = at_x.residual <= at_x.tolerance
-                && (last_update <= noise || at_x.residual == 0.0);
+            let converged =
+                at_x.residual <= at_x.tolerance && (last_update <= noise || at_x.residual == 0.0);
             let report = NewtonReport {
                 iterations: iteration,
                 residual: at_x.residual,

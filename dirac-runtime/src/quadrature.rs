@@ -357,9 +357,7 @@ mod tests {
         let dp = |t: f64| 2.0 - 3.0 * t * t;
         for (i, &c) in q.nodes().iter().enumerate() {
             let value: f64 = (0..=3).map(|j| q.ell(i, j) * p(j as f64 / 3.0)).sum();
-            let slope: f64 = (0..=3)
-                .map(|j| q.ell_prime(i, j) * p(j as f64 / 3.0))
-                .sum();
+            let slope: f64 = (0..=3).map(|j| q.ell_prime(i, j) * p(j as f64 / 3.0)).sum();
             assert!((value - p(c)).abs() < 1e-14);
             assert!((slope - dp(c)).abs() < 1e-13);
         }
@@ -369,7 +367,10 @@ mod tests {
     fn named_rules_match_their_formulas() {
         let m = Quadrature::midpoint();
         assert_eq!((m.nodes(), m.weights()), (&[0.5][..], &[1.0][..]));
-        assert_eq!((m.basis(0, 0), m.basis_derivative(0, 1)), (Some(0.5), Some(1.0)));
+        assert_eq!(
+            (m.basis(0, 0), m.basis_derivative(0, 1)),
+            (Some(0.5), Some(1.0))
+        );
         let t = Quadrature::trapezoid();
         assert_eq!(t.weights(), &[0.5, 0.5]);
         assert_eq!(t.name(), "trapezoid");

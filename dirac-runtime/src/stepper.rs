@@ -375,12 +375,13 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     /// Runs `steps` steps and returns the trajectory, starting with the current state.
     ///
     /// A step that fails ends the run with [`Interrupted`], which keeps the trajectory up to the
-    /// last good step (the stepper stays there too); `?` turns it into its [`DiracError`].
-    pub fn run(&mut self, steps: usize) -> Result<Trajectory<N>, Interrupted<N>> {
+    /// last good step (the stepper stays there too, unless the step succeeded and only its
+    /// sample failed, e.g. a non-finite energy); `?` turns it into its [`DiracError`].
+    pub fn run(&mut self, steps: usize) -> Result<Trajectory<N>, Box<Interrupted<N>>> {
         let mut trajectory = self.trajectory();
         match self.record(&mut trajectory, steps, 1) {
             Ok(()) => Ok(trajectory),
-            Err(error) => Err(Interrupted { trajectory, error }),
+            Err(error) => Err(Box::new(Interrupted { trajectory, error })),
         }
     }
 

@@ -59,7 +59,8 @@ impl HandMidpoint {
             q: q0,
             p: p0,
             increment: v0 * h,
-            newton: Newton::new(2, NewtonOptions::default()).expect("the default options are valid"),
+            newton: Newton::new(2, NewtonOptions::default())
+                .expect("the default options are valid"),
             x: DVector::zeros(2),
             last_iterations: 0,
         }

@@ -96,7 +96,8 @@ pub fn save_table(reports: &[Report], path: &str) -> std::io::Result<()> {
             r.quadrature,
             r.h,
             r.steps,
-            r.max_energy_error.map_or(String::new(), |e| format!("{e:e}")),
+            r.max_energy_error
+                .map_or(String::new(), |e| format!("{e:e}")),
             r.wall.as_secs_f64(),
             r.check
         )?;
