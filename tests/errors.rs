@@ -303,6 +303,17 @@ fn out_of_range_queries_are_errors_not_panics() {
             .is_err()
     );
     assert!(trajectory.is_empty());
+    // Recording a constrained system into a trajectory without multiplier columns.
+    let mut stepper = Stepper::new(scenes::circuit::RLC, Quadrature::midpoint(), 0.01).unwrap();
+    stepper
+        .start_from_velocity(scenes::circuit::q0(), SVector::zeros())
+        .unwrap();
+    let mut plain = Trajectory::new(stepper.coordinate_names()).unwrap();
+    assert!(matches!(
+        stepper.record(&mut plain, 3, 1),
+        Err(DiracError::Dimension(_))
+    ));
+    assert!(plain.is_empty() && stepper.steps() == 0);
     let mut newton = dirac::Newton::new(2, NewtonOptions::default()).unwrap();
     let mut x = dirac::nalgebra::DVector::zeros(3);
     assert_eq!(

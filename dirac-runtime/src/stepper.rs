@@ -64,6 +64,14 @@ fn compensated_add<const N: usize>(
     }
 }
 
+/// A solved step, not yet current: the new state, how Newton went, the constraint violation.
+#[derive(Debug, Clone, Copy)]
+struct Proposal<const N: usize> {
+    next: State<N>,
+    report: NewtonReport,
+    violation: f64,
+}
+
 /// A variational integrator for one system, one quadrature and one step size.
 ///
 /// Each step solves for the increments `Z_j = Q_j − q_k` of the `s` points of the step (the
@@ -281,6 +289,13 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
 
     /// Advances one step. On error the state is unchanged.
     pub fn step(&mut self) -> Result<(), DiracError> {
+        let proposal = self.solve_step()?;
+        self.accept(proposal);
+        Ok(())
+    }
+
+    /// Solves the next step without making it current: the state is unchanged whatever happens.
+    fn solve_step(&mut self) -> Result<Proposal<N>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
         let s = self.discrete.quadrature().degree();
         let h = self.discrete.h();
@@ -348,15 +363,30 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         if !lagrangian.is_finite() {
             return Err(DiracError::NonFinite {
                 what: format!(
-                    "the Lagrangian at the end of step {} (the step leaves its domain; try a \
+                    "the Lagrangian at the end of step {} (the step leaves its domain or overflows; try a \
                      smaller step)",
                     self.steps
                 ),
                 value: lagrangian,
             });
         }
+        next.t = self.start + (self.steps + 1) as f64 * h;
+        let violation = if S::ONE_FORMS + S::HOLONOMIC > 0 {
+            constraint::violation(self.system(), self.point, &state.q, &next.q)
+        } else {
+            0.0
+        };
+        Ok(Proposal {
+            next,
+            report,
+            violation,
+        })
+    }
+
+    /// Makes a solved step current; its multipliers and increments are still in `unknowns`.
+    fn accept(&mut self, proposal: Proposal<N>) {
         if S::ONE_FORMS + S::HOLONOMIC > 0 {
-            self.violation = constraint::violation(self.system(), self.point, &state.q, &next.q);
+            let s = self.discrete.quadrature().degree();
             let count = self.multipliers.len();
             self.multipliers
                 .copy_from_slice(&self.unknowns.as_slice()[N * s..N * s + count]);
@@ -365,18 +395,17 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             Some(previous) => previous.copy_from(&self.unknowns),
             None => self.previous = Some(self.unknowns.clone()),
         }
+        self.violation = proposal.violation;
         self.steps += 1;
-        next.t = self.start + self.steps as f64 * h;
-        self.state = Some(next);
-        self.report = Some(report);
-        Ok(())
+        self.state = Some(proposal.next);
+        self.report = Some(proposal.report);
     }
 
     /// Runs `steps` steps and returns the trajectory, starting with the current state.
     ///
-    /// A step that fails ends the run with [`Interrupted`], which keeps the trajectory up to the
-    /// last good step (the stepper stays there too, unless the step succeeded and only its
-    /// sample failed, e.g. a non-finite energy); `?` turns it into its [`DiracError`].
+    /// A step that fails (or whose energy cannot be computed) ends the run with
+    /// [`Interrupted`], which keeps the trajectory up to the last good step, where the stepper
+    /// stays; `?` turns it into its [`DiracError`].
     pub fn run(&mut self, steps: usize) -> Result<Trajectory<N>, Box<Interrupted<N>>> {
         let mut trajectory = self.trajectory();
         match self.record(&mut trajectory, steps, 1) {
@@ -386,27 +415,46 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     }
 
     /// Appends the current state and then every `every`-th of the next `steps` states to
-    /// `trajectory`. On error, the trajectory keeps what was recorded before the failing step.
+    /// `trajectory`. On error the trajectory ends with the current state: a step is made current
+    /// only once its sample (its energy) could be computed.
     pub fn record(
         &mut self,
         trajectory: &mut Trajectory<N>,
         steps: usize,
         every: usize,
     ) -> Result<(), DiracError> {
+        let state = self.state.ok_or(DiracError::NotStarted)?;
+        if trajectory.multiplier_names().len() != self.multipliers.len() {
+            return Err(DiracError::Dimension(format!(
+                "the trajectory records {} multipliers and the system has {}; start it with \
+                 Stepper::trajectory",
+                trajectory.multiplier_names().len(),
+                self.multipliers.len()
+            )));
+        }
         let every = every.max(1);
-        self.push_to(trajectory)?;
+        let energy = self.energy_of(&state, self.steps)?;
+        self.push_sample(trajectory, &state, energy)?;
         for k in 1..=steps {
-            self.step()?;
+            let proposal = self.solve_step()?;
             if k % every == 0 {
-                self.push_to(trajectory)?;
+                let energy = self.energy_of(&proposal.next, self.steps + 1)?;
+                let next = proposal.next;
+                self.accept(proposal);
+                self.push_sample(trajectory, &next, energy)?;
+            } else {
+                self.accept(proposal);
             }
         }
         Ok(())
     }
 
-    fn push_to(&self, trajectory: &mut Trajectory<N>) -> Result<(), DiracError> {
-        let state = self.state.ok_or(DiracError::NotStarted)?;
-        let energy = self.energy()?;
+    fn push_sample(
+        &self,
+        trajectory: &mut Trajectory<N>,
+        state: &State<N>,
+        energy: f64,
+    ) -> Result<(), DiracError> {
         if S::ONE_FORMS + S::HOLONOMIC > 0 {
             trajectory.push_constrained(
                 state.t,
@@ -415,11 +463,11 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 energy,
                 self.violation,
                 self.multipliers(),
-            )?;
+            )
         } else {
             trajectory.push(state.t, state.q, state.p, energy);
+            Ok(())
         }
-        Ok(())
     }
 
     /// Multipliers of the last step: one per constraint one-form, then one per holonomic
@@ -532,10 +580,16 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     /// never NaN, where it is not finite.
     pub fn energy(&self) -> Result<f64, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
-        let energy = legendre::energy(self.system(), &state.q, &self.v()?);
+        self.energy_of(&state, self.steps)
+    }
+
+    /// The energy of `state`, reached after `steps` steps (for the error message).
+    fn energy_of(&self, state: &State<N>, steps: u64) -> Result<f64, DiracError> {
+        let v = self.velocity_at(&state.q, &state.p, &state.v_hint)?;
+        let energy = legendre::energy(self.system(), &state.q, &v);
         if !energy.is_finite() {
             return Err(DiracError::NonFinite {
-                what: format!("the energy after step {}", self.steps),
+                what: format!("the energy after step {steps}"),
                 value: energy,
             });
         }

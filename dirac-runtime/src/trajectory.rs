@@ -88,6 +88,11 @@ impl<const N: usize> Trajectory<N> {
         Ok(())
     }
 
+    /// Names of the recorded multipliers (empty for an unconstrained system).
+    pub fn multiplier_names(&self) -> &[String] {
+        &self.multiplier_names
+    }
+
     /// Constraint violation of the step that ended at each sample (empty when unconstrained).
     pub fn constraint_violation(&self) -> &[f64] {
         &self.violation
