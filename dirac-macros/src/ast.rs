@@ -5,7 +5,6 @@ use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
 use syn::{Expr, Ident, Token, bracketed};
 
-pub use crate::one_form::Term;
 
 /// Length of a coordinate array: a literal or the name of a constant (or const parameter).
 #[derive(Clone)]
@@ -61,6 +60,14 @@ impl Parse for Coordinate {
     }
 }
 
+/// One term of a one-form: the coordinate's flat index and its coefficient (both expressions),
+/// and the span of the user's term.
+pub struct Term {
+    pub index: TokenStream,
+    pub coefficient: TokenStream,
+    pub span: Span,
+}
+
 /// The attribute's arguments, each kept with its key for error reporting.
 pub struct Arguments {
     pub entries: Vec<syn::Meta>,
@@ -77,8 +84,8 @@ impl Parse for Arguments {
 
 /// How the Lagrangian is given.
 pub enum Lagrangian {
-    /// An expression over coordinates, `dot(...)` velocities and parameters.
-    Expression(Expr),
+    /// An expression over coordinates, `dot(...)` velocities and parameters, rewritten to a `__D`.
+    Expression(TokenStream),
     /// A generic function `fn(&Self, &SVector<D, N>, &SVector<D, N>) -> D`.
     Function(syn::Path),
 }
@@ -99,7 +106,7 @@ pub struct Model {
     /// Constraint one-forms, each a list of terms.
     pub one_forms: Vec<Vec<Term>>,
     /// Holonomic constraints `g(q)`.
-    pub holonomic: Vec<Expr>,
+    pub holonomic: Vec<TokenStream>,
     /// Terms of all force one-forms together.
     pub forces: Vec<Term>,
     pub inputs: Vec<Ident>,
