@@ -765,10 +765,11 @@ pub fn combine(family: Family, first: Piece, links: Vec<(BinOp, Piece)>) -> Piec
         (Class::Constant, None) => Class::Constant,
         _ => Class::Dual,
     };
-    let mut tokens = TokenStream::new();
+    // The operands in the order emitted, each after its operator.
+    let mut sequence = Vec::with_capacity(links.len() + 1);
     let mut rest = links.into_iter();
     match lead {
-        None => tokens.extend(first.at(operand)),
+        None => sequence.push(first.at(operand)),
         Some(k) => {
             let mut prefix = first.at(operand);
             for (op, piece) in rest.by_ref().take(k) {
@@ -785,32 +786,51 @@ pub fn combine(family: Family, first: Piece, links: Vec<(BinOp, Piece)>) -> Piec
                     .into_iter()
                     .next()
                     .map_or(span, |t| t.span());
-                let leading = match op {
+                sequence.push(match op {
                     BinOp::Sub(_) => dual.negated(op_span).tokens,
                     BinOp::Div(_) => {
                         let recip = Ident::new("recip", op_span);
                         dual.method(&recip, TokenStream::new(), Class::Dual).tokens
                     }
                     _ => dual.at(operand),
-                };
-                let joint = match family {
-                    Family::Sum => quote_spanned!(op_span=> +),
-                    Family::Product => quote_spanned!(op_span=> *),
-                };
-                tokens.extend(quote!(#leading #joint #constant));
+                });
+                sequence.push(match family {
+                    Family::Sum => quote_spanned!(op_span=> + #constant),
+                    Family::Product => quote_spanned!(op_span=> * #constant),
+                });
             }
         }
     }
-    for (op, piece) in rest {
-        tokens.extend(op.into_token_stream());
-        tokens.extend(piece.at(operand));
-    }
+    sequence.extend(rest.map(|(op, piece)| {
+        let piece = piece.at(operand);
+        quote!(#op #piece)
+    }));
+    let binding = match sequence.len() > CHUNK {
+        true => Binding::Atom,
+        false => family.binding(),
+    };
     Piece {
-        tokens,
+        tokens: chunked(sequence, span),
         class,
-        binding: family.binding(),
+        binding,
         span,
     }
+}
+
+/// Operands per statement of a long chain.
+const CHUNK: usize = 64;
+
+/// A chain's tokens: flat up to [`CHUNK`] operands, else a block of statements each continuing
+/// it by `CHUNK` operands (rustc recurses on a flat chain as deep as it is long).
+fn chunked(sequence: Vec<TokenStream>, span: Span) -> TokenStream {
+    if sequence.len() <= CHUNK {
+        return sequence.into_iter().collect();
+    }
+    let chain = Ident::new("__chain", span);
+    let mut chunks = sequence.chunks(CHUNK);
+    let first = chunks.next().unwrap_or_default();
+    let rest = chunks.map(|chunk| quote!(let #chain = #chain #(#chunk)*;));
+    quote!({ let #chain = #(#first)*; #(#rest)* #chain })
 }
 
 /// Binds a coordinate's position and velocity (`__D`, or `[__D; K]` for an array) from `__q`, `__v`.
