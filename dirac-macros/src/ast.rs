@@ -5,7 +5,6 @@ use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
 use syn::{Expr, Ident, Token, bracketed};
 
-
 /// Length of a coordinate array: a literal or the name of a constant (or const parameter).
 #[derive(Clone)]
 pub enum Length {
@@ -32,7 +31,12 @@ pub struct Coordinate {
 
 impl Parse for Coordinate {
     fn parse(input: ParseStream) -> syn::Result<Self> {
-        let name: Ident = input.parse()?;
+        let name: Ident = input.parse().map_err(|e| {
+            syn::Error::new(
+                e.span(),
+                "expected a coordinate: a name such as `x` or an array such as `theta[4]`",
+            )
+        })?;
         if !input.peek(syn::token::Bracket) {
             return Ok(Self { name, length: None });
         }

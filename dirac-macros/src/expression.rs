@@ -64,6 +64,8 @@ pub enum Class {
 /// Where an expression stands.
 pub struct Scope<'a> {
     pub coordinates: &'a [Coordinate],
+    /// The struct's fields (a reserved one is reported on the field, not where it is used).
+    pub fields: &'a [Ident],
     /// `None` where velocities are allowed, else what to say when `dot(...)` appears.
     pub no_velocities: Option<&'static str>,
     /// Appended to the message for an unsupported expression (where else to write code).
@@ -654,7 +656,7 @@ impl<'a> Rewriter<'a> {
         let Some(ident) = p.path.get_ident() else {
             return Piece::atom(tokens, Class::Constant, span);
         };
-        if is_reserved(ident) {
+        if is_reserved(ident) && !self.scope.fields.contains(ident) {
             return self.error(ident.span(), reserved_message(ident));
         }
         if ident == "self" {
@@ -691,7 +693,8 @@ impl<'a> Rewriter<'a> {
                 Class::Dual
             }
             None => {
-                if let Some(ident) = p.path.get_ident().filter(|i| is_reserved(i)) {
+                let reserved = |i: &&Ident| is_reserved(i) && !self.scope.fields.contains(i);
+                if let Some(ident) = p.path.get_ident().filter(reserved) {
                     return self.error(ident.span(), reserved_message(ident));
                 }
                 if !self.integer_constant(

@@ -7,7 +7,7 @@ use proc_macro2::{Span, TokenStream};
 use quote::quote_spanned;
 use syn::{BinOp, Expr, ExprIndex, UnOp};
 
-use crate::ast::{Coordinate, Term, offsets};
+use crate::ast::{Coordinate, Length, Term, offsets};
 use crate::expression::{Family, Piece, Rewriter, bounds, combine, spine, subexpressions};
 
 /// Splits `form` into terms `coefficient · d(coordinate)`; errors go into the rewriter's context.
@@ -120,8 +120,9 @@ impl Splitter<'_, '_> {
         self.rewriter.errors.push_range(start, end, message);
     }
 
-    /// The flat index of `dx` or `dtheta[i]` with coefficient one. An array element's index goes
-    /// through an array of the coordinate's length, so rustc rejects a constant index out of range.
+    /// The flat index of `dx` or `dtheta[i]` with coefficient one. An index the macro cannot check
+    /// goes through an array of the coordinate's length, so rustc rejects a constant one out of
+    /// range (and a run-time one panics rather than landing on another coordinate).
     fn differential(&mut self, k: usize, index: Option<&ExprIndex>, expr: &Expr) -> Vec<Part> {
         let coordinate = &self.rewriter.scope.coordinates[k];
         let offset = self.offsets[k].clone();
@@ -132,10 +133,17 @@ impl Splitter<'_, '_> {
                 if !self.rewriter.index(coordinate, &ix.index) {
                     return Vec::new();
                 }
-                let (i, length) = (&ix.index, length.tokens());
+                let i = &ix.index;
                 let (at, _) = bounds(i);
-                let index = quote_spanned! {at=>
-                    #offset + { let __k: usize = #i; let _: () = [(); #length][__k]; __k }
+                let index = match (length, &**i) {
+                    // Checked by `index` above.
+                    (Length::Literal(..), Expr::Lit(_)) => quote_spanned!(at=> #offset + #i),
+                    _ => {
+                        let length = length.tokens();
+                        quote_spanned! {at=>
+                            #offset + { let __k: usize = #i; let _: () = [(); #length][__k]; __k }
+                        }
+                    }
                 };
                 vec![(index, Piece::one(span))]
             }
@@ -185,7 +193,9 @@ impl Splitter<'_, '_> {
     fn sum(&mut self, b: &syn::ExprBinary, depth: usize) -> Vec<Part> {
         let (first, links) = spine(b, Family::Sum);
         let mut parts = Vec::new();
-        for (op, operand) in std::iter::once((None, first)).chain(links.into_iter().map(|(op, e)| (Some(op), e))) {
+        for (op, operand) in
+            std::iter::once((None, first)).chain(links.into_iter().map(|(op, e)| (Some(op), e)))
+        {
             if !self.contains(operand) {
                 self.no_differential(operand);
                 continue;
@@ -238,7 +248,10 @@ impl Splitter<'_, '_> {
                     .iter()
                     .map(|(op, p)| (*op, or_coefficient(p)))
                     .collect();
-                (index, combine(Family::Product, or_coefficient(&first), links))
+                (
+                    index,
+                    combine(Family::Product, or_coefficient(&first), links),
+                )
             })
             .collect()
     }

@@ -211,7 +211,9 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         (Some(_), None) => None,
     };
     let quadrature = match e.quadrature {
-        None => Some(quote!(::core::result::Result::Ok(::dirac::Quadrature::midpoint()))),
+        None => Some(quote!(::core::result::Result::Ok(
+            ::dirac::Quadrature::midpoint()
+        ))),
         Some(expr) => match quadrature::parse(&expr) {
             Ok(tokens) => Some(tokens),
             Err(err) => {
@@ -234,10 +236,12 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
             None
         }
     });
+    let fields: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
     let (one_forms, holonomic, forces) = match &coordinates {
         Some(coordinates) => {
             let positions = Scope {
                 coordinates,
+                fields: &fields,
                 no_velocities: Some(
                     "constraints depend on positions only: dot(...) cannot appear here",
                 ),
@@ -257,6 +261,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 .collect();
             let state = Scope {
                 coordinates,
+                fields: &fields,
                 no_velocities: None,
                 elsewhere: "",
             };
@@ -349,8 +354,10 @@ fn lagrangian_of(
             return Some(Lagrangian::Function(p.path.clone()));
         }
     }
+    let fields: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
     let scope = Scope {
         coordinates,
+        fields: &fields,
         no_velocities: None,
         elsewhere: "; for other code write a generic function and give \
                     `lagrangian = path::to::function`",
@@ -442,7 +449,6 @@ fn parameters(item: &syn::ItemStruct, errors: &mut Errors) -> Vec<Parameter> {
             let name = field.ident.clone()?;
             if is_reserved(&name) {
                 errors.push(name.span(), reserved_message(&name));
-                return None;
             }
             match &field.ty {
                 ty if is_f64(ty) => Some(Parameter { name, array: false }),
