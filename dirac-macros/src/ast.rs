@@ -120,14 +120,14 @@ pub struct Model {
 
 /// Number of coordinates as a const expression (a literal when every length is one).
 pub fn dimension(coordinates: &[Coordinate]) -> TokenStream {
+    // `None` also when the sum overflows: rustc then reports the overflow in the expression.
     let literal: Option<usize> = coordinates
         .iter()
-        .map(|c| match &c.length {
-            None => Some(1),
-            Some(Length::Literal(n, _)) => Some(*n),
+        .try_fold(0usize, |sum, c| match &c.length {
+            None => sum.checked_add(1),
+            Some(Length::Literal(n, _)) => sum.checked_add(*n),
             Some(Length::Named(_)) => None,
-        })
-        .sum();
+        });
     match (literal, coordinates) {
         (Some(n), _) => quote::quote!(#n),
         (None, [single]) => single

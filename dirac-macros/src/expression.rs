@@ -372,7 +372,8 @@ impl<'a> Rewriter<'a> {
             _ => None,
         };
         match (&coordinate.length, literal) {
-            (Some(Length::Literal(n, _)), Some((i, span))) if i >= *n => {
+            // A zero length is reported on the coordinate.
+            (Some(Length::Literal(n, _)), Some((i, span))) if i >= *n && *n > 0 => {
                 self.errors.push(
                     span,
                     format!(

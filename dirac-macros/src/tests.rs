@@ -227,3 +227,16 @@ fn deep_nesting_is_one_error() {
     let output = expand(&format!("coordinates(x), lagrangian = {nested}"), ITEM).unwrap();
     assert_eq!(output.to_string().matches("compile_error").count(), 1);
 }
+
+/// Inputs that once reached arithmetic in the macro: an index into a zero-length array, array
+/// lengths summing past `usize::MAX`. Each is a compile error.
+#[test]
+fn edge_lengths_are_errors() {
+    for args in [
+        "coordinates(theta[0]), lagrangian = theta[0] * dot(theta[0])",
+        "coordinates(a[18446744073709551615], b[2]), lagrangian = a[0] * dot(b[1])",
+    ] {
+        let output = expand(args, ITEM).unwrap();
+        assert!(parses(&output), "{args}");
+    }
+}
