@@ -5,8 +5,6 @@ use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
 use syn::{Expr, Ident, Token, bracketed};
 
-pub use crate::one_form::Term;
-
 /// Length of a coordinate array: a literal or the name of a constant (or const parameter).
 #[derive(Clone)]
 pub enum Length {
@@ -33,7 +31,12 @@ pub struct Coordinate {
 
 impl Parse for Coordinate {
     fn parse(input: ParseStream) -> syn::Result<Self> {
-        let name: Ident = input.parse()?;
+        let name: Ident = input.parse().map_err(|e| {
+            syn::Error::new(
+                e.span(),
+                "expected a coordinate: a name such as `x` or an array such as `theta[4]`",
+            )
+        })?;
         if !input.peek(syn::token::Bracket) {
             return Ok(Self { name, length: None });
         }
@@ -61,6 +64,14 @@ impl Parse for Coordinate {
     }
 }
 
+/// One term of a one-form: the coordinate's flat index and its coefficient (both expressions),
+/// and the span of the user's term.
+pub struct Term {
+    pub index: TokenStream,
+    pub coefficient: TokenStream,
+    pub span: Span,
+}
+
 /// The attribute's arguments, each kept with its key for error reporting.
 pub struct Arguments {
     pub entries: Vec<syn::Meta>,
@@ -77,8 +88,8 @@ impl Parse for Arguments {
 
 /// How the Lagrangian is given.
 pub enum Lagrangian {
-    /// An expression over coordinates, `dot(...)` velocities and parameters.
-    Expression(Expr),
+    /// An expression over coordinates, `dot(...)` velocities and parameters, rewritten to a `__D`.
+    Expression(TokenStream),
     /// A generic function `fn(&Self, &SVector<D, N>, &SVector<D, N>) -> D`.
     Function(syn::Path),
 }
@@ -99,7 +110,7 @@ pub struct Model {
     /// Constraint one-forms, each a list of terms.
     pub one_forms: Vec<Vec<Term>>,
     /// Holonomic constraints `g(q)`.
-    pub holonomic: Vec<Expr>,
+    pub holonomic: Vec<TokenStream>,
     /// Terms of all force one-forms together.
     pub forces: Vec<Term>,
     pub inputs: Vec<Ident>,
@@ -109,14 +120,14 @@ pub struct Model {
 
 /// Number of coordinates as a const expression (a literal when every length is one).
 pub fn dimension(coordinates: &[Coordinate]) -> TokenStream {
+    // `None` also when the sum overflows: rustc then reports the overflow in the expression.
     let literal: Option<usize> = coordinates
         .iter()
-        .map(|c| match &c.length {
-            None => Some(1),
-            Some(Length::Literal(n, _)) => Some(*n),
+        .try_fold(0usize, |sum, c| match &c.length {
+            None => sum.checked_add(1),
+            Some(Length::Literal(n, _)) => sum.checked_add(*n),
             Some(Length::Named(_)) => None,
-        })
-        .sum();
+        });
     match (literal, coordinates) {
         (Some(n), _) => quote::quote!(#n),
         (None, [single]) => single

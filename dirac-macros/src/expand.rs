@@ -28,11 +28,12 @@ pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
             return quote!(#error #item);
         }
     };
-    match validate::model(arguments, item.clone()) {
+    match validate::model(arguments, item) {
         Outcome::Valid(model) => expand(&model),
         Outcome::Invalid {
             errors,
             coordinates,
+            item,
         } => {
             let errors = errors.to_compile_errors();
             let stub = coordinates
@@ -71,10 +72,9 @@ fn expand(model: &Model) -> TokenStream {
         Lagrangian::Function(path) => quote_spanned!(path.span()=> #path(self, __q, __v)),
         Lagrangian::Expression(expr) => {
             let bindings = bindings(true);
-            let result = quote_spanned!(expr.span()=> let __lagrangian: __D = #expr;);
             quote! {
                 #bindings
-                #result
+                let __lagrangian: __D = #expr;
                 __lagrangian
             }
         }
@@ -113,7 +113,7 @@ fn expand(model: &Model) -> TokenStream {
 
         #[automatically_derived]
         #header {
-            #[allow(unused_variables, non_snake_case, clippy::all)]
+            #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
             fn lagrangian<__D: ::dirac::Scalar>(
                 &self,
                 __q: &::dirac::nalgebra::SVector<__D, #n>,
@@ -148,7 +148,7 @@ fn expand(model: &Model) -> TokenStream {
 fn accumulate(target: &TokenStream, terms: &[crate::ast::Term]) -> TokenStream {
     let terms = terms.iter().map(|t| {
         let (index, coefficient) = (&t.index, &t.coefficient);
-        quote_spanned!(coefficient.span()=> #target[#index] += #coefficient;)
+        quote_spanned!(t.span=> #target[#index] += #coefficient;)
     });
     quote!(#(#terms)*)
 }
@@ -171,7 +171,7 @@ fn dirac_items(
         items.extend(quote! {
             const ONE_FORMS: usize = #count;
 
-            #[allow(unused_variables, non_snake_case, clippy::all)]
+            #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
             fn one_form<__D: ::dirac::Scalar>(
                 &self,
                 __q: &::dirac::nalgebra::SVector<__D, #n>,
@@ -198,7 +198,7 @@ fn dirac_items(
         items.extend(quote! {
             const HOLONOMIC: usize = #count;
 
-            #[allow(unused_variables, non_snake_case, clippy::all)]
+            #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
             fn holonomic<__D: ::dirac::Scalar>(
                 &self,
                 __q: &::dirac::nalgebra::SVector<__D, #n>,
@@ -223,7 +223,7 @@ fn dirac_items(
         items.extend(quote! {
             const FORCES: bool = true;
 
-            #[allow(unused_variables, non_snake_case, clippy::all)]
+            #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
             fn force<__D: ::dirac::Scalar>(
                 &self,
                 __q: &::dirac::nalgebra::SVector<__D, #n>,

@@ -54,3 +54,6 @@ mod validate;
 pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
     expand::dirac_system(args.into(), item.into()).into()
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,250 +1,265 @@
 //! One-forms written in differentials, `sin(phi)*dx - cos(phi)*dy` or `-r * dot(q_l) * dq_l`:
-//! checked to be linear in the differentials and split into one coefficient per coordinate.
+//! checked to be linear in the differentials and split into one coefficient per differential,
+//! each rewritten like the Lagrangian. Sums and products are walked as loops over their left
+//! spine; only nesting recurses, capped like the Lagrangian's.
 
 use proc_macro2::{Span, TokenStream};
-use quote::quote;
-use syn::spanned::Spanned;
-use syn::{BinOp, Expr, Ident};
+use quote::quote_spanned;
+use syn::{BinOp, Expr, ExprIndex, UnOp};
 
-use crate::ast::Coordinate;
+use crate::ast::{Coordinate, Length, Term, offsets};
+use crate::expression::{Family, Piece, Rewriter, bounds, combine, spine, subexpressions};
 
-/// One term of a one-form: the coordinate's flat index (an expression) and its coefficient.
-pub struct Term {
-    pub index: TokenStream,
-    pub coefficient: Expr,
+/// Splits `form` into terms `coefficient · d(coordinate)`; errors go into the rewriter's context.
+pub fn terms(form: &Expr, rewriter: &mut Rewriter) -> Vec<Term> {
+    let offsets = offsets(rewriter.scope.coordinates);
+    let mut splitter = Splitter { rewriter, offsets };
+    if !splitter.contains(form) {
+        splitter.no_differential(form);
+        return Vec::new();
+    }
+    splitter
+        .split(form, 0)
+        .into_iter()
+        .map(|(index, coefficient)| Term {
+            index,
+            span: coefficient.span(),
+            coefficient: coefficient.into_scalar(),
+        })
+        .collect()
 }
 
-/// Splits `expr` into terms `coefficient · d(coordinate)`; every error carries the user's span.
-pub fn terms(
-    expr: &Expr,
+/// Whether the differential of one of `coordinates` occurs in `expr`.
+pub fn has_differential(expr: &Expr, coordinates: &[Coordinate]) -> bool {
+    subexpressions(expr).any(|e| differential(coordinates, e).is_some())
+}
+
+/// `dx` or `dtheta[i]`: the coordinate's position and the indexing, not yet checked.
+fn differential<'e>(
     coordinates: &[Coordinate],
-    offsets: &[TokenStream],
-) -> syn::Result<Vec<Term>> {
-    let splitter = Splitter {
-        coordinates,
-        offsets,
+    expr: &'e Expr,
+) -> Option<(usize, Option<&'e ExprIndex>)> {
+    let (path, index) = match expr {
+        Expr::Path(p) => (p, None),
+        Expr::Index(ix) => match &*ix.expr {
+            Expr::Path(p) => (p, Some(ix)),
+            _ => return None,
+        },
+        _ => return None,
     };
-    if !splitter.contains(expr) {
-        return Err(splitter.no_differential(expr));
-    }
-    splitter.split(expr)
+    let name = path.path.get_ident()?.to_string();
+    let rest = name.strip_prefix('d')?;
+    let k = coordinates.iter().position(|c| c.name == rest)?;
+    Some((k, index))
 }
 
-struct Splitter<'a> {
-    coordinates: &'a [Coordinate],
-    offsets: &'a [TokenStream],
+struct Splitter<'r, 'a> {
+    rewriter: &'r mut Rewriter<'a>,
+    offsets: Vec<TokenStream>,
 }
 
-impl Splitter<'_> {
-    /// The coordinate whose differential `ident` is (`dx` for `x`).
-    fn differential(&self, ident: &Ident) -> Option<usize> {
-        let name = ident.to_string();
-        let rest = name.strip_prefix('d')?;
-        self.coordinates.iter().position(|c| c.name == rest)
+/// A term being split: the flat index of its differential and its coefficient.
+type Part = (TokenStream, Piece);
+
+impl Splitter<'_, '_> {
+    fn coordinates(&self) -> &[Coordinate] {
+        self.rewriter.scope.coordinates
     }
 
-    /// `dx`, or `dtheta[i]` for an array coordinate: the flat index.
-    fn as_differential(&self, expr: &Expr) -> Option<syn::Result<TokenStream>> {
-        match expr {
-            Expr::Path(p) => {
-                let k = self.differential(p.path.get_ident()?)?;
-                let offset = &self.offsets[k];
-                Some(match self.coordinates[k].length {
-                    None => Ok(offset.clone()),
-                    Some(_) => Err(syn::Error::new(
-                        p.span(),
-                        format!(
-                            "`{}` is an array: write the differential of one element, e.g. d{}[0]",
-                            self.coordinates[k].name, self.coordinates[k].name
-                        ),
-                    )),
-                })
-            }
-            Expr::Index(ix) => {
-                let Expr::Path(p) = &*ix.expr else {
-                    return None;
-                };
-                let k = self.differential(p.path.get_ident()?)?;
-                let offset = &self.offsets[k];
-                let index = &ix.index;
-                Some(match self.coordinates[k].length {
-                    Some(_) => Ok(quote!((#offset + #index))),
-                    None => Err(syn::Error::new(
-                        ix.span(),
-                        format!(
-                            "`{}` is a single coordinate, not an array",
-                            self.coordinates[k].name
-                        ),
-                    )),
-                })
-            }
-            _ => None,
-        }
-    }
-
-    /// Whether a differential occurs anywhere in `expr`.
     fn contains(&self, expr: &Expr) -> bool {
-        if self.as_differential(expr).is_some() {
-            return true;
-        }
-        match expr {
-            Expr::Paren(p) => self.contains(&p.expr),
-            Expr::Group(g) => self.contains(&g.expr),
-            Expr::Unary(u) => self.contains(&u.expr),
-            Expr::Binary(b) => self.contains(&b.left) || self.contains(&b.right),
-            Expr::Call(c) => c.args.iter().any(|a| self.contains(a)),
-            Expr::MethodCall(m) => {
-                self.contains(&m.receiver) || m.args.iter().any(|a| self.contains(a))
-            }
-            Expr::Index(ix) => self.contains(&ix.expr),
-            _ => false,
-        }
+        has_differential(expr, self.coordinates())
     }
 
-    /// An identifier `d…` in `expr` that is not the differential of a coordinate.
-    fn stray_differential(&self, expr: &Expr) -> Option<Ident> {
-        match expr {
-            Expr::Path(p) => p
-                .path
-                .get_ident()
-                .filter(|i| {
-                    let name = i.to_string();
-                    name.len() > 1 && name.starts_with('d') && self.differential(i).is_none()
-                })
-                .cloned(),
-            Expr::Paren(p) => self.stray_differential(&p.expr),
-            Expr::Group(g) => self.stray_differential(&g.expr),
-            Expr::Unary(u) => self.stray_differential(&u.expr),
-            Expr::Binary(b) => self
-                .stray_differential(&b.left)
-                .or_else(|| self.stray_differential(&b.right)),
-            Expr::Index(ix) => self.stray_differential(&ix.expr),
-            _ => None,
-        }
-    }
-
-    fn no_differential(&self, expr: &Expr) -> syn::Error {
-        if let Some(stray) = self.stray_differential(expr) {
-            let names: Vec<String> = self
-                .coordinates
-                .iter()
-                .map(|c| format!("`{}`", c.name))
-                .collect();
-            return syn::Error::new(
-                stray.span(),
-                format!(
-                    "`{stray}` is not the differential of a coordinate; the coordinates are {}",
-                    names.join(", ")
-                ),
-            );
-        }
+    fn names(&self, prefix: &str) -> String {
         let names: Vec<String> = self
-            .coordinates
+            .coordinates()
             .iter()
-            .map(|c| format!("`d{}`", c.name))
+            .map(|c| format!("`{prefix}{}`", c.name))
             .collect();
-        syn::Error::new(
-            expr.span(),
-            format!(
-                "this term has no differential: a one-form is a sum of terms, each a coefficient \
-                 times one of {}",
-                names.join(", ")
-            ),
-        )
+        names.join(", ")
     }
 
-    fn not_linear(span: Span, why: &str) -> syn::Error {
-        syn::Error::new(
-            span,
+    fn error(&mut self, span: Span, message: impl std::fmt::Display) -> Vec<Part> {
+        self.rewriter.errors.push(span, message);
+        Vec::new()
+    }
+
+    fn not_linear(&mut self, expr: &Expr, why: &str) -> Vec<Part> {
+        let (start, end) = bounds(expr);
+        self.rewriter.errors.push_range(
+            start,
+            end,
             format!("a one-form must be linear in the differentials: {why}"),
-        )
+        );
+        Vec::new()
     }
 
-    fn scaled(terms: Vec<Term>, f: impl Fn(&Expr) -> Expr) -> Vec<Term> {
-        terms
+    /// Reports a term without a differential, naming a stray `dz` if it has one.
+    fn no_differential(&mut self, expr: &Expr) {
+        let stray = subexpressions(expr).find_map(|e| match e {
+            Expr::Path(p) => p.path.get_ident().filter(|i| {
+                let name = i.to_string();
+                name.len() > 1 && name.starts_with('d')
+            }),
+            _ => None,
+        });
+        if let Some(stray) = stray {
+            let message = format!(
+                "`{stray}` is not the differential of a coordinate; the coordinates are {}",
+                self.names("")
+            );
+            self.rewriter.errors.push(stray.span(), message);
+            return;
+        }
+        let (start, end) = bounds(expr);
+        let message = format!(
+            "this term has no differential: a one-form is a sum of terms, each a coefficient \
+             times one of {}",
+            self.names("d")
+        );
+        self.rewriter.errors.push_range(start, end, message);
+    }
+
+    /// The flat index of `dx` or `dtheta[i]` with coefficient one. An index the macro cannot check
+    /// goes through an array of the coordinate's length, so rustc rejects a constant one out of
+    /// range (and a run-time one panics rather than landing on another coordinate).
+    fn differential(&mut self, k: usize, index: Option<&ExprIndex>, expr: &Expr) -> Vec<Part> {
+        let coordinate = &self.rewriter.scope.coordinates[k];
+        let offset = self.offsets[k].clone();
+        let (span, _) = bounds(expr);
+        match (&coordinate.length, index) {
+            (None, None) => vec![(offset, Piece::one(span))],
+            (Some(length), Some(ix)) => {
+                if !self.rewriter.index(coordinate, &ix.index) {
+                    return Vec::new();
+                }
+                let i = &ix.index;
+                let (at, _) = bounds(i);
+                let index = match (length, &**i) {
+                    // Checked by `index` above.
+                    (Length::Literal(..), Expr::Lit(_)) => quote_spanned!(at=> #offset + #i),
+                    _ => {
+                        let length = length.tokens();
+                        quote_spanned! {at=>
+                            #offset + { let __k: usize = #i; let _: () = [(); #length][__k]; __k }
+                        }
+                    }
+                };
+                vec![(index, Piece::one(span))]
+            }
+            (Some(_), None) => {
+                let message = format!(
+                    "`{0}` is an array: write the differential of one element, e.g. d{0}[0]",
+                    coordinate.name
+                );
+                self.error(span, message)
+            }
+            (None, Some(_)) => {
+                let message = format!("`{}` is a single coordinate, not an array", coordinate.name);
+                self.error(span, message)
+            }
+        }
+    }
+
+    /// Splits `expr`, which contains a differential, at nesting `depth`.
+    fn split(&mut self, expr: &Expr, depth: usize) -> Vec<Part> {
+        if !self.rewriter.within_nesting(expr, depth) {
+            return Vec::new();
+        }
+        if let Some((k, index)) = differential(self.coordinates(), expr) {
+            return self.differential(k, index, expr);
+        }
+        match expr {
+            Expr::Paren(p) => self.split(&p.expr, depth + 1),
+            Expr::Group(g) => self.split(&g.expr, depth + 1),
+            Expr::Unary(syn::ExprUnary {
+                op: UnOp::Neg(minus),
+                expr: inner,
+                ..
+            }) => negated(self.split(inner, depth + 1), minus.span),
+            Expr::Binary(b) => match Family::of(&b.op) {
+                Some(Family::Sum) => self.sum(b, depth),
+                Some(Family::Product) => self.product(b, expr, depth),
+                None => self.not_linear(expr, "only + - * / combine its terms"),
+            },
+            _ => self.not_linear(
+                expr,
+                "a differential appears inside a function or method call",
+            ),
+        }
+    }
+
+    /// `a ± b ± ...`: every term must have a differential.
+    fn sum(&mut self, b: &syn::ExprBinary, depth: usize) -> Vec<Part> {
+        let (first, links) = spine(b, Family::Sum);
+        let mut parts = Vec::new();
+        for (op, operand) in
+            std::iter::once((None, first)).chain(links.into_iter().map(|(op, e)| (Some(op), e)))
+        {
+            if !self.contains(operand) {
+                self.no_differential(operand);
+                continue;
+            }
+            let split = self.split(operand, depth + 1);
+            match op {
+                Some(BinOp::Sub(minus)) => parts.extend(negated(split, minus.span)),
+                _ => parts.extend(split),
+            }
+        }
+        parts
+    }
+
+    /// `a * b / c ...` with exactly one factor, not a divisor, holding the differentials: each of
+    /// its terms becomes the product with that factor replaced by the term's coefficient.
+    fn product(&mut self, b: &syn::ExprBinary, expr: &Expr, depth: usize) -> Vec<Part> {
+        let (first, links) = spine(b, Family::Product);
+        let factors: Vec<(Option<&BinOp>, &Expr)> = std::iter::once((None, first))
+            .chain(links.iter().map(|&(op, e)| (Some(op), e)))
+            .collect();
+        let with: Vec<usize> = (0..factors.len())
+            .filter(|&i| self.contains(factors[i].1))
+            .collect();
+        let j = match with[..] {
+            [j] => j,
+            [_, second, ..] => {
+                return self.not_linear(factors[second].1, "this multiplies two differentials");
+            }
+            [] => {
+                self.no_differential(expr);
+                return Vec::new();
+            }
+        };
+        if let (Some(BinOp::Div(_)), factor) = factors[j] {
+            return self.not_linear(factor, "this divides by a differential");
+        }
+        let mut rewrite = |i: usize, e: &Expr| (i != j).then(|| self.rewriter.expr(e, depth + 1));
+        let first = rewrite(0, first);
+        let links: Vec<(BinOp, Option<Piece>)> = links
+            .iter()
+            .enumerate()
+            .map(|(i, &(op, e))| (*op, rewrite(i + 1, e)))
+            .collect();
+        let inner = self.split(factors[j].1, depth + 1);
+        inner
             .into_iter()
-            .map(|t| Term {
-                coefficient: f(&t.coefficient),
-                index: t.index,
+            .map(|(index, coefficient)| {
+                let or_coefficient = |p: &Option<Piece>| p.clone().unwrap_or(coefficient.clone());
+                let links = links
+                    .iter()
+                    .map(|(op, p)| (*op, or_coefficient(p)))
+                    .collect();
+                (
+                    index,
+                    combine(Family::Product, or_coefficient(&first), links),
+                )
             })
             .collect()
     }
+}
 
-    fn split(&self, expr: &Expr) -> syn::Result<Vec<Term>> {
-        if let Some(index) = self.as_differential(expr) {
-            let span = expr.span();
-            return Ok(vec![Term {
-                index: index?,
-                coefficient: syn::parse_quote_spanned!(span=> 1.0),
-            }]);
-        }
-        match expr {
-            Expr::Paren(p) => self.split(&p.expr),
-            Expr::Group(g) => self.split(&g.expr),
-            Expr::Unary(u) if matches!(u.op, syn::UnOp::Neg(_)) => Ok(Self::scaled(
-                self.split(&u.expr)?,
-                |c| syn::parse_quote_spanned!(u.span()=> -(#c)),
-            )),
-            Expr::Binary(b) => {
-                let (left, right) = (self.contains(&b.left), self.contains(&b.right));
-                match (&b.op, left, right) {
-                    (BinOp::Add(_) | BinOp::Sub(_), true, true) => {
-                        let mut terms = self.split(&b.left)?;
-                        let rest = self.split(&b.right)?;
-                        if matches!(b.op, BinOp::Sub(_)) {
-                            terms.extend(Self::scaled(
-                                rest,
-                                |c| syn::parse_quote_spanned!(b.op.span()=> -(#c)),
-                            ));
-                        } else {
-                            terms.extend(rest);
-                        }
-                        Ok(terms)
-                    }
-                    (BinOp::Add(_) | BinOp::Sub(_), false, _) => Err(self.no_differential(&b.left)),
-                    (BinOp::Add(_) | BinOp::Sub(_), _, false) => {
-                        Err(self.no_differential(&b.right))
-                    }
-                    (BinOp::Mul(_), true, true) => Err(Self::not_linear(
-                        b.op.span(),
-                        "this multiplies two differentials",
-                    )),
-                    (BinOp::Mul(_), false, true) => {
-                        let factor = &b.left;
-                        Ok(Self::scaled(
-                            self.split(&b.right)?,
-                            |c| syn::parse_quote_spanned!(b.op.span()=> (#factor) * (#c)),
-                        ))
-                    }
-                    (BinOp::Mul(_), true, false) => {
-                        let factor = &b.right;
-                        Ok(Self::scaled(
-                            self.split(&b.left)?,
-                            |c| syn::parse_quote_spanned!(b.op.span()=> (#c) * (#factor)),
-                        ))
-                    }
-                    (BinOp::Div(_), true, false) => {
-                        let divisor = &b.right;
-                        Ok(Self::scaled(
-                            self.split(&b.left)?,
-                            |c| syn::parse_quote_spanned!(b.op.span()=> (#c) / (#divisor)),
-                        ))
-                    }
-                    (BinOp::Div(_), _, true) => Err(Self::not_linear(
-                        b.right.span(),
-                        "this divides by a differential",
-                    )),
-                    _ => Err(Self::not_linear(
-                        b.op.span(),
-                        "only +, −, ·, / combine its terms",
-                    )),
-                }
-            }
-            other if self.contains(other) => Err(Self::not_linear(
-                other.span(),
-                "a differential appears inside a function or method call",
-            )),
-            other => Err(self.no_differential(other)),
-        }
-    }
+fn negated(parts: Vec<Part>, minus: Span) -> Vec<Part> {
+    parts
+        .into_iter()
+        .map(|(index, coefficient)| (index, coefficient.negated(minus)))
+        .collect()
 }

@@ -2,20 +2,21 @@
 
 use std::collections::HashSet;
 
-use proc_macro2::{Span, TokenStream};
+use proc_macro2::{Punct, Spacing, Span, TokenStream, TokenTree};
 use quote::quote;
 use syn::punctuated::Punctuated;
 use syn::spanned::Spanned;
 use syn::{Expr, Fields, GenericParam, Ident, Meta, Token, Type};
 
-use crate::ast::{Arguments, Coordinate, Lagrangian, Length, Model, Parameter, Term, offsets};
-use crate::expression::Scope;
+use crate::ast::{Arguments, Coordinate, Lagrangian, Length, Model, Parameter};
+use crate::expression::{Rewriter, Scope, bounds, is_reserved, reserved_message};
 use crate::{expression, one_form, quadrature};
 
 const KEYS: &str = "`coordinates(...)`, `lagrangian = ...`, `quadrature = ...`, \
      `constraints(...)`, `holonomic(...)`, `forces(...)`, `inputs(...)` and `constraint_at = ...`";
 
-/// Collected errors; reported together.
+/// Every error found, each with the span of the user's tokens; reported together. Validation,
+/// the rewriter and the one-form splitter all push into one.
 #[derive(Default)]
 pub struct Errors(Vec<syn::Error>);
 
@@ -24,8 +25,25 @@ impl Errors {
         self.0.push(syn::Error::new(span, message));
     }
 
-    pub fn extend(&mut self, errors: Vec<syn::Error>) {
-        self.0.extend(errors);
+    /// An error underlining from the token at `start` to the one at `end`.
+    pub fn push_range(&mut self, start: Span, end: Span, message: impl std::fmt::Display) {
+        let ends: TokenStream = [start, end]
+            .into_iter()
+            .map(|span| {
+                let mut end = Punct::new('.', Spacing::Alone);
+                end.set_span(span);
+                TokenTree::Punct(end)
+            })
+            .collect();
+        self.0.push(syn::Error::new_spanned(ends, message));
+    }
+
+    pub fn add(&mut self, error: syn::Error) {
+        self.0.push(error);
+    }
+
+    pub fn len(&self) -> usize {
+        self.0.len()
     }
 
     pub fn is_empty(&self) -> bool {
@@ -44,13 +62,16 @@ pub enum Outcome {
     Invalid {
         errors: Errors,
         coordinates: Option<Vec<Coordinate>>,
+        /// The struct as it is to be emitted (without a repeated attribute).
+        item: Box<syn::ItemStruct>,
     },
 }
 
 /// The arguments by key, before their contents are checked.
 #[derive(Default)]
 struct Entries {
-    coordinates: Option<(Span, Vec<Coordinate>)>,
+    /// `Some((span, None))`: given but unreadable (already reported).
+    coordinates: Option<(Span, Option<Vec<Coordinate>>)>,
     lagrangian: Option<Expr>,
     quadrature: Option<Expr>,
     constraints: Option<Vec<Expr>>,
@@ -60,22 +81,26 @@ struct Entries {
     constraint_at: Option<Expr>,
 }
 
-fn list<T: syn::parse::Parse>(list: &syn::MetaList, errors: &mut Errors) -> Option<Vec<T>> {
+/// The items of `key(a, b, ...)`; `empty` is the message for an empty list.
+fn list<T: syn::parse::Parse>(
+    list: &syn::MetaList,
+    empty: &str,
+    errors: &mut Errors,
+) -> Option<Vec<T>> {
     match list.parse_args_with(Punctuated::<T, Token![,]>::parse_terminated) {
         Ok(items) if items.is_empty() => {
-            errors.push(
-                list.span(),
-                "the list is empty; leave the argument out instead",
-            );
+            errors.push_range(list.path.span(), list.delimiter.span().close(), empty);
             None
         }
         Ok(items) => Some(items.into_iter().collect()),
         Err(e) => {
-            errors.0.push(e);
+            errors.add(e);
             None
         }
     }
 }
+
+const LEAVE_OUT: &str = "the list is empty; leave the argument out instead";
 
 fn entries(arguments: Arguments, errors: &mut Errors) -> Entries {
     let mut e = Entries::default();
@@ -93,14 +118,14 @@ fn entries(arguments: Arguments, errors: &mut Errors) -> Entries {
         }
         match (key.as_str(), entry) {
             ("coordinates", Meta::List(l)) => {
-                e.coordinates = list(&l, errors)
-                    .map(|c| (span, c))
-                    .or(Some((span, Vec::new())))
+                let empty = "a system needs at least one coordinate, e.g. coordinates(x) or \
+                             coordinates(x, theta[4])";
+                e.coordinates = Some((span, list(&l, empty, errors)));
             }
-            ("constraints", Meta::List(l)) => e.constraints = list(&l, errors),
-            ("holonomic", Meta::List(l)) => e.holonomic = list(&l, errors),
-            ("forces", Meta::List(l)) => e.forces = list(&l, errors),
-            ("inputs", Meta::List(l)) => e.inputs = list(&l, errors),
+            ("constraints", Meta::List(l)) => e.constraints = list(&l, LEAVE_OUT, errors),
+            ("holonomic", Meta::List(l)) => e.holonomic = list(&l, LEAVE_OUT, errors),
+            ("forces", Meta::List(l)) => e.forces = list(&l, LEAVE_OUT, errors),
+            ("inputs", Meta::List(l)) => e.inputs = list(&l, LEAVE_OUT, errors),
             ("lagrangian", Meta::NameValue(nv)) => e.lagrangian = Some(nv.value),
             ("quadrature", Meta::NameValue(nv)) => e.quadrature = Some(nv.value),
             ("constraint_at", Meta::NameValue(nv)) => e.constraint_at = Some(nv.value),
@@ -121,16 +146,45 @@ fn entries(arguments: Arguments, errors: &mut Errors) -> Entries {
     e
 }
 
+/// Reports every further `#[dirac_system]` on the struct and removes it (it would expand again).
+fn repeated_attributes(item: &mut syn::ItemStruct, errors: &mut Errors) {
+    item.attrs.retain(|attr| {
+        let repeated = attr
+            .path()
+            .segments
+            .last()
+            .is_some_and(|s| s.ident == "dirac_system");
+        if repeated {
+            errors.push_range(
+                attr.pound_token.span,
+                attr.bracket_token.span.close(),
+                "`#[dirac_system]` is applied twice; remove this one",
+            );
+        }
+        !repeated
+    });
+}
+
 /// Validates the arguments against the struct.
-pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
+pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     let mut errors = Errors::default();
+    repeated_attributes(&mut item, &mut errors);
     let e = entries(arguments, &mut errors);
     let parameters = parameters(&item, &mut errors);
+    if e.forces.is_some() {
+        for p in parameters.iter().filter(|p| p.name == "t") {
+            errors.push(
+                p.name.span(),
+                "a field named `t` would hide the time `t` of forces(...); rename the field",
+            );
+        }
+    }
     let coordinates = match e.coordinates {
-        Some((span, list)) => {
-            check_coordinates(span, &list, &parameters, &item, &mut errors);
+        Some((_, Some(list))) => {
+            check_coordinates(&list, &parameters, &item, &mut errors);
             Some(list)
         }
+        Some((_, None)) => None,
         None => {
             errors.push(
                 Span::call_site(),
@@ -157,11 +211,13 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
         (Some(_), None) => None,
     };
     let quadrature = match e.quadrature {
-        None => Some(quote!(::core::result::Result::Ok(::dirac::Quadrature::midpoint()))),
+        None => Some(quote!(::core::result::Result::Ok(
+            ::dirac::Quadrature::midpoint()
+        ))),
         Some(expr) => match quadrature::parse(&expr) {
             Ok(tokens) => Some(tokens),
             Err(err) => {
-                errors.0.push(err);
+                errors.add(err);
                 None
             }
         },
@@ -180,24 +236,22 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
             None
         }
     });
+    let fields: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
     let (one_forms, holonomic, forces) = match &coordinates {
         Some(coordinates) => {
-            let names: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
-            let mut force_names = names.clone();
-            force_names.extend(inputs.iter().cloned());
-            force_names.push(Ident::new("t", Span::call_site()));
             let positions = Scope {
                 coordinates,
-                constants: &names,
+                fields: &fields,
                 no_velocities: Some(
                     "constraints depend on positions only: dot(...) cannot appear here",
                 ),
+                elsewhere: "",
             };
             let one_forms = e
                 .constraints
                 .unwrap_or_default()
                 .iter()
-                .filter_map(|form| split(form, &positions, &mut errors))
+                .map(|form| one_form::terms(form, &mut Rewriter::new(&positions, &mut errors)))
                 .collect();
             let holonomic = e
                 .holonomic
@@ -205,17 +259,17 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
                 .iter()
                 .filter_map(|g| holonomic_of(g, &positions, &mut errors))
                 .collect();
-            let scope = Scope {
+            let state = Scope {
                 coordinates,
-                constants: &force_names,
+                fields: &fields,
                 no_velocities: None,
+                elsewhere: "",
             };
             let forces = e
                 .forces
                 .unwrap_or_default()
                 .iter()
-                .filter_map(|form| split(form, &scope, &mut errors))
-                .flatten()
+                .flat_map(|form| one_form::terms(form, &mut Rewriter::new(&state, &mut errors)))
                 .collect();
             (one_forms, holonomic, forces)
         }
@@ -239,50 +293,23 @@ pub fn model(arguments: Arguments, item: syn::ItemStruct) -> Outcome {
         (coordinates, ..) => Outcome::Invalid {
             errors,
             coordinates,
+            item: Box::new(item),
         },
     }
 }
 
-/// A one-form split into terms with rewritten coefficients.
-fn split(form: &Expr, scope: &Scope, errors: &mut Errors) -> Option<Vec<Term>> {
-    let offsets = offsets(scope.coordinates);
-    let terms = match one_form::terms(form, scope.coordinates, &offsets) {
-        Ok(terms) => terms,
-        Err(e) => {
-            errors.0.push(e);
-            return None;
-        }
-    };
-    let mut rewritten = Vec::with_capacity(terms.len());
-    for term in terms {
-        match expression::rewrite(&term.coefficient, scope) {
-            Ok(coefficient) => rewritten.push(Term {
-                index: term.index,
-                coefficient,
-            }),
-            Err(found) => errors.extend(found),
-        }
-    }
-    Some(rewritten)
-}
-
 /// A holonomic constraint `g(q)`: an expression of the positions, not a one-form.
-fn holonomic_of(g: &Expr, scope: &Scope, errors: &mut Errors) -> Option<Expr> {
-    let offsets = offsets(scope.coordinates);
-    if one_form::terms(g, scope.coordinates, &offsets).is_ok() {
-        errors.push(
-            g.span(),
+fn holonomic_of(g: &Expr, scope: &Scope, errors: &mut Errors) -> Option<TokenStream> {
+    if one_form::has_differential(g, scope.coordinates) {
+        let (start, end) = bounds(g);
+        errors.push_range(
+            start,
+            end,
             "holonomic constraints are functions g(q) = 0 of the coordinates; write one-forms in constraints(...)",
         );
         return None;
     }
-    match expression::rewrite(g, scope) {
-        Ok(g) => Some(g),
-        Err(found) => {
-            errors.extend(found);
-            None
-        }
-    }
+    expression::rewrite(g, scope, errors)
 }
 
 fn check_inputs(
@@ -295,15 +322,17 @@ fn check_inputs(
     for input in inputs {
         if !seen.insert(input.to_string()) {
             errors.push(input.span(), format!("duplicate input `{input}`"));
-        }
-        let clash = coordinates.iter().any(|c| c.name == *input)
+        } else if is_reserved(input) {
+            errors.push(input.span(), reserved_message(input));
+        } else if coordinates.iter().any(|c| c.name == *input)
             || parameters.iter().any(|p| p.name == *input)
-            || input == "t";
-        if clash {
+            || input == "t"
+        {
             errors.push(
                 input.span(),
                 format!(
-                    "input `{input}` has the name of a coordinate, a parameter or the time `t`"
+                    "input `{input}` has the name of a coordinate, a parameter or the time `t`; \
+                     rename it"
                 ),
             );
         }
@@ -325,37 +354,35 @@ fn lagrangian_of(
             return Some(Lagrangian::Function(p.path.clone()));
         }
     }
-    let names: Vec<_> = parameters.iter().map(|p| p.name.clone()).collect();
+    let fields: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
     let scope = Scope {
         coordinates,
-        constants: &names,
+        fields: &fields,
         no_velocities: None,
+        elsewhere: "; for other code write a generic function and give \
+                    `lagrangian = path::to::function`",
     };
-    match expression::rewrite(&expr, &scope) {
-        Ok(expr) => Some(Lagrangian::Expression(expr)),
-        Err(found) => {
-            errors.extend(found);
-            None
-        }
-    }
+    expression::rewrite(&expr, &scope, errors).map(Lagrangian::Expression)
 }
 
 fn check_coordinates(
-    span: Span,
     list: &[Coordinate],
     parameters: &[Parameter],
     item: &syn::ItemStruct,
     errors: &mut Errors,
 ) {
-    if list.is_empty() {
-        errors.push(span, "a system needs at least one coordinate");
-    }
     let mut seen = HashSet::new();
     for c in list {
         if !seen.insert(c.name.to_string()) {
             errors.push(c.name.span(), format!("duplicate coordinate `{}`", c.name));
-        }
-        if parameters.iter().any(|p| p.name == c.name) {
+        } else if is_reserved(&c.name) {
+            errors.push(c.name.span(), reserved_message(&c.name));
+        } else if c.name == "t" {
+            errors.push(
+                c.name.span(),
+                "`t` names the time (in forces(...)); give the coordinate another name",
+            );
+        } else if parameters.iter().any(|p| p.name == c.name) {
             errors.push(
                 c.name.span(),
                 format!(
@@ -420,6 +447,9 @@ fn parameters(item: &syn::ItemStruct, errors: &mut Errors) -> Vec<Parameter> {
         .iter()
         .filter_map(|field| {
             let name = field.ident.clone()?;
+            if is_reserved(&name) {
+                errors.push(name.span(), reserved_message(&name));
+            }
             match &field.ty {
                 ty if is_f64(ty) => Some(Parameter { name, array: false }),
                 Type::Array(a) if is_f64(&a.elem) => Some(Parameter { name, array: true }),

@@ -1,0 +1,242 @@
+//! The macro as a library function: random token streams and random expression trees never make
+//! it panic, and well-formed expressions expand to Rust that parses.
+
+use proc_macro2::TokenStream;
+use proptest::prelude::*;
+use proptest::sample::select;
+
+use crate::expand::dirac_system;
+use crate::expression::{BINARY, UNARY};
+
+const ITEM: &str = "struct S { m: f64, k: [f64; 2] }";
+
+/// Expands `#[dirac_system(args)] ITEM`; `None` if `args` does not tokenise.
+fn expand(args: &str, item: &str) -> Option<TokenStream> {
+    let args: TokenStream = args.parse().ok()?;
+    let item: TokenStream = item.parse().ok()?;
+    Some(dirac_system(args, item))
+}
+
+fn is_error(output: &TokenStream) -> bool {
+    output.to_string().contains("compile_error")
+}
+
+fn parses(output: &TokenStream) -> bool {
+    syn::parse2::<syn::File>(output.clone()).is_ok()
+}
+
+/// Expressions built from every supported form, with odd literals and paths.
+fn expression(one_form: bool) -> impl Strategy<Value = String> {
+    let mut leaves = vec![
+        "x",
+        "y",
+        "theta[0]",
+        "theta[1]",
+        "m",
+        "k[1]",
+        "C",
+        "std::f64::consts::PI",
+        "0.5",
+        "2",
+        "0",
+        "1e300",
+        "5e-324",
+        "18446744073709551616",
+        "0x10",
+    ];
+    leaves.extend(match one_form {
+        true => ["dx", "dtheta[1]"],
+        false => ["dot(x)", "dot(theta[1])"],
+    });
+    let functions: Vec<&str> = UNARY.to_vec();
+    let binary: Vec<&str> = BINARY
+        .iter()
+        .map(|b| b.0)
+        .filter(|f| *f != "powi")
+        .collect();
+    select(leaves)
+        .prop_map(String::from)
+        .prop_recursive(6, 48, 3, move |inner| {
+            prop_oneof![
+                (
+                    inner.clone(),
+                    select(vec!["+", "-", "*", "/"]),
+                    inner.clone()
+                )
+                    .prop_map(|(a, op, b)| format!("{a} {op} {b}")),
+                inner.clone().prop_map(|a| format!("-{a}")),
+                inner.clone().prop_map(|a| format!("({a})")),
+                (select(functions.clone()), inner.clone(), any::<bool>()).prop_map(
+                    |(f, a, method)| match method {
+                        true => format!("({a}).{f}()"),
+                        false => format!("{f}({a})"),
+                    }
+                ),
+                (
+                    select(binary.clone()),
+                    inner.clone(),
+                    inner.clone(),
+                    any::<bool>()
+                )
+                    .prop_map(|(f, a, b, method)| match method {
+                        true => format!("({a}).{f}({b})"),
+                        false => format!("{f}({a}, {b})"),
+                    }),
+                (inner.clone(), -3i32..4).prop_map(|(a, n)| format!("powi({a}, {n})")),
+                inner.clone().prop_map(|a| format!("user({a})")),
+            ]
+        })
+}
+
+/// Balanced token soup: names, keywords, operators and literals, grouped at random.
+fn tokens() -> impl Strategy<Value = String> {
+    let vocabulary = vec![
+        "x",
+        "theta",
+        "dx",
+        "dot",
+        "sin",
+        "powi",
+        "powf",
+        "m",
+        "t",
+        "__q",
+        "self",
+        "fn",
+        "struct",
+        "coordinates",
+        "lagrangian",
+        "constraints",
+        "holonomic",
+        "forces",
+        "inputs",
+        "quadrature",
+        "galerkin",
+        "constraint_at",
+        "+",
+        "-",
+        "*",
+        "/",
+        "^",
+        "%",
+        "=",
+        ",",
+        ".",
+        ";",
+        "!",
+        "::",
+        "&",
+        "|",
+        "<",
+        ">",
+        "..",
+        "'a",
+        "1",
+        "0",
+        "2.5",
+        "1e400",
+        "99999999999999999999999",
+        "1u8",
+        "2f32",
+        "\"s\"",
+        "true",
+    ];
+    select(vocabulary)
+        .prop_map(String::from)
+        .prop_recursive(5, 64, 6, |inner| {
+            (
+                prop::collection::vec(inner, 0..6),
+                select(vec![("(", ")"), ("[", "]"), ("{", "}"), ("", "")]),
+            )
+                .prop_map(|(parts, (open, close))| format!("{open}{}{close}", parts.join(" ")))
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_lagrangians_expand_to_rust(expr in expression(false)) {
+        let output = expand(&format!("coordinates(x, y, theta[2]), lagrangian = {expr}"), ITEM)
+            .expect("tokenises");
+        prop_assert!(!is_error(&output), "{expr}\n{output}");
+        prop_assert!(parses(&output), "{expr}\n{output}");
+    }
+
+    #[test]
+    fn random_one_forms_and_holonomic_constraints_never_panic(
+        form in expression(true),
+        g in expression(false),
+    ) {
+        let args = format!(
+            "coordinates(x, y, theta[2]), lagrangian = dot(x) * dot(x), constraints({form}), \
+             holonomic({g}), forces({form})"
+        );
+        let output = expand(&args, ITEM).expect("tokenises");
+        prop_assert!(parses(&output), "{args}\n{output}");
+    }
+
+    #[test]
+    fn random_tokens_never_panic(soup in tokens()) {
+        for args in [
+            soup.clone(),
+            format!("coordinates(x, theta[2]), lagrangian = {soup}"),
+            format!("coordinates(x, theta[2]), lagrangian = dot(x) * dot(x), constraints({soup})"),
+            format!("coordinates({soup}), lagrangian = x"),
+            format!("coordinates(x), lagrangian = x, quadrature = {soup}"),
+        ] {
+            if let Some(output) = expand(&args, ITEM) {
+                prop_assert!(parses(&output), "{args}\n{output}");
+            }
+        }
+        let _ = expand("coordinates(x), lagrangian = x", &format!("struct S {{ {soup} }}"));
+        let _ = expand("coordinates(x), lagrangian = x", &soup);
+    }
+}
+
+/// A 10 000-term sum, as syn parses it a 10 000-deep left spine, expands without deep recursion.
+#[test]
+fn ten_thousand_terms_expand() {
+    let sum: Vec<String> = (0..10_000)
+        .map(|i| {
+            format!(
+                "{}.5 * dot(theta[{}]) * theta[{}]",
+                i % 7,
+                i % 2,
+                (i + 1) % 2
+            )
+        })
+        .collect();
+    let force: Vec<String> = (0..10_000)
+        .map(|i| format!("{}.5 * dot(theta[1]) * dtheta[{}]", i % 7, i % 2))
+        .collect();
+    let args = format!(
+        "coordinates(x, theta[2]), lagrangian = 1.0 - {}, forces({})",
+        sum.join(" + "),
+        force.join(" - "),
+    );
+    let output = expand(&args, ITEM).expect("tokenises");
+    assert!(!is_error(&output));
+    assert!(parses(&output));
+}
+
+/// Nesting beyond the limit is one error, not a crash.
+#[test]
+fn deep_nesting_is_one_error() {
+    let nested = format!("{}x{}", "(".repeat(300), ")".repeat(300));
+    let output = expand(&format!("coordinates(x), lagrangian = {nested}"), ITEM).unwrap();
+    assert_eq!(output.to_string().matches("compile_error").count(), 1);
+}
+
+/// Inputs that once reached arithmetic in the macro: an index into a zero-length array, array
+/// lengths summing past `usize::MAX`. Each is a compile error.
+#[test]
+fn edge_lengths_are_errors() {
+    for args in [
+        "coordinates(theta[0]), lagrangian = theta[0] * dot(theta[0])",
+        "coordinates(a[18446744073709551615], b[2]), lagrangian = a[0] * dot(b[1])",
+    ] {
+        let output = expand(args, ITEM).unwrap();
+        assert!(parses(&output), "{args}");
+    }
+}
