@@ -1,6 +1,7 @@
 //! A model with a 10 000-term Lagrangian and a 10 000-term force one-form compiles (the macro and
 //! rustc see no recursion as deep as the sum is long) and evaluates to the value computed term by
-//! term in plain Rust. `scripts/compile_times.sh` writes the same programs (through
+//! term in plain Rust, and its momentum ∂L/∂v (through the stepper's dual numbers) to the
+//! closed form. `scripts/compile_times.sh` writes the same programs (through
 //! `write_programs`) to time their builds.
 
 use std::fmt::Write;
@@ -11,15 +12,16 @@ fn coefficient(i: usize) -> f64 {
     1.0 + (i % 7) as f64 * 0.125
 }
 
-/// Term `i` of the Lagrangian, with its sign, in the coordinates `q[4]` and the parameter `m`.
+/// Term `i` of the Lagrangian, with its sign, on a line of its own (as generated models are
+/// written), in the coordinates `q[4]` and the parameter `m`.
 fn lagrangian_term(i: usize) -> String {
     let (k, c) = (i % 4, coefficient(i));
     match i % 5 {
-        0 => format!(" + {c:?} * dot(q[{k}]).powi(2)"),
-        1 => format!(" - {c:?} * q[{k}]"),
-        2 => format!(" + {c:?} / (1.0 + q[{k}] * q[{k}])"),
-        3 => format!(" - m * {c:?} * cos(q[{k}])"),
-        _ => format!(" + {c:?}"),
+        0 => format!("\n        + {c:?} * dot(q[{k}]).powi(2)"),
+        1 => format!("\n        - {c:?} * q[{k}]"),
+        2 => format!("\n        + {c:?} / (1.0 + q[{k}] * q[{k}])"),
+        3 => format!("\n        - m * {c:?} * cos(q[{k}])"),
+        _ => format!("\n        + {c:?}"),
     }
 }
 
@@ -34,8 +36,8 @@ fn program(terms: usize) -> String {
         let (k, c) = (i % 4, coefficient(i));
         let sign = match i {
             0 => "",
-            _ if i % 2 == 0 => " +",
-            _ => " -",
+            _ if i % 2 == 0 => "\n        +",
+            _ => "\n        -",
         };
         write!(force, "{sign} {c:?} * dot(q[{k}]) * dq[{k}]").unwrap();
     }
@@ -57,8 +59,12 @@ fn main() {{
     let v = vector![0.5, 0.6, -0.7, 0.8];
     let (mut expected, mut scale) = (0.25_f64, 0.25_f64);
     let mut force = [0.0_f64; 4];
+    let mut momentum = [0.0_f64; 4];
     for i in 0..{terms}_usize {{
         let (k, c) = (i % 4, 1.0 + (i % 7) as f64 * 0.125);
+        if i % 5 == 0 {{
+            momentum[k] += 2.0 * c * v[k];
+        }}
         let term = match i % 5 {{
             0 => c * v[k] * v[k],
             1 => -c * q[k],
@@ -73,8 +79,11 @@ fn main() {{
     let l: f64 = system.lagrangian(&q, &v);
     assert!((l - expected).abs() <= 1e-12 * scale, "L = {{l}}, expected {{expected}}");
     let f: SVector<f64, 4> = system.force(&q, &v, 0.0, &[]);
+    // ∂L/∂v through the dual numbers the stepper uses.
+    let p = dirac::legendre::momentum(&system, &q, &v);
     for k in 0..4 {{
         assert!((f[k] - force[k]).abs() <= 1e-12 * scale, "f[{{k}}] = {{}}, expected {{}}", f[k], force[k]);
+        assert!((p[k] - momentum[k]).abs() <= 1e-12 * scale, "p[{{k}}] = {{}}, expected {{}}", p[k], momentum[k]);
     }}
 }}
 "#

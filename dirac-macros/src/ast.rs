@@ -116,6 +116,8 @@ pub struct Model {
     pub inputs: Vec<Ident>,
     /// `::dirac::ConstraintPoint::...` when `constraint_at` is given.
     pub constraint_point: Option<TokenStream>,
+    /// Continuations of long chains, each emitted as a method of its own.
+    pub parts: Vec<crate::expression::Part>,
 }
 
 /// Number of coordinates as a const expression (a literal when every length is one).

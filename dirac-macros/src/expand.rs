@@ -5,7 +5,7 @@ use quote::{quote, quote_spanned};
 use syn::spanned::Spanned;
 
 use crate::ast::{Arguments, Coordinate, Lagrangian, Model, dimension, offsets};
-use crate::expression::bind_coordinate;
+use crate::expression::{Context, bind_coordinate, part_ident};
 use crate::validate::{self, Outcome};
 
 /// Entry point: parse, validate, expand; on error the struct, the errors and a stub impl.
@@ -80,6 +80,7 @@ fn expand(model: &Model) -> TokenStream {
         }
     };
     let dirac = dirac_items(model, &n, &bindings);
+    let parts = parts(model, &n, &bindings);
     let names = model.coordinates.iter().zip(&offsets).map(|(c, offset)| {
         let name = c.name.to_string();
         match &c.length {
@@ -111,6 +112,8 @@ fn expand(model: &Model) -> TokenStream {
     quote! {
         #item
 
+        #parts
+
         #[automatically_derived]
         #header {
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
@@ -140,6 +143,57 @@ fn expand(model: &Model) -> TokenStream {
             }
 
             #dirac
+        }
+    }
+}
+
+/// The inputs bound by name for the forces.
+fn input_bindings(model: &Model) -> TokenStream {
+    let inputs = model
+        .inputs
+        .iter()
+        .enumerate()
+        .map(|(i, u)| quote!(let #u: f64 = __inputs[#i];));
+    quote!(#(#inputs)*)
+}
+
+/// The hoisted continuations of long chains, as private methods of the model (none for a model
+/// without chains longer than one chunk). Each binds what its context's method binds.
+fn parts(model: &Model, n: &TokenStream, bindings: &dyn Fn(bool) -> TokenStream) -> TokenStream {
+    if model.parts.is_empty() {
+        return TokenStream::new();
+    }
+    let vector = quote!(&::dirac::nalgebra::SVector<__D, #n>);
+    let methods = model.parts.iter().enumerate().map(|(k, part)| {
+        let (parameters, prelude) = match part.context {
+            Context::Lagrangian => (quote!(__q: #vector, __v: #vector,), bindings(true)),
+            Context::Force => {
+                let state = bindings(true);
+                let inputs = input_bindings(model);
+                (
+                    quote!(__q: #vector, __v: #vector, t: f64, __inputs: &[f64],),
+                    quote!(#state #inputs),
+                )
+            }
+            Context::Positions => (quote!(__q: #vector,), bindings(false)),
+        };
+        let (name, body, scalar) = (part_ident(k), &part.body, &part.scalar);
+        quote! {
+            #[doc(hidden)]
+            #[inline(never)]
+            #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
+            fn #name<__D: ::dirac::Scalar>(&self, #parameters __chain: #scalar) -> #scalar {
+                #prelude
+                #body
+            }
+        }
+    });
+    let name = &model.item.ident;
+    let (impl_generics, ty_generics, where_clause) = model.item.generics.split_for_impl();
+    quote! {
+        #[automatically_derived]
+        impl #impl_generics #name #ty_generics #where_clause {
+            #(#methods)*
         }
     }
 }
@@ -214,11 +268,7 @@ fn dirac_items(
     }
     if !model.forces.is_empty() {
         let state = bindings(true);
-        let inputs = model
-            .inputs
-            .iter()
-            .enumerate()
-            .map(|(i, u)| quote!(let #u: f64 = __inputs[#i];));
+        let inputs = input_bindings(model);
         let sum = accumulate(&quote!(__f), &model.forces);
         items.extend(quote! {
             const FORCES: bool = true;
@@ -232,7 +282,7 @@ fn dirac_items(
                 __inputs: &[f64],
             ) -> ::dirac::nalgebra::SVector<__D, #n> {
                 #state
-                #(#inputs)*
+                #inputs
                 let mut __f = ::dirac::nalgebra::SVector::<__D, #n>::from_element(#zero);
                 #sum
                 __f

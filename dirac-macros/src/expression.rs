@@ -8,6 +8,8 @@
 //! unary minus) recurses, and it is capped at [`MAX_NESTING`]. Every emitted token keeps the span
 //! of the user's token it comes from, so type errors point at them.
 
+use std::cell::RefCell;
+
 use proc_macro2::{Delimiter, Group, Literal, Span, TokenStream, TokenTree};
 use quote::{ToTokens, format_ident, quote, quote_spanned};
 use syn::{BinOp, Expr, ExprBinary, Ident, Lit, UnOp};
@@ -70,6 +72,47 @@ pub struct Scope<'a> {
     pub no_velocities: Option<&'static str>,
     /// Appended to the message for an unsupported expression (where else to write code).
     pub elsewhere: &'static str,
+    /// The generated method the expression is emitted into.
+    pub context: Context,
+    /// The model's hoisted parts of long chains, shared by every expression of the model.
+    pub parts: &'a RefCell<Vec<Part>>,
+}
+
+/// The generated method an expression is emitted into, which fixes what its hoisted parts are
+/// passed: the Lagrangian's `(q, v)`, the forces' `(q, v, t, inputs)`, or the constraints' `q`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Context {
+    Lagrangian,
+    Force,
+    Positions,
+}
+
+impl Context {
+    /// The arguments a hoisted part is called with, each followed by a comma.
+    fn arguments(self) -> TokenStream {
+        match self {
+            Context::Lagrangian => quote!(__q, __v,),
+            Context::Force => quote!(__q, __v, t, __inputs,),
+            Context::Positions => quote!(__q,),
+        }
+    }
+}
+
+/// A continuation of a long chain, emitted as a method of its own (`__dirac_part_k`) that takes
+/// the chain so far and returns it continued by [`CHUNK`] operands. LLVM's optimisation of one
+/// function grows faster than linearly with its size; a chain of any length then costs many
+/// bounded functions (and one call per [`CHUNK`] operands at run time).
+pub struct Part {
+    pub context: Context,
+    /// `__chain op x op x ...`.
+    pub body: TokenStream,
+    /// The chain's type: `__D`, or `f64` for a chain of constants.
+    pub scalar: TokenStream,
+}
+
+/// The name of hoisted part `k`.
+pub fn part_ident(k: usize) -> Ident {
+    format_ident!("__dirac_part_{}", k)
 }
 
 /// How tightly emitted tokens bind, loosest first: they are parenthesised where an operator
@@ -553,7 +596,7 @@ impl<'a> Rewriter<'a> {
             .into_iter()
             .map(|(op, operand)| (*op, self.expr(operand, depth + 1)))
             .collect();
-        combine(family, first, links)
+        self.combine(family, first, links)
     }
 
     /// Rewrites one expression at nesting `depth` and classifies it.
@@ -755,86 +798,105 @@ fn is_known(ident: &Ident) -> bool {
     UNARY.contains(&name.as_str()) || BINARY.iter().any(|(n, _)| *n == name)
 }
 
-/// Emits `first op1 x1 op2 x2 ...` with constants kept in `f64`. Dual numbers implement
-/// `D op f64` but not `f64 op D`, so a constant prefix followed by a dual operand `d` is moved
-/// after it: `c - d ...` becomes `-d + c ...`, `c / d ...` becomes `d.recip() * c ...`.
-pub fn combine(family: Family, first: Piece, links: Vec<(BinOp, Piece)>) -> Piece {
-    let operand = family.operand();
-    let span = first.span;
-    let lead = match first.class {
-        Class::Dual => None,
-        Class::Constant => links.iter().position(|(_, p)| p.class == Class::Dual),
-    };
-    let class = match (first.class, lead) {
-        (Class::Constant, None) => Class::Constant,
-        _ => Class::Dual,
-    };
-    // The operands in the order emitted, each after its operator.
-    let mut sequence = Vec::with_capacity(links.len() + 1);
-    let mut rest = links.into_iter();
-    match lead {
-        None => sequence.push(first.at(operand)),
-        Some(k) => {
-            let mut prefix = first.at(operand);
-            for (op, piece) in rest.by_ref().take(k) {
-                prefix.extend(op.into_token_stream());
-                prefix.extend(piece.at(operand));
-            }
-            let constant = match k {
-                0 => prefix,
-                _ => parenthesised(prefix, span),
-            };
-            if let Some((op, dual)) = rest.next() {
-                let op_span = op
-                    .to_token_stream()
-                    .into_iter()
-                    .next()
-                    .map_or(span, |t| t.span());
-                sequence.push(match op {
-                    BinOp::Sub(_) => dual.negated(op_span).tokens,
-                    BinOp::Div(_) => {
-                        let recip = Ident::new("recip", op_span);
-                        dual.method(&recip, TokenStream::new(), Class::Dual).tokens
-                    }
-                    _ => dual.at(operand),
-                });
-                sequence.push(match family {
-                    Family::Sum => quote_spanned!(op_span=> + #constant),
-                    Family::Product => quote_spanned!(op_span=> * #constant),
-                });
-            }
-        }
-    }
-    sequence.extend(rest.map(|(op, piece)| {
-        let piece = piece.at(operand);
-        quote!(#op #piece)
-    }));
-    let binding = match sequence.len() > CHUNK {
-        true => Binding::Atom,
-        false => family.binding(),
-    };
-    Piece {
-        tokens: chunked(sequence, span),
-        class,
-        binding,
-        span,
-    }
-}
-
 /// Operands per statement of a long chain.
 const CHUNK: usize = 64;
 
-/// A chain's tokens: flat up to [`CHUNK`] operands, else a block of statements each continuing
-/// it by `CHUNK` operands (rustc recurses on a flat chain as deep as it is long).
-fn chunked(sequence: Vec<TokenStream>, span: Span) -> TokenStream {
-    if sequence.len() <= CHUNK {
-        return sequence.into_iter().collect();
+impl Rewriter<'_> {
+    /// Emits `first op1 x1 op2 x2 ...` with constants kept in `f64`. Dual numbers implement
+    /// `D op f64` but not `f64 op D`, so a constant prefix followed by a dual operand `d` is moved
+    /// after it: `c - d ...` becomes `-d + c ...`, `c / d ...` becomes `d.recip() * c ...`.
+    pub fn combine(&self, family: Family, first: Piece, links: Vec<(BinOp, Piece)>) -> Piece {
+        let operand = family.operand();
+        let span = first.span;
+        let lead = match first.class {
+            Class::Dual => None,
+            Class::Constant => links.iter().position(|(_, p)| p.class == Class::Dual),
+        };
+        let class = match (first.class, lead) {
+            (Class::Constant, None) => Class::Constant,
+            _ => Class::Dual,
+        };
+        // The operands in the order emitted, each after its operator.
+        let mut sequence = Vec::with_capacity(links.len() + 1);
+        let mut rest = links.into_iter();
+        match lead {
+            None => sequence.push(first.at(operand)),
+            Some(k) => {
+                let mut prefix = first.at(operand);
+                for (op, piece) in rest.by_ref().take(k) {
+                    prefix.extend(op.into_token_stream());
+                    prefix.extend(piece.at(operand));
+                }
+                let constant = match k {
+                    0 => prefix,
+                    _ => parenthesised(prefix, span),
+                };
+                if let Some((op, dual)) = rest.next() {
+                    let op_span = op
+                        .to_token_stream()
+                        .into_iter()
+                        .next()
+                        .map_or(span, |t| t.span());
+                    sequence.push(match op {
+                        BinOp::Sub(_) => dual.negated(op_span).tokens,
+                        BinOp::Div(_) => {
+                            let recip = Ident::new("recip", op_span);
+                            dual.method(&recip, TokenStream::new(), Class::Dual).tokens
+                        }
+                        _ => dual.at(operand),
+                    });
+                    sequence.push(match family {
+                        Family::Sum => quote_spanned!(op_span=> + #constant),
+                        Family::Product => quote_spanned!(op_span=> * #constant),
+                    });
+                }
+            }
+        }
+        sequence.extend(rest.map(|(op, piece)| {
+            let piece = piece.at(operand);
+            quote!(#op #piece)
+        }));
+        let binding = match sequence.len() > CHUNK {
+            true => Binding::Atom,
+            false => family.binding(),
+        };
+        Piece {
+            tokens: self.chunked(sequence, class, span),
+            class,
+            binding,
+            span,
+        }
     }
-    let chain = Ident::new("__chain", span);
-    let mut chunks = sequence.chunks(CHUNK);
-    let first = chunks.next().unwrap_or_default();
-    let rest = chunks.map(|chunk| quote!(let #chain = #chain #(#chunk)*;));
-    quote!({ let #chain = #(#first)*; #(#rest)* #chain })
+
+    /// A chain's tokens: flat up to [`CHUNK`] operands; longer, its first [`CHUNK`] operands
+    /// and then one call per [`CHUNK`] more, each a hoisted [`Part`] (rustc recurses on a flat chain
+    /// as deep as it is long, and LLVM slows down more than linearly on one long function).
+    fn chunked(&self, sequence: Vec<TokenStream>, class: Class, span: Span) -> TokenStream {
+        if sequence.len() <= CHUNK {
+            return sequence.into_iter().collect();
+        }
+        let chain = Ident::new("__chain", span);
+        let scalar = match class {
+            Class::Dual => quote_spanned!(span=> __D),
+            Class::Constant => quote_spanned!(span=> f64),
+        };
+        let arguments = self.scope.context.arguments();
+        let mut parts = self.scope.parts.borrow_mut();
+        let mut chunks = sequence.chunks(CHUNK);
+        let first = chunks.next().unwrap_or_default();
+        let calls: Vec<TokenStream> = chunks
+            .map(|chunk| {
+                let name = part_ident(parts.len());
+                parts.push(Part {
+                    context: self.scope.context,
+                    body: quote!(#chain #(#chunk)*),
+                    scalar: scalar.clone(),
+                });
+                quote!(let #chain = self.#name(#arguments #chain);)
+            })
+            .collect();
+        quote!({ let #chain: #scalar = #(#first)*; #(#calls)* #chain })
+    }
 }
 
 /// Binds a coordinate's position and velocity (`__D`, or `[__D; K]` for an array) from `__q`, `__v`.

@@ -8,7 +8,7 @@ use quote::quote_spanned;
 use syn::{BinOp, Expr, ExprIndex, UnOp};
 
 use crate::ast::{Coordinate, Length, Term, offsets};
-use crate::expression::{Family, Piece, Rewriter, bounds, combine, spine, subexpressions};
+use crate::expression::{Family, Piece, Rewriter, bounds, spine, subexpressions};
 
 /// Splits `form` into terms `coefficient · d(coordinate)`; errors go into the rewriter's context.
 pub fn terms(form: &Expr, rewriter: &mut Rewriter) -> Vec<Term> {
@@ -18,13 +18,44 @@ pub fn terms(form: &Expr, rewriter: &mut Rewriter) -> Vec<Term> {
         splitter.no_differential(form);
         return Vec::new();
     }
-    splitter
-        .split(form, 0)
+    let parts = splitter.split(form, 0);
+    collected(parts, splitter.rewriter)
         .into_iter()
         .map(|(index, coefficient)| Term {
             index,
             span: coefficient.span(),
             coefficient: coefficient.into_scalar(),
+        })
+        .collect()
+}
+
+/// The terms of one differential summed into one coefficient, in order of first appearance:
+/// `Σ_k c_k dx` is one statement `w[x] += Σ_k c_k` (a chain the rewriter emits in bounded
+/// chunks), not one statement per term, which LLVM optimises in time growing faster than
+/// linearly with the number of statements.
+fn collected(parts: Vec<Part>, rewriter: &Rewriter) -> Vec<Part> {
+    let mut groups: Vec<(String, TokenStream, Vec<Piece>)> = Vec::new();
+    for (index, coefficient) in parts {
+        let key = index.to_string();
+        match groups.iter_mut().find(|(k, ..)| *k == key) {
+            Some((.., pieces)) => pieces.push(coefficient),
+            None => groups.push((key, index, vec![coefficient])),
+        }
+    }
+    groups
+        .into_iter()
+        .filter_map(|(_, index, pieces)| {
+            let mut pieces = pieces.into_iter();
+            let first = pieces.next()?;
+            let links: Vec<(BinOp, Piece)> = pieces
+                .map(|p| (BinOp::Add(syn::Token![+](p.span())), p))
+                .collect();
+            let sum = if links.is_empty() {
+                first
+            } else {
+                rewriter.combine(Family::Sum, first, links)
+            };
+            Some((index, sum))
         })
         .collect()
 }
@@ -250,7 +281,8 @@ impl Splitter<'_, '_> {
                     .collect();
                 (
                     index,
-                    combine(Family::Product, or_coefficient(&first), links),
+                    self.rewriter
+                        .combine(Family::Product, or_coefficient(&first), links),
                 )
             })
             .collect()

@@ -1,5 +1,6 @@
 //! Checks the attribute and the struct, collecting every error with the span of the user's tokens.
 
+use std::cell::RefCell;
 use std::collections::HashSet;
 
 use proc_macro2::{Punct, Spacing, Span, TokenStream, TokenTree};
@@ -9,7 +10,7 @@ use syn::spanned::Spanned;
 use syn::{Expr, Fields, GenericParam, Ident, Meta, Token, Type};
 
 use crate::ast::{Arguments, Coordinate, Lagrangian, Length, Model, Parameter};
-use crate::expression::{Rewriter, Scope, bounds, is_reserved, reserved_message};
+use crate::expression::{Context, Part, Rewriter, Scope, bounds, is_reserved, reserved_message};
 use crate::{expression, one_form, quadrature};
 
 const KEYS: &str = "`coordinates(...)`, `lagrangian = ...`, `quadrature = ...`, \
@@ -168,6 +169,7 @@ fn repeated_attributes(item: &mut syn::ItemStruct, errors: &mut Errors) {
 /// Validates the arguments against the struct.
 pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     let mut errors = Errors::default();
+    let parts = RefCell::new(Vec::new());
     repeated_attributes(&mut item, &mut errors);
     let e = entries(arguments, &mut errors);
     let parameters = parameters(&item, &mut errors);
@@ -206,7 +208,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
             None
         }
         (Some(expr), Some(coordinates)) => {
-            lagrangian_of(expr, coordinates, &parameters, &mut errors)
+            lagrangian_of(expr, coordinates, &parameters, &parts, &mut errors)
         }
         (Some(_), None) => None,
     };
@@ -246,6 +248,8 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                     "constraints depend on positions only: dot(...) cannot appear here",
                 ),
                 elsewhere: "",
+                context: Context::Positions,
+                parts: &parts,
             };
             let one_forms = e
                 .constraints
@@ -264,6 +268,8 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 fields: &fields,
                 no_velocities: None,
                 elsewhere: "",
+                context: Context::Force,
+                parts: &parts,
             };
             let forces = e
                 .forces
@@ -288,6 +294,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 forces,
                 inputs,
                 constraint_point,
+                parts: parts.into_inner(),
             }))
         }
         (coordinates, ..) => Outcome::Invalid {
@@ -344,6 +351,7 @@ fn lagrangian_of(
     expr: Expr,
     coordinates: &[Coordinate],
     parameters: &[Parameter],
+    parts: &RefCell<Vec<Part>>,
     errors: &mut Errors,
 ) -> Option<Lagrangian> {
     if let Expr::Path(p) = &expr {
@@ -361,6 +369,8 @@ fn lagrangian_of(
         no_velocities: None,
         elsewhere: "; for other code write a generic function and give \
                     `lagrangian = path::to::function`",
+        context: Context::Lagrangian,
+        parts,
     };
     expression::rewrite(&expr, &scope, errors).map(Lagrangian::Expression)
 }
