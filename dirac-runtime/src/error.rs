@@ -53,11 +53,12 @@ pub enum DiracError {
         /// The residual tolerance that was not met.
         tolerance: f64,
     },
-    /// Newton's method reached a root without contracting: its updates grew, so the root may
-    /// not be the continuation of the trajectory (the step does not resolve the dynamics, or the
-    /// Jacobian is nearly singular). The state is unchanged.
+    /// Newton's method did not contract from the predictor (successive updates shrank too
+    /// slowly or grew), so a root it would reach may not be the continuation of the trajectory:
+    /// the step does not resolve the dynamics, or the Jacobian is nearly singular. The solve was
+    /// abandoned and the state is unchanged.
     #[error(
-        "{problem} at step {step}: Newton's updates did not contract (ratio {contraction:.2}, \
+        "{problem} at step {step}: Newton's updates did not contract (ratio {contraction:.3}, \
          at most {max_contraction} accepted), so the root it would reach may not continue the \
          trajectory; try a smaller step"
     )]

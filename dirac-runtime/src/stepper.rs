@@ -415,8 +415,9 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     }
 
     /// Appends the current state and then every `every`-th of the next `steps` states to
-    /// `trajectory`. On error the trajectory ends with the current state: a step is made current
-    /// only once its sample (its energy) could be computed.
+    /// `trajectory`. On error the stepper stays at the last good step and the trajectory keeps
+    /// every sample recorded up to it; a sampled step is made current only once its energy could
+    /// be computed (unsampled steps are not asked for their energy).
     pub fn record(
         &mut self,
         trajectory: &mut Trajectory<N>,
@@ -465,8 +466,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 self.multipliers(),
             )
         } else {
-            trajectory.push(state.t, state.q, state.p, energy);
-            Ok(())
+            trajectory.push(state.t, state.q, state.p, energy)
         }
     }
 
@@ -589,7 +589,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         let energy = legendre::energy(self.system(), &state.q, &v);
         if !energy.is_finite() {
             return Err(DiracError::NonFinite {
-                what: format!("the energy after step {steps}"),
+                what: format!("the energy after {steps} steps"),
                 value: energy,
             });
         }
@@ -688,6 +688,14 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 step: self.steps,
                 contraction,
                 max_contraction: self.newton.options().max_contraction,
+            },
+            NewtonFailure::NonFinite if problem == LEGENDRE => DiracError::NonFinite {
+                what: format!(
+                    "the residual of {problem} after {} steps (the velocity iterate left the \
+                     Lagrangian's domain; start_from_momentum_near takes a guess inside it)",
+                    self.steps
+                ),
+                value: f64::NAN,
             },
             NewtonFailure::NonFinite => DiracError::NonFinite {
                 what: format!(

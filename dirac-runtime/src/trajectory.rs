@@ -14,8 +14,8 @@ use crate::error::DiracError;
 /// use nalgebra::vector;
 /// let mut trajectory = Trajectory::new(vec!["x".into()])?;
 /// assert!(Trajectory::<1>::new(vec![]).is_err()); // one name per coordinate
-/// trajectory.push(0.0, vector![1.0], vector![0.0], 0.5);
-/// trajectory.push(0.1, vector![0.99], vector![-0.1], 0.5001);
+/// trajectory.push(0.0, vector![1.0], vector![0.0], 0.5)?;
+/// trajectory.push(0.1, vector![0.99], vector![-0.1], 0.5001)?;
 /// let mut csv = Vec::new();
 /// trajectory.write_csv(&mut csv)?;
 /// assert!(String::from_utf8(csv).unwrap().starts_with("t,x,p_x,energy\n0,1,0,0.5\n"));
@@ -82,7 +82,7 @@ impl<const N: usize> Trajectory<N> {
                 multipliers.len()
             )));
         }
-        self.push(t, q, p, energy);
+        self.append(t, q, p, energy);
         self.violation.push(violation);
         self.multipliers.push(multipliers.to_vec());
         Ok(())
@@ -108,8 +108,26 @@ impl<const N: usize> Trajectory<N> {
         self.violation.iter().cloned().fold(0.0, f64::max)
     }
 
-    /// Appends a sample.
-    pub fn push(&mut self, t: f64, q: SVector<f64, N>, p: SVector<f64, N>, energy: f64) {
+    /// Appends a sample of an unconstrained system; a trajectory that records multipliers takes
+    /// [`push_constrained`](Self::push_constrained) instead (an error here).
+    pub fn push(
+        &mut self,
+        t: f64,
+        q: SVector<f64, N>,
+        p: SVector<f64, N>,
+        energy: f64,
+    ) -> Result<(), DiracError> {
+        if !self.multiplier_names.is_empty() {
+            return Err(DiracError::Dimension(format!(
+                "the trajectory records {} multipliers: use push_constrained",
+                self.multiplier_names.len()
+            )));
+        }
+        self.append(t, q, p, energy);
+        Ok(())
+    }
+
+    fn append(&mut self, t: f64, q: SVector<f64, N>, p: SVector<f64, N>, energy: f64) {
         self.t.push(t);
         self.q.push(q);
         self.p.push(p);
