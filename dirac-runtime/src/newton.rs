@@ -294,15 +294,13 @@ impl Newton {
             }
             let update = self.update.amax();
             // The contraction of full steps, while the iteration is still converging.
-            if let (Some(previous), false) = (previous, within) {
-                if update > noise {
-                    contraction = contraction.max(update / previous);
-                    if contraction > options.max_contraction {
-                        return Err(NewtonFailure::NotContracting {
-                            contraction,
-                            iterations: iteration,
-                        });
-                    }
+            if let (Some(previous), false, true) = (previous, within, update > noise) {
+                contraction = contraction.max(update / previous);
+                if contraction > options.max_contraction {
+                    return Err(NewtonFailure::NotContracting {
+                        contraction,
+                        iterations: iteration,
+                    });
                 }
             }
             let mut length = 1.0;
