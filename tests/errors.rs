@@ -372,3 +372,25 @@ fn an_untrusted_step_leaves_the_whole_stepper_as_it_was() {
     assert_eq!(ra, rb);
     assert_eq!(same(&a), same(&b));
 }
+
+/// A hand-written model may name an invalid quadrature: `Stepper::from_system` refuses it with
+/// the quadrature's error (the macro checks its own at compile time).
+struct BadQuadrature;
+
+impl DiracSystem<1> for BadQuadrature {
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+        (v[0] * v[0] - q[0] * q[0]) * 0.5
+    }
+
+    fn quadrature(&self) -> Result<Quadrature, DiracError> {
+        Quadrature::galerkin(0, Rule::GaussLegendre(1))
+    }
+}
+
+#[test]
+fn an_invalid_quadrature_of_a_model_is_an_error() {
+    assert!(matches!(
+        Stepper::from_system(BadQuadrature, 0.1),
+        Err(DiracError::InvalidQuadrature(_))
+    ));
+}
