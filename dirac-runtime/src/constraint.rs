@@ -16,68 +16,11 @@
 //! (`E_{k+1} − E_k = −h R (Δq/h)²`) holds to round-off. Holonomic constraints
 //! `g(q_{k+1}) = 0` take their impulse `dg(q_k)ᵀ λ` on `p_k`'s equation (SHAKE).
 
-use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
-use num_dual::{Derivative, DualSVec64};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+pub use crate::constraint_point::ConstraintPoint;
+use crate::derivatives::{gradient, lift};
 use crate::system::DiracSystem;
-
-/// Where on a step the constraint one-forms are evaluated.
-///
-/// Measured on the knife edge (`tests/dirac.rs`): `Start` and `End` are first order, `Midpoint`
-/// second order. For the same scene `Start` loses energy and `End` gains it, while `Midpoint`
-/// keeps it bounded. Where the one-forms are constant (circuits, interconnections) all three
-/// coincide.
-///
-/// ```
-/// use dirac_runtime::ConstraintPoint;
-/// assert_eq!(ConstraintPoint::default(), ConstraintPoint::Midpoint);
-/// assert_eq!(ConstraintPoint::End.theta(), 1.0);
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum ConstraintPoint {
-    /// `q_c = q_k`: the seed's (+) scheme.
-    Start,
-    /// `q_c = (q_k + q_{k+1}) / 2`.
-    #[default]
-    Midpoint,
-    /// `q_c = q_{k+1}`: the (−) scheme.
-    End,
-}
-
-impl ConstraintPoint {
-    /// `θ` in `q_c = q_k + θ (q_{k+1} − q_k)`.
-    pub fn theta(self) -> f64 {
-        match self {
-            ConstraintPoint::Start => 0.0,
-            ConstraintPoint::Midpoint => 0.5,
-            ConstraintPoint::End => 1.0,
-        }
-    }
-
-    /// `σ`: the share of the constraint impulse on the equation of `p_k`; the rest goes to
-    /// `p_{k+1}`.
-    pub fn share(self) -> f64 {
-        match self {
-            ConstraintPoint::Midpoint => 0.5,
-            ConstraintPoint::Start | ConstraintPoint::End => 1.0,
-        }
-    }
-}
-
-type Dual<const N: usize> = DualSVec64<N>;
-
-/// `x` as first-order duals whose component `i` moves with `weight` along direction `i`:
-/// functions of it return their value and their derivative along `weight · δx`.
-pub(crate) fn lift<const N: usize>(x: &SVector<f64, N>, weight: f64) -> SVector<Dual<N>, N> {
-    SVector::from_fn(|i, _| {
-        let eps = SVector::<f64, N>::from_fn(|j, _| if i == j { weight } else { 0.0 });
-        Dual::<N>::new(x[i], Derivative::some(eps))
-    })
-}
-
-fn gradient<const N: usize>(x: &Dual<N>) -> SVector<f64, N> {
-    x.eps.unwrap_generic(Const::<N>, U1)
-}
 
 /// One-form `a` at `q`: the row `A_a(q)` and its derivative `∂A_a,i/∂q_j` (row `i`, column `j`).
 pub(crate) fn one_form<S: DiracSystem<N>, const N: usize>(

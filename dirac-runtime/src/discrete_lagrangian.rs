@@ -5,90 +5,16 @@
 //! `L_d = h Σ_i b_i L(q_i, v_i)`. Its derivative in the point `Q_j` is
 //! `h Σ_i b_i [ℓ_j(c_i) ∂_q L + (ℓ'_j(c_i)/h) ∂_v L]`, and its second derivatives follow by the
 //! chain rule from the Hessian of `L` at the nodes. Every derivative of `L` comes from one
-//! evaluation of the user's Lagrangian over [`HyperDualSVec64`]: seeding the two dual directions
-//! along `(α_x, β_x)` and `(α_y, β_y)` in `(q, v)` yields both gradients along those directions and
-//! the mixed second derivative in one pass.
+//! evaluation of the user's Lagrangian over [`num_dual::HyperDualSVec64`] (the `derivatives`
+//! module): seeding the two dual directions along `(α_x, β_x)` and `(α_y, β_y)` in `(q, v)` yields
+//! both gradients along those directions and the mixed second derivative in one pass.
 
-use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
-use num_dual::{Derivative, HyperDualSVec64};
+use nalgebra::{DMatrix, DVector, SVector};
 
+use crate::derivatives::{Seed, seeded};
 use crate::error::DiracError;
 use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
-
-/// A direction in `(q, v)`: moving the seeded variable by `δ` moves `q` by `position · δ` and `v`
-/// by `velocity · δ`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Seed {
-    pub position: f64,
-    pub velocity: f64,
-}
-
-impl Seed {
-    pub const POSITION: Seed = Seed {
-        position: 1.0,
-        velocity: 0.0,
-    };
-    pub const VELOCITY: Seed = Seed {
-        position: 0.0,
-        velocity: 1.0,
-    };
-    pub const NONE: Seed = Seed {
-        position: 0.0,
-        velocity: 0.0,
-    };
-}
-
-/// `L` with its gradients along two seeded directions and the mixed second derivative.
-pub(crate) struct Seeded<const N: usize> {
-    pub value: f64,
-    /// `∂L/∂x` along the first seed.
-    pub first: SVector<f64, N>,
-    /// `∂L/∂y` along the second seed.
-    pub second: SVector<f64, N>,
-    /// `∂²L/∂x∂y` (rows: first seed, columns: second seed).
-    pub mixed: SMatrix<f64, N, N>,
-}
-
-/// Evaluates `L(q, v)` over hyper-dual numbers seeded along `x` and `y`.
-pub(crate) fn seeded<S: DiracSystem<N>, const N: usize>(
-    system: &S,
-    q: &SVector<f64, N>,
-    v: &SVector<f64, N>,
-    x: Seed,
-    y: Seed,
-) -> Seeded<N> {
-    type H<const N: usize> = HyperDualSVec64<N, N>;
-    let lift = |value: &SVector<f64, N>, wx: f64, wy: f64| {
-        SVector::<H<N>, N>::from_fn(|c, _| {
-            let eps1 = if wx == 0.0 {
-                Derivative::none()
-            } else {
-                Derivative::some(SVector::<f64, N>::from_fn(
-                    |i, _| if i == c { wx } else { 0.0 },
-                ))
-            };
-            let eps2 = if wy == 0.0 {
-                Derivative::none()
-            } else {
-                Derivative::some(SMatrix::<f64, 1, N>::from_fn(
-                    |_, i| if i == c { wy } else { 0.0 },
-                ))
-            };
-            H::<N>::new(value[c], eps1, eps2, Derivative::none())
-        })
-    };
-    let l = system.lagrangian(
-        &lift(q, x.position, y.position),
-        &lift(v, x.velocity, y.velocity),
-    );
-    Seeded {
-        value: l.re,
-        first: l.eps1.unwrap_generic(Const::<N>, U1),
-        second: l.eps2.unwrap_generic(U1, Const::<N>).transpose(),
-        mixed: l.eps1eps2.unwrap_generic(Const::<N>, Const::<N>),
-    }
-}
 
 /// The discrete Lagrangian of `system` under `quadrature` with step `h`.
 ///

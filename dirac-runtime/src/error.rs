@@ -3,8 +3,6 @@
 
 use thiserror::Error;
 
-use crate::trajectory::Trajectory;
-
 /// What went wrong, with enough context to act on it.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum DiracError {
@@ -100,42 +98,4 @@ pub enum DiracError {
     /// Writing a trajectory failed.
     #[error("could not write the trajectory: {0}")]
     Io(String),
-}
-
-/// A run that stopped at a failing step: the trajectory up to the last good step, and why.
-///
-/// `?` converts it into its [`DiracError`] (dropping the trajectory); match on it to keep the
-/// steps made.
-///
-/// ```
-/// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
-/// use nalgebra::{SVector, vector};
-/// /// L = v²/2 − √(1 − q): the potential ends at q = 1.
-/// struct Edge;
-/// impl DiracSystem<1> for Edge {
-///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-///         v[0] * v[0] * 0.5 - (-q[0] + 1.0).sqrt()
-///     }
-/// }
-/// let mut stepper = Stepper::new(Edge, Quadrature::midpoint(), 0.1)?;
-/// stepper.start_from_velocity(vector![0.0], vector![1.0])?;
-/// let interrupted = stepper.run(100).unwrap_err();
-/// assert_eq!(interrupted.trajectory.len() as u64, stepper.steps() + 1);
-/// assert!(stepper.q()[0] < 1.0);
-/// # Ok::<(), dirac_runtime::DiracError>(())
-/// ```
-#[derive(Debug, Clone, PartialEq, Error)]
-#[error("the run stopped after {} samples: {error}", trajectory.len())]
-pub struct Interrupted<const N: usize> {
-    /// Every sample recorded before the failing step.
-    pub trajectory: Trajectory<N>,
-    /// Why the step failed.
-    #[source]
-    pub error: DiracError,
-}
-
-impl<const N: usize> From<Box<Interrupted<N>>> for DiracError {
-    fn from(interrupted: Box<Interrupted<N>>) -> Self {
-        interrupted.error
-    }
 }

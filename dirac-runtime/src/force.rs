@@ -4,7 +4,7 @@
 
 use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
 
-use crate::constraint::lift;
+use crate::derivatives::lift;
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::system::DiracSystem;
 

@@ -5,23 +5,11 @@
 use nalgebra::{DMatrix, DVector, SVector};
 
 use crate::constraint;
-use crate::discrete_lagrangian::{Seed, seeded};
+use crate::derivatives::{Seed, degenerate, seeded};
 use crate::system::DiracSystem;
 
 /// Relative tolerance on the initial constraint residuals.
 const TOLERANCE: f64 = 1e-9;
-
-/// Coordinates with no kinetic term at `(q, v)`: rows of `∂²L/∂v²` that vanish.
-pub(crate) fn degenerate<S: DiracSystem<N>, const N: usize>(
-    system: &S,
-    q: &SVector<f64, N>,
-    v: &SVector<f64, N>,
-) -> Vec<usize> {
-    let vv = seeded(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed;
-    (0..N)
-        .filter(|&i| vv.row(i).iter().all(|x| *x == 0.0))
-        .collect()
-}
 
 /// Checks `(q0, v0)` against the holonomic constraints `g(q0) = 0`, `dg(q0) v0 = 0`, the one-forms
 /// `A(q0) v0 = 0`, and the hidden constraints of the degenerate coordinates `D`: their

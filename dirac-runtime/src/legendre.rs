@@ -2,7 +2,7 @@
 
 use nalgebra::{DVector, SVector};
 
-use crate::discrete_lagrangian::{Seed, seeded};
+use crate::derivatives::{Seed, degenerate, seeded};
 use crate::newton::{Newton, NewtonFailure};
 use crate::system::DiracSystem;
 
@@ -61,7 +61,7 @@ pub(crate) fn velocity<S: DiracSystem<N>, const N: usize>(
     p: &SVector<f64, N>,
     guess: &SVector<f64, N>,
 ) -> Result<SVector<f64, N>, NewtonFailure> {
-    let dead = crate::initial_state::degenerate(system, q, guess);
+    let dead = degenerate(system, q, guess);
     let mut x = DVector::from_column_slice(guess.as_slice());
     newton.solve(&mut x, |x, r, j| {
         let v = SVector::<f64, N>::from_column_slice(x.as_slice());

@@ -4,10 +4,13 @@
 //! The path from a model to a step is visible in the modules: [`system`] (the continuous
 //! Lagrangian, one-forms, forces) → [`quadrature`] → [`discrete_lagrangian`] (slot derivatives),
 //! `force` (discrete Lagrange–d'Alembert forces) and [`constraint`] (multiplier rows) →
-//! [`newton`] → [`stepper`] → [`trajectory`].
+//! [`newton`] → [`stepper`] → [`trajectory`]. Every derivative of the model's functions is taken
+//! by dual numbers in one private module, `derivatives`.
 #![warn(missing_docs)]
 
 pub mod constraint;
+mod constraint_point;
+mod derivatives;
 pub mod discrete_lagrangian;
 pub mod error;
 mod force;
@@ -23,14 +26,14 @@ pub mod trajectory;
 
 pub use constraint::ConstraintPoint;
 pub use discrete_lagrangian::DiscreteLagrangian;
-pub use error::{DiracError, Interrupted};
+pub use error::DiracError;
 pub use lu::SingularPivot;
 pub use newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 pub use quadrature::{Quadrature, Rule};
 pub use scalar::Scalar;
 pub use stepper::Stepper;
 pub use system::DiracSystem;
-pub use trajectory::Trajectory;
+pub use trajectory::{Interrupted, Trajectory};
 
 pub use nalgebra;
 pub use num_dual;

@@ -11,13 +11,13 @@ use nalgebra::{DVector, SVector};
 
 use crate::constraint::{self, ConstraintPoint, StepConstraints};
 use crate::discrete_lagrangian::DiscreteLagrangian;
-use crate::error::{DiracError, Interrupted};
+use crate::error::DiracError;
 use crate::initial_state;
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
-use crate::trajectory::Trajectory;
+use crate::trajectory::{Interrupted, Trajectory};
 
 const EULER_LAGRANGE: &str = "the discrete Euler–Lagrange equations";
 const LEGENDRE: &str = "the Legendre transform (velocity from momentum)";

@@ -2,7 +2,7 @@
 
 use nalgebra::SVector;
 
-use crate::constraint::ConstraintPoint;
+use crate::constraint_point::ConstraintPoint;
 use crate::error::DiracError;
 use crate::quadrature::Quadrature;
 use crate::scalar::Scalar;

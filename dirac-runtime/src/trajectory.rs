@@ -5,6 +5,8 @@ use std::path::Path;
 
 use nalgebra::SVector;
 
+use thiserror::Error;
+
 use crate::error::DiracError;
 
 /// A sampled trajectory `(t, q, p, E)` of a system with `N` coordinates.
@@ -224,5 +226,43 @@ impl<const N: usize> Trajectory<N> {
         self.write_csv(std::io::BufWriter::new(
             std::fs::File::create(path).map_err(io)?,
         ))
+    }
+}
+
+/// A run that stopped at a failing step: the trajectory up to the last good step, and why.
+///
+/// `?` converts it into its [`DiracError`] (dropping the trajectory); match on it to keep the
+/// steps made.
+///
+/// ```
+/// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+/// use nalgebra::{SVector, vector};
+/// /// L = v²/2 − √(1 − q): the potential ends at q = 1.
+/// struct Edge;
+/// impl DiracSystem<1> for Edge {
+///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+///         v[0] * v[0] * 0.5 - (-q[0] + 1.0).sqrt()
+///     }
+/// }
+/// let mut stepper = Stepper::new(Edge, Quadrature::midpoint(), 0.1)?;
+/// stepper.start_from_velocity(vector![0.0], vector![1.0])?;
+/// let interrupted = stepper.run(100).unwrap_err();
+/// assert_eq!(interrupted.trajectory.len() as u64, stepper.steps() + 1);
+/// assert!(stepper.q()[0] < 1.0);
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("the run stopped after {} samples: {error}", trajectory.len())]
+pub struct Interrupted<const N: usize> {
+    /// Every sample recorded before the failing step.
+    pub trajectory: Trajectory<N>,
+    /// Why the step failed.
+    #[source]
+    pub error: DiracError,
+}
+
+impl<const N: usize> From<Box<Interrupted<N>>> for DiracError {
+    fn from(interrupted: Box<Interrupted<N>>) -> Self {
+        interrupted.error
     }
 }

@@ -1,0 +1,110 @@
+//! Derivatives of the model's functions by dual numbers, in one place: the Lagrangian's
+//! gradients and second derivatives along seeded directions in `(q, v)` (hyper-dual numbers),
+//! first derivatives of position functions (one-forms, holonomic constraints, forces) by
+//! first-order duals, and the coordinates without kinetic energy that the mass matrix reveals.
+
+use nalgebra::{Const, SMatrix, SVector, U1};
+use num_dual::{Derivative, DualSVec64, HyperDualSVec64};
+
+use crate::system::DiracSystem;
+
+/// A direction in `(q, v)`: moving the seeded variable by `δ` moves `q` by `position · δ` and `v`
+/// by `velocity · δ`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Seed {
+    pub position: f64,
+    pub velocity: f64,
+}
+
+impl Seed {
+    pub const POSITION: Seed = Seed {
+        position: 1.0,
+        velocity: 0.0,
+    };
+    pub const VELOCITY: Seed = Seed {
+        position: 0.0,
+        velocity: 1.0,
+    };
+    pub const NONE: Seed = Seed {
+        position: 0.0,
+        velocity: 0.0,
+    };
+}
+
+/// `L` with its gradients along two seeded directions and the mixed second derivative.
+pub(crate) struct Seeded<const N: usize> {
+    pub value: f64,
+    /// `∂L/∂x` along the first seed.
+    pub first: SVector<f64, N>,
+    /// `∂L/∂y` along the second seed.
+    pub second: SVector<f64, N>,
+    /// `∂²L/∂x∂y` (rows: first seed, columns: second seed).
+    pub mixed: SMatrix<f64, N, N>,
+}
+
+/// Evaluates `L(q, v)` over hyper-dual numbers seeded along `x` and `y`.
+pub(crate) fn seeded<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+    x: Seed,
+    y: Seed,
+) -> Seeded<N> {
+    type H<const N: usize> = HyperDualSVec64<N, N>;
+    let lift = |value: &SVector<f64, N>, wx: f64, wy: f64| {
+        SVector::<H<N>, N>::from_fn(|c, _| {
+            let eps1 = if wx == 0.0 {
+                Derivative::none()
+            } else {
+                Derivative::some(SVector::<f64, N>::from_fn(
+                    |i, _| if i == c { wx } else { 0.0 },
+                ))
+            };
+            let eps2 = if wy == 0.0 {
+                Derivative::none()
+            } else {
+                Derivative::some(SMatrix::<f64, 1, N>::from_fn(
+                    |_, i| if i == c { wy } else { 0.0 },
+                ))
+            };
+            H::<N>::new(value[c], eps1, eps2, Derivative::none())
+        })
+    };
+    let l = system.lagrangian(
+        &lift(q, x.position, y.position),
+        &lift(v, x.velocity, y.velocity),
+    );
+    Seeded {
+        value: l.re,
+        first: l.eps1.unwrap_generic(Const::<N>, U1),
+        second: l.eps2.unwrap_generic(U1, Const::<N>).transpose(),
+        mixed: l.eps1eps2.unwrap_generic(Const::<N>, Const::<N>),
+    }
+}
+
+type Dual<const N: usize> = DualSVec64<N>;
+
+/// `x` as first-order duals whose component `i` moves with `weight` along direction `i`:
+/// functions of it return their value and their derivative along `weight · δx`.
+pub(crate) fn lift<const N: usize>(x: &SVector<f64, N>, weight: f64) -> SVector<Dual<N>, N> {
+    SVector::from_fn(|i, _| {
+        let eps = SVector::<f64, N>::from_fn(|j, _| if i == j { weight } else { 0.0 });
+        Dual::<N>::new(x[i], Derivative::some(eps))
+    })
+}
+
+pub(crate) fn gradient<const N: usize>(x: &Dual<N>) -> SVector<f64, N> {
+    x.eps.unwrap_generic(Const::<N>, U1)
+}
+
+/// Coordinates with no kinetic term at `(q, v)`: rows of `∂²L/∂v²` that vanish.
+pub(crate) fn degenerate<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+) -> Vec<usize> {
+    let vv = seeded(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed;
+    (0..N)
+        .filter(|&i| vv.row(i).iter().all(|x| *x == 0.0))
+        .collect()
+}
