@@ -235,6 +235,39 @@ impl Newton {
         })
     }
 
+    /// Armijo backtracking along the update: halves the step from `x` until the residual is
+    /// finite and its norm decreases sufficiently (or is within tolerance, where round-off admits
+    /// no decrease). Leaves the accepted point in `trial`; `None` when the step became negligible.
+    fn backtrack<F>(
+        &mut self,
+        x: &DVector<f64>,
+        at_x: Evaluation,
+        evaluate: &mut F,
+    ) -> Result<Option<(Evaluation, f64)>, NewtonFailure>
+    where
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, &mut DMatrix<f64>) -> f64,
+    {
+        let mut length = 1.0;
+        while length >= 1e-10 {
+            self.trial.copy_from(x);
+            self.trial.axpy(-length, &self.update, 1.0);
+            let trial = std::mem::take(&mut self.trial);
+            let at_trial = self.evaluate(&trial, evaluate);
+            self.trial = trial;
+            match at_trial {
+                Ok(e)
+                    if e.residual <= (1.0 - 1e-4 * length) * at_x.residual
+                        || e.residual <= e.tolerance =>
+                {
+                    return Ok(Some((e, length)));
+                }
+                Ok(_) | Err(NewtonFailure::NonFinite) => length *= 0.5,
+                Err(failure) => return Err(failure),
+            }
+        }
+        Ok(None)
+    }
+
     /// Solves `F(x) = 0` from the initial guess in `x`; `x` holds the solution on success and an
     /// unspecified iterate on failure.
     ///
@@ -303,38 +336,22 @@ impl Newton {
                     });
                 }
             }
-            let mut length = 1.0;
-            at_x = loop {
-                self.trial.copy_from(x);
-                self.trial.axpy(-length, &self.update, 1.0);
-                let trial = std::mem::take(&mut self.trial);
-                let at_trial = self.evaluate(&trial, &mut evaluate);
-                self.trial = trial;
-                match at_trial {
-                    Err(NewtonFailure::NonFinite) if options.line_search && length >= 1e-10 => {
-                        length *= 0.5
-                    }
-                    Err(failure) => return Err(failure),
-                    Ok(e) if !options.line_search => break e,
-                    // Armijo: accept a sufficient decrease of the residual's norm, or a
-                    // residual already within tolerance (round-off admits no decrease there).
-                    Ok(e)
-                        if e.residual <= (1.0 - 1e-4 * length) * at_x.residual
-                            || e.residual <= e.tolerance =>
-                    {
-                        break e;
-                    }
-                    Ok(_) if length < 1e-10 => {
-                        return Err(NewtonFailure::NoConvergence {
-                            residual: at_x.residual,
-                            update,
-                            iterations: iteration,
-                        });
-                    }
-                    Ok(_) => length *= 0.5,
-                }
+            let length = if options.line_search {
+                let Some((at_trial, length)) = self.backtrack(x, at_x, &mut evaluate)? else {
+                    return Err(NewtonFailure::NoConvergence {
+                        residual: at_x.residual,
+                        update,
+                        iterations: iteration,
+                    });
+                };
+                at_x = at_trial;
+                x.copy_from(&self.trial);
+                length
+            } else {
+                x.axpy(-1.0, &self.update, 1.0);
+                at_x = self.evaluate(x, &mut evaluate)?;
+                1.0
             };
-            x.copy_from(&self.trial);
             previous = (length == 1.0).then_some(update);
         }
         Err(NewtonFailure::NoConvergence {

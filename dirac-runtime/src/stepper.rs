@@ -363,8 +363,8 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         if !lagrangian.is_finite() {
             return Err(DiracError::NonFinite {
                 what: format!(
-                    "the Lagrangian at the end of step {} (the step leaves its domain or overflows; try a \
-                     smaller step)",
+                    "the Lagrangian at the end of step {} (the step leaves its domain or \
+                     overflows; try a smaller step)",
                     self.steps
                 ),
                 value: lagrangian,
