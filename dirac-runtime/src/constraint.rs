@@ -1,11 +1,13 @@
 //! Constraints on a step: one-forms `A(q) v = 0` evaluated at a chosen point of the step, and
 //! holonomic constraints `g(q) = 0` imposed exactly at `q_{k+1}`.
 //!
-//! With `q_c = q_k + θ (q_{k+1} − q_k)` the one-forms' discrete constraint is
-//! `A(q_c)(q_{k+1} − q_k) = 0` and the constraint impulse is `A(q_c)ᵀ μ`:
+//! In the chart centred at `q_k` (on `Rⁿ`: `ξ = q − q_k`) the one-forms read
+//! `Ã(ξ) = (T_ξ R_{q_k})ᵀ A(R_{q_k}(ξ))`. With the constraint point `ξ_c = θ ξ_s` (on `Rⁿ`,
+//! `q_c = q_k + θ (q_{k+1} − q_k)`) the discrete constraint is `Ã(ξ_c) ξ_s = 0` and the
+//! constraint impulse is `Ã(ξ_c)ᵀ μ`:
 //!
 //! ```text
-//! p_k + D1 L_d + f⁻ + σ A(q_c)ᵀ μ = 0,     p_{k+1} = D2 L_d + f⁺ − (1 − σ) A(q_c)ᵀ μ … (sign of μ free)
+//! p_k + D1 L_d + f⁻ + σ Ãᵀ μ = 0,     p_{k+1} = D2 L_d + f⁺ + (1 − σ) Ãᵀ μ
 //! ```
 //!
 //! where `σ` is the share of the impulse on `p_k`'s equation. At the start and the end point
@@ -14,75 +16,104 @@
 //! (`f⁻ = f⁺ = (h/2) F`): the scheme is then symmetric, and for quadratic energies with constant
 //! one-forms (circuits) it conserves `E(q_k, p_k)` exactly, and its balance with resistors
 //! (`E_{k+1} − E_k = −h R (Δq/h)²`) holds to round-off. Holonomic constraints
-//! `g(q_{k+1}) = 0` take their impulse `dg(q_k)ᵀ λ` on `p_k`'s equation (SHAKE).
+//! `g(R_{q_k}(ξ_s)) = 0` take their impulse `d(g∘R_{q_k})(0)ᵀ λ` (on `Rⁿ`, `dg(q_k)ᵀ λ`) on
+//! `p_k`'s equation (SHAKE).
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
 pub use crate::constraint_point::ConstraintPoint;
 use crate::derivatives::{gradient, lift};
+use crate::euler_lagrange::Layout;
 use crate::system::DiracSystem;
 
-/// One-form `a` at `q`: the row `A_a(q)` and its derivative `∂A_a,i/∂q_j` (row `i`, column `j`).
-pub(crate) fn one_form<S: DiracSystem<N>, const N: usize>(
+/// One-form `a` read in the chart centred at `base`, at `xi`: the row `Ã_a(ξ)` and its
+/// derivative `∂Ã_a,i/∂ξ_j` (row `i`, column `j`).
+pub(crate) fn one_form_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
     system: &S,
-    q: &SVector<f64, N>,
+    space: &C,
+    base: &SVector<f64, N>,
+    xi: &SVector<f64, N>,
     a: usize,
 ) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
-    let row = system.one_form(&lift(q, 1.0), a);
+    let xi = lift(xi, 1.0);
+    let row = space.pull_back(base, &xi, &system.one_form(&space.retract(base, &xi), a));
     let value = row.map(|x| x.re);
     let derivative = SMatrix::<f64, N, N>::from_fn(|i, j| gradient(&row[i])[j]);
     (value, derivative)
 }
 
-/// Holonomic constraint `b` at `q`: `g_b(q)` and its one-form `dg_b(q)`.
+/// Holonomic constraint `b` read in the chart centred at `base`, at `xi`: `g_b(R(ξ))` and its
+/// gradient in `ξ`.
+pub(crate) fn holonomic_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
+    system: &S,
+    space: &C,
+    base: &SVector<f64, N>,
+    xi: &SVector<f64, N>,
+    b: usize,
+) -> (f64, SVector<f64, N>) {
+    let g = system.holonomic(&space.retract(base, &lift(xi, 1.0)), b);
+    (g.re, gradient(&g))
+}
+
+/// One-form `a` at `q` in the model's coordinates: `A_a(q)` and `∂A_a,i/∂q_j`.
+pub(crate) fn one_form<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    a: usize,
+) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
+    one_form_in_chart(system, &Euclidean, q, &SVector::zeros(), a)
+}
+
+/// Holonomic constraint `b` at `q` in the model's coordinates: `g_b(q)` and `dg_b(q)`.
 pub(crate) fn holonomic<S: DiracSystem<N>, const N: usize>(
     system: &S,
     q: &SVector<f64, N>,
     b: usize,
 ) -> (f64, SVector<f64, N>) {
-    let g = system.holonomic(&lift(q, 1.0), b);
-    (g.re, gradient(&g))
+    holonomic_in_chart(system, &Euclidean, q, &SVector::zeros(), b)
 }
 
-/// What the constraint rows of one step need besides the unknowns: the system, where the
-/// one-forms are evaluated, the start `q_k`, and `dg_b(q_k)` (constant over the step, see
+/// What the constraint rows of one step need besides the unknowns: the system and its space,
+/// where the one-forms are evaluated, the start `q_k`, the layout of the unknowns, and the
+/// holonomic impulse directions `d(g_b∘R_{q_k})(0)` (constant over the step, see
 /// [`holonomic_forms`]).
-pub(crate) struct StepConstraints<'a, S, const N: usize> {
+pub(crate) struct StepConstraints<'a, S, C, const N: usize> {
     pub system: &'a S,
+    pub space: &'a C,
     pub point: ConstraintPoint,
     pub base: &'a SVector<f64, N>,
+    pub layout: &'a Layout,
     pub holonomic_forms: &'a [SVector<f64, N>],
 }
 
-impl<S: DiracSystem<N>, const N: usize> StepConstraints<'_, S, N> {
-    /// The constraint rows, appended after the `N s` Euler–Lagrange rows.
-    ///
-    /// `x` holds the unknowns `[Z_1..Z_s, μ (one-forms), λ (holonomic)]`. Adds the constraint
-    /// forces to rows `0..N`, writes the constraint residuals, fills the matching Jacobian entries,
-    /// and returns the total constraint impulse `A(q_c)ᵀ μ + dg(q_k)ᵀ λ` (what they add to
-    /// `p_{k+1} − p_k`) with the size of the terms of the constraint rows.
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraints<'_, S, C, N> {
+    /// Adds the constraint forces to the rows of `p_k`'s equation, writes the constraint rows,
+    /// fills the matching Jacobian entries, and returns the constraint impulses (total, and the
+    /// share on the end point) with the size of the terms of the constraint rows.
     pub(crate) fn add(
         &self,
         x: &DVector<f64>,
-        euler_lagrange_rows: usize,
         residual: &mut DVector<f64>,
         jacobian: &mut DMatrix<f64>,
-    ) -> (SVector<f64, N>, f64) {
+    ) -> (StepCovectors<N>, f64) {
         let Self {
             system,
+            space,
             point,
             base,
+            layout,
             holonomic_forms,
         } = *self;
-        let step_col = euler_lagrange_rows - N;
+        let step_col = layout.end_point();
         let step = x.fixed_rows::<N>(step_col).into_owned();
         let (theta, share) = (point.theta(), point.share());
         let mut impulse = SVector::<f64, N>::zeros();
         let mut scale = 0.0_f64;
-        let q_c = base + step * theta;
+        let xi_c = step * theta;
         for a in 0..S::ONE_FORMS {
-            let (row, derivative) = one_form(system, &q_c, a);
-            let col = euler_lagrange_rows + a;
+            let (row, derivative) = one_form_in_chart(system, space, base, &xi_c, a);
+            let col = layout.one_form(a);
             let mu = x[col];
             impulse += row * mu;
             for i in 0..N {
@@ -92,7 +123,7 @@ impl<S: DiracSystem<N>, const N: usize> StepConstraints<'_, S, N> {
                     jacobian[(i, step_col + j)] += share * theta * mu * derivative[(i, j)];
                 }
             }
-            // A_a(q_c) · Z_s and its derivative in Z_s (q_c moves with Z_s by θ).
+            // Ã_a(ξ_c) · ξ_s and its derivative in ξ_s (ξ_c moves with ξ_s by θ).
             residual[col] = row.dot(&step);
             scale = scale.max(row.abs().dot(&step.abs()));
             let through_point = derivative.transpose() * step * theta;
@@ -100,47 +131,55 @@ impl<S: DiracSystem<N>, const N: usize> StepConstraints<'_, S, N> {
                 jacobian[(col, step_col + j)] = row[j] + through_point[j];
             }
         }
-        let end = base + step;
+        let end = impulse * (1.0 - share);
         for (b, force_form) in holonomic_forms.iter().enumerate() {
-            let col = euler_lagrange_rows + S::ONE_FORMS + b;
+            let col = layout.holonomic(b);
             let lambda = x[col];
             impulse += force_form * lambda;
             for i in 0..N {
                 residual[i] += lambda * force_form[i];
                 jacobian[(i, col)] += force_form[i];
             }
-            let (g, form) = holonomic(system, &end, b);
+            let (g, form) = holonomic_in_chart(system, space, base, &step, b);
             residual[col] = g;
-            scale = scale.max(form.abs().dot(&end.abs()).max(g.abs()));
+            let end_point = space.retract(base, &step);
+            scale = scale.max(form.abs().dot(&end_point.abs()).max(g.abs()));
             for j in 0..N {
                 jacobian[(col, step_col + j)] = form[j];
             }
         }
-        (impulse, scale)
+        (StepCovectors { impulse, end }, scale)
     }
 }
 
-/// Fills `forms[b] = dg_b(q)`: the directions of the holonomic constraint forces of a step from `q`.
-pub(crate) fn holonomic_forms<S: DiracSystem<N>, const N: usize>(
+/// Fills `forms[b] = d(g_b∘R_q)(0)`: the directions of the holonomic constraint impulses of a
+/// step from `q`, in the chart at `q`.
+pub(crate) fn holonomic_forms<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
     system: &S,
+    space: &C,
     q: &SVector<f64, N>,
     forms: &mut [SVector<f64, N>],
 ) {
     for (b, form) in forms.iter_mut().enumerate() {
-        *form = holonomic(system, q, b).1;
+        *form = holonomic_in_chart(system, space, q, &SVector::zeros(), b).1;
     }
 }
 
-/// The largest constraint violation of a step from `q0` to `q1`: `|A(q_c)(q1 − q0)|` over the
-/// one-forms and `|g(q1)|` over the holonomic constraints.
-pub(crate) fn violation<S: DiracSystem<N>, const N: usize>(
+/// The largest constraint violation of a step `ξ` from `q0` to `q1`: `|Ã(ξ_c) ξ|` over the
+/// one-forms (on `Rⁿ`, `|A(q_c)(q1 − q0)|`) and `|g(q1)|` over the holonomic constraints.
+pub(crate) fn violation<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
     system: &S,
+    space: &C,
     point: ConstraintPoint,
     q0: &SVector<f64, N>,
+    xi: &SVector<f64, N>,
     q1: &SVector<f64, N>,
 ) -> f64 {
-    let q_c = q0 + (q1 - q0) * point.theta();
-    let forms = (0..S::ONE_FORMS).map(|a| system.one_form(&q_c, a).dot(&(q1 - q0)).abs());
+    let xi_c = xi * point.theta();
+    let forms = (0..S::ONE_FORMS).map(|a| {
+        let row = space.pull_back(q0, &xi_c, &system.one_form(&space.retract(q0, &xi_c), a));
+        row.dot(xi).abs()
+    });
     let holonomic = (0..S::HOLONOMIC).map(|b| system.holonomic(q1, b).abs());
     forms.chain(holonomic).fold(0.0, f64::max)
 }

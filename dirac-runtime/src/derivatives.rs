@@ -2,11 +2,46 @@
 //! gradients and second derivatives along seeded directions in `(q, v)` (hyper-dual numbers),
 //! first derivatives of position functions (one-forms, holonomic constraints, forces) by
 //! first-order duals, and the coordinates without kinetic energy that the mass matrix reveals.
+//!
+//! The Lagrangian is differentiated either in the model's coordinates or read in a chart of the
+//! configuration space ([`InChart`]), through the same [`PhaseFunction`].
 
 use nalgebra::{Const, SMatrix, SVector, U1};
 use num_dual::{Derivative, DualSVec64, HyperDualSVec64};
 
+use crate::configuration_space::ConfigurationSpace;
+use crate::scalar::Scalar;
 use crate::system::DiracSystem;
+
+/// A function of `(q, v)` over any scalar: the model's Lagrangian, or the Lagrangian in a chart.
+pub(crate) trait PhaseFunction<const N: usize> {
+    fn value<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D;
+}
+
+impl<S: DiracSystem<N>, const N: usize> PhaseFunction<N> for S {
+    #[inline]
+    fn value<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D {
+        self.lagrangian(q, v)
+    }
+}
+
+/// The model's Lagrangian read in the chart centred at `base`: `ℓ(ξ, ξ̇) = L(R(ξ), TR(ξ) ξ̇)`.
+pub(crate) struct InChart<'a, S, C, const N: usize> {
+    pub system: &'a S,
+    pub space: &'a C,
+    pub base: &'a SVector<f64, N>,
+}
+
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> PhaseFunction<N>
+    for InChart<'_, S, C, N>
+{
+    #[inline]
+    fn value<D: Scalar>(&self, xi: &SVector<D, N>, xi_dot: &SVector<D, N>) -> D {
+        let q = self.space.retract(self.base, xi);
+        let v = self.space.push_forward(self.base, xi, xi_dot);
+        self.system.lagrangian(&q, &v)
+    }
+}
 
 /// A direction in `(q, v)`: moving the seeded variable by `δ` moves `q` by `position · δ` and `v`
 /// by `velocity · δ`.
@@ -43,8 +78,8 @@ pub(crate) struct Seeded<const N: usize> {
 }
 
 /// Evaluates `L(q, v)` over hyper-dual numbers seeded along `x` and `y`.
-pub(crate) fn seeded<S: DiracSystem<N>, const N: usize>(
-    system: &S,
+pub(crate) fn seeded<F: PhaseFunction<N>, const N: usize>(
+    lagrangian: &F,
     q: &SVector<f64, N>,
     v: &SVector<f64, N>,
     x: Seed,
@@ -70,7 +105,7 @@ pub(crate) fn seeded<S: DiracSystem<N>, const N: usize>(
             H::<N>::new(value[c], eps1, eps2, Derivative::none())
         })
     };
-    let l = system.lagrangian(
+    let l = lagrangian.value(
         &lift(q, x.position, y.position),
         &lift(v, x.velocity, y.velocity),
     );

@@ -1,22 +1,28 @@
 //! The discrete Lagrangian `L_d(Q_0, …, Q_s)` of a system under a quadrature, and its slot
 //! derivatives and second derivatives by hyper-dual numbers.
 //!
-//! With node positions `q_i = Σ_j ℓ_j(c_i) Q_j` and velocities `v_i = (1/h) Σ_j ℓ'_j(c_i) Q_j`,
-//! `L_d = h Σ_i b_i L(q_i, v_i)`. Its derivative in the point `Q_j` is
-//! `h Σ_i b_i [ℓ_j(c_i) ∂_q L + (ℓ'_j(c_i)/h) ∂_v L]`, and its second derivatives follow by the
-//! chain rule from the Hessian of `L` at the nodes. Every derivative of `L` comes from one
-//! evaluation of the user's Lagrangian over [`num_dual::HyperDualSVec64`] (the `derivatives`
-//! module): seeding the two dual directions along `(α_x, β_x)` and `(α_y, β_y)` in `(q, v)` yields
-//! both gradients along those directions and the mixed second derivative in one pass.
+//! A step from `q_k` works in the chart centred at `q_k` (see
+//! [`configuration_space`](crate::configuration_space)): the points are `Q_j = R_{q_k}(ξ_j)`
+//! with `ξ_0 = 0`. With chart nodes `ξ(c_i) = Σ_j ℓ_j(c_i) ξ_j` and chart velocities
+//! `ξ̇(c_i) = (1/h) Σ_j ℓ'_j(c_i) ξ_j`, `L_d = h Σ_i b_i ℓ(ξ(c_i), ξ̇(c_i))` where
+//! `ℓ(ξ, ξ̇) = L(R_{q_k}(ξ), T_ξR_{q_k} ξ̇)`. Its derivative in the point `ξ_j` is
+//! `h Σ_i b_i [ℓ_j(c_i) ∂_ξ ℓ + (ℓ'_j(c_i)/h) ∂_ξ̇ ℓ]`, and its second derivatives follow by the
+//! chain rule from the Hessian of `ℓ` at the nodes. On `Rⁿ`, `ℓ = L` at `q_k + ξ`. Every
+//! derivative comes from one evaluation of the user's Lagrangian over
+//! [`num_dual::HyperDualSVec64`] (the `derivatives` module): seeding the two dual directions
+//! along `(α_x, β_x)` and `(α_y, β_y)` in `(ξ, ξ̇)` yields both gradients along those directions
+//! and the mixed second derivative in one pass.
 
 use nalgebra::{DMatrix, DVector, SVector};
 
-use crate::derivatives::{Seed, seeded};
+use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
+use crate::derivatives::{InChart, PhaseFunction, Seed, seeded};
 use crate::error::DiracError;
 use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
 
-/// The discrete Lagrangian of `system` under `quadrature` with step `h`.
+/// The discrete Lagrangian of `system` under `quadrature` with step `h`, on the configuration
+/// space `C` (`Rⁿ` unless given).
 ///
 /// ```
 /// use dirac_runtime::{DiracSystem, DiscreteLagrangian, Quadrature, Scalar};
@@ -34,17 +40,26 @@ use crate::system::DiracSystem;
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
 #[derive(Debug, Clone)]
-pub struct DiscreteLagrangian<S, const N: usize> {
+pub struct DiscreteLagrangian<S, const N: usize, C = Euclidean> {
     system: S,
+    space: C,
     quadrature: Quadrature,
     h: f64,
 }
 
 impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
-    /// `L_d` for step `h`.
+    /// `L_d` for step `h` on `Rⁿ`.
     pub fn new(system: S, quadrature: Quadrature, h: f64) -> Self {
+        Self::on_space(system, Euclidean, quadrature, h)
+    }
+}
+
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagrangian<S, N, C> {
+    /// `L_d` for step `h`, with the step's points `R_{q_k}(ξ_j)` in `space`.
+    pub fn on_space(system: S, space: C, quadrature: Quadrature, h: f64) -> Self {
         Self {
             system,
+            space,
             quadrature,
             h,
         }
@@ -53,6 +68,11 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
     /// The continuous system.
     pub fn system(&self) -> &S {
         &self.system
+    }
+
+    /// The configuration space.
+    pub fn space(&self) -> &C {
+        &self.space
     }
 
     /// The quadrature.
@@ -65,25 +85,34 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
         self.h
     }
 
-    /// Position and velocity at node `i` of the path from `base = Q_0` with increments
-    /// `Z_j = Q_j − Q_0` (`j = 1..=s`). The velocity is summed from the increments, not from the
-    /// points, so it carries no cancellation of the large `Q_0` terms.
+    /// The Lagrangian read in the chart centred at `base`.
+    pub(crate) fn in_chart<'a>(&'a self, base: &'a SVector<f64, N>) -> InChart<'a, S, C, N> {
+        InChart {
+            system: &self.system,
+            space: &self.space,
+            base,
+        }
+    }
+
+    /// Chart position and velocity at node `i` of the path with points `ξ_j` (`j = 1..=s`,
+    /// `ξ_0 = 0`). The velocity is summed from the chart increments, so it carries no
+    /// cancellation of the large `q_k` terms.
     pub(crate) fn node(
         &self,
         i: usize,
-        base: &SVector<f64, N>,
         increments: &[SVector<f64, N>],
     ) -> (SVector<f64, N>, SVector<f64, N>) {
-        let mut dq = SVector::zeros();
+        let mut xi = SVector::zeros();
         let mut v = SVector::zeros();
         for (j, z) in increments.iter().enumerate() {
-            dq += z * self.quadrature.ell(i, j + 1);
+            xi += z * self.quadrature.ell(i, j + 1);
             v += z * (self.quadrature.ell_prime(i, j + 1) / self.h);
         }
-        (base + dq, v)
+        (xi, v)
     }
 
-    /// `L_d(Q_0, …, Q_s)`; `points` holds the `s + 1` points of the step (an error otherwise).
+    /// `L_d(Q_0, …, Q_s)`; `points` holds the `s + 1` points of the step (an error otherwise, or
+    /// when a point lies outside the chart centred at `Q_0`).
     pub fn value(&self, points: &[SVector<f64, N>]) -> Result<f64, DiracError> {
         if points.len() != self.quadrature.degree() + 1 {
             return Err(DiracError::Dimension(format!(
@@ -93,21 +122,29 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
                 points.len()
             )));
         }
-        let increments: Vec<_> = points[1..].iter().map(|q| q - points[0]).collect();
+        let increments = points[1..]
+            .iter()
+            .map(|q| self.space.local(&points[0], q))
+            .collect::<Option<Vec<_>>>()
+            .ok_or_else(|| {
+                DiracError::Dimension("a point of the step lies outside the chart at Q_0".into())
+            })?;
+        let chart = self.in_chart(&points[0]);
         Ok((0..self.quadrature.nodes().len())
             .map(|i| {
-                let (q, v) = self.node(i, &points[0], &increments);
-                self.h * self.quadrature.weights()[i] * self.system.lagrangian(&q, &v)
+                let (xi, xi_dot) = self.node(i, &increments);
+                self.h * self.quadrature.weights()[i] * chart.value(&xi, &xi_dot)
             })
             .sum())
     }
 
-    /// The discrete Euler–Lagrange system of one step and the new momentum.
+    /// The discrete Euler–Lagrange rows of one step.
     ///
-    /// The points are `Q_0 = base` and `Q_j = base + Z_j`; the unknowns are the increments
-    /// `Z_1, …, Z_s` (`Q_s = q_{k+1}`), blocks of `N`. Writes the residual
-    /// `[p_k + ∂L_d/∂Q_0; ∂L_d/∂Q_1; …; ∂L_d/∂Q_{s−1}]` and adds its Jacobian into `jacobian`
-    /// (which the caller zeroes).
+    /// The points are `Q_0 = base` and `Q_j = R_base(ξ_j)`; the unknowns are `ξ_1, …, ξ_s`
+    /// (`Q_s = q_{k+1}`), blocks of `N`. Writes the residual
+    /// `[π_k + ∂L_d/∂ξ_0; ∂L_d/∂ξ_1; …; ∂L_d/∂ξ_{s−1}]` (`π_k` the momentum in the chart) into
+    /// the first `N s` rows and adds its Jacobian into `jacobian` (which the caller zeroes).
+    /// Returns the slot covectors and the size of the terms summed into the residual.
     pub(crate) fn euler_lagrange(
         &self,
         base: &SVector<f64, N>,
@@ -115,25 +152,27 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
         momentum: &SVector<f64, N>,
         residual: &mut DVector<f64>,
         jacobian: &mut DMatrix<f64>,
-    ) -> StepEquations<N> {
+    ) -> (StepCovectors<N>, f64) {
         let s = self.quadrature.degree();
         let h = self.h;
         residual.fill(0.0);
         residual.rows_mut(0, N).copy_from(momentum);
         let mut impulse = SVector::zeros();
+        let mut end = SVector::zeros();
         let mut magnitude = momentum.abs();
         let quad = &self.quadrature;
+        let chart = self.in_chart(base);
         for (i, &b) in quad.weights().iter().enumerate() {
             let w = h * b;
-            let (q, v) = self.node(i, base, increments);
+            let (xi, xi_dot) = self.node(i, increments);
             let a = |j: usize| quad.ell(i, j);
             let d = |j: usize| quad.ell_prime(i, j) / h;
             if s == 1 {
-                // One pair of slots: seed the directions of Q_0 and Q_1 themselves.
+                // One pair of slots: seed the directions of ξ_0 and ξ_1 themselves.
                 let l = seeded(
-                    &self.system,
-                    &q,
-                    &v,
+                    &chart,
+                    &xi,
+                    &xi_dot,
                     Seed {
                         position: a(0),
                         velocity: d(0),
@@ -146,23 +185,22 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
                 let mut r = residual.rows_mut(0, N);
                 r += l.first * w;
                 impulse += (l.first + l.second) * w;
+                end += l.second * w;
                 magnitude += (l.first.abs() + l.second.abs()) * w;
                 let mut block = jacobian.fixed_view_mut::<N, N>(0, 0);
                 block += l.mixed * w;
             } else {
-                // Many pairs: the Hessian of L at the node, then the chain rule.
-                let qv = seeded(&self.system, &q, &v, Seed::POSITION, Seed::VELOCITY);
-                let qq = seeded(&self.system, &q, &v, Seed::POSITION, Seed::POSITION).mixed;
-                let vv = seeded(&self.system, &q, &v, Seed::VELOCITY, Seed::VELOCITY).mixed;
+                // Many pairs: the Hessian of ℓ at the node, then the chain rule.
+                let qv = seeded(&chart, &xi, &xi_dot, Seed::POSITION, Seed::VELOCITY);
+                let qq = seeded(&chart, &xi, &xi_dot, Seed::POSITION, Seed::POSITION).mixed;
+                let vv = seeded(&chart, &xi, &xi_dot, Seed::VELOCITY, Seed::VELOCITY).mixed;
                 let (lq, lv, qv) = (qv.first, qv.second, qv.mixed);
                 impulse += lq * w;
+                end += (lq * a(s) + lv * d(s)) * w;
                 magnitude += (lq.abs() + lv.abs() * s as f64 / h) * w;
                 for j in 0..s {
-                    let g = (lq * a(j) + lv * d(j)) * w;
-                    if j < s {
-                        let mut r = residual.rows_mut(j * N, N);
-                        r += g;
-                    }
+                    let mut r = residual.rows_mut(j * N, N);
+                    r += (lq * a(j) + lv * d(j)) * w;
                 }
                 for j in 0..s {
                     for k in 1..=s {
@@ -176,21 +214,8 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
                 }
             }
         }
-        StepEquations {
-            impulse,
-            scale: magnitude.amax(),
-        }
+        (StepCovectors { impulse, end }, magnitude.amax())
     }
-}
-
-/// What one evaluation of the step equations yields besides the residual and Jacobian.
-pub(crate) struct StepEquations<const N: usize> {
-    /// `Σ_j ∂L_d/∂Q_j = h Σ_i b_i ∂_q L(q_i, v_i)` (as `Σ_j ℓ_j = 1`, `Σ_j ℓ'_j = 0`): at the
-    /// solution this is `D_2 L_d − p_k = p_{k+1} − p_k`, the momentum change over the step,
-    /// obtained without the cancellation between `p_k` and `∂L_d/∂Q_0`.
-    pub impulse: SVector<f64, N>,
-    /// Size of the terms summed into the residual: its round-off floor is a few ulps of this.
-    pub scale: f64,
 }
 
 #[cfg(test)]
@@ -235,9 +260,9 @@ mod tests {
         let increments = |points: &[SVector<f64, 2>]| -> Vec<SVector<f64, 2>> {
             points[1..].iter().map(|q| q - points[0]).collect()
         };
-        let impulse = ld
-            .euler_lagrange(&points[0], &increments(&points), &p, &mut r, &mut jac)
-            .impulse;
+        let (covectors, _) =
+            ld.euler_lagrange(&points[0], &increments(&points), &p, &mut r, &mut jac);
+        let impulse = covectors.impulse;
         for c in 0..2 {
             assert!((r[c] - p[c] - fd(&ld, &points, 0, c)).abs() < 1e-8);
             for j in 1..s {
@@ -245,6 +270,7 @@ mod tests {
             }
             let total: f64 = (0..=s).map(|j| fd(&ld, &points, j, c)).sum();
             assert!((impulse[c] - total).abs() < 1e-8);
+            assert!((covectors.end[c] - fd(&ld, &points, s, c)).abs() < 1e-8);
         }
         // Jacobian columns against differences of the residual.
         let eps = 1e-6;

@@ -95,6 +95,9 @@ pub enum DiracError {
     /// A vector or a table index of the wrong size.
     #[error("{0}")]
     Dimension(String),
+    /// A step left the region where the configuration space's chart is defined or invertible.
+    #[error("{0}; nothing was changed (try a smaller step)")]
+    OutsideChart(String),
     /// Writing a trajectory failed.
     #[error("could not write the trajectory: {0}")]
     Io(String),

@@ -2,17 +2,21 @@
 //! derivatives by dual numbers, Newton's method, the stepper and trajectories.
 //!
 //! The path from a model to a step is visible in the modules: [`system`] (the continuous
-//! Lagrangian, one-forms, forces) → [`quadrature`] → [`discrete_lagrangian`] (slot derivatives),
-//! `force` (discrete Lagrange–d'Alembert forces) and [`constraint`] (multiplier rows) →
-//! [`newton`] → [`stepper`] → [`trajectory`]. Every derivative of the model's functions is taken
-//! by dual numbers in one private module, `derivatives`.
+//! Lagrangian, one-forms, forces) on a [`configuration_space`] (a retraction and its charts) →
+//! [`quadrature`] → [`discrete_lagrangian`] (slot derivatives in the chart), `force` (discrete
+//! Lagrange–d'Alembert forces) and [`constraint`] (multiplier rows) → [`euler_lagrange`] (the
+//! step's residual, unknowns and update, behind the [`step_equations`] seam) → [`newton`] →
+//! [`stepper`] → [`trajectory`]. Every derivative of the model's functions is taken by dual
+//! numbers in one private module, `derivatives`.
 #![warn(missing_docs)]
 
+pub mod configuration_space;
 pub mod constraint;
 mod constraint_point;
 mod derivatives;
 pub mod discrete_lagrangian;
 pub mod error;
+pub mod euler_lagrange;
 mod force;
 mod initial_state;
 pub mod legendre;
@@ -20,10 +24,12 @@ mod lu;
 pub mod newton;
 pub mod quadrature;
 pub mod scalar;
+pub mod step_equations;
 pub mod stepper;
 pub mod system;
 pub mod trajectory;
 
+pub use configuration_space::{ConfigurationSpace, Euclidean};
 pub use constraint::ConstraintPoint;
 pub use discrete_lagrangian::DiscreteLagrangian;
 pub use error::DiracError;
@@ -31,6 +37,7 @@ pub use lu::SingularPivot;
 pub use newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 pub use quadrature::{Quadrature, Rule};
 pub use scalar::Scalar;
+pub use step_equations::{State, StepEquations};
 pub use stepper::Stepper;
 pub use system::DiracSystem;
 pub use trajectory::{Interrupted, Trajectory};

@@ -1,68 +1,30 @@
-//! The stepper: solves the implicit discrete Euler–Lagrange equations in position–momentum form,
+//! The stepper: drives the [`StepEquations`] of a model with Newton's method on the exact
+//! Jacobian, one step at a time. For a Lagrangian model these are the discrete Euler–Lagrange
+//! equations in position–momentum form ([`EulerLagrange`]),
 //!
 //! ```text
 //! p_k + D_1 L_d(q_k, q_{k+1}) = 0          (solved for q_{k+1} and the internal points)
 //! p_{k+1} = D_2 L_d(q_k, q_{k+1})
 //! ```
 //!
-//! with Newton's method on the exact Jacobian. A failed step returns an error and changes nothing.
+//! A failed step returns an error and changes nothing.
+
+use std::marker::PhantomData;
 
 use nalgebra::{DVector, SVector};
 
-use crate::constraint::{self, ConstraintPoint, StepConstraints};
+use crate::configuration_space::{ConfigurationSpace, Euclidean};
+use crate::constraint::ConstraintPoint;
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
+use crate::euler_lagrange::{EulerLagrange, check_finite};
 use crate::initial_state;
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 use crate::quadrature::Quadrature;
+use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
 use crate::trajectory::{Interrupted, Trajectory};
-
-const EULER_LAGRANGE: &str = "the discrete Euler–Lagrange equations";
-const LEGENDRE: &str = "the Legendre transform (velocity from momentum)";
-
-/// The state of a stepper: time, position, momentum.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct State<const N: usize> {
-    t: f64,
-    q: SVector<f64, N>,
-    p: SVector<f64, N>,
-    /// A velocity near the one at `(q, p)`: the initial velocity, then the last step's mean
-    /// velocity. It seeds the first predictor and the Legendre inversion.
-    v_hint: SVector<f64, N>,
-    /// Round-off left out of `q` and `p` by the compensated (Kahan) updates.
-    q_carry: SVector<f64, N>,
-    p_carry: SVector<f64, N>,
-}
-
-impl<const N: usize> State<N> {
-    fn new(t: f64, q: SVector<f64, N>, p: SVector<f64, N>, v_hint: SVector<f64, N>) -> Self {
-        Self {
-            t,
-            q,
-            p,
-            v_hint,
-            q_carry: SVector::zeros(),
-            p_carry: SVector::zeros(),
-        }
-    }
-}
-
-/// `sum += increment` with Kahan compensation: over millions of steps the state then carries
-/// round-off from each increment, not from each sum.
-fn compensated_add<const N: usize>(
-    sum: &mut SVector<f64, N>,
-    carry: &mut SVector<f64, N>,
-    increment: &SVector<f64, N>,
-) {
-    for i in 0..sum.len() {
-        let y = increment[i] - carry[i];
-        let t = sum[i] + y;
-        carry[i] = (t - sum[i]) - y;
-        sum[i] = t;
-    }
-}
 
 /// A solved step, not yet current: the new state, how Newton went, the constraint violation.
 #[derive(Debug, Clone, Copy)]
@@ -72,12 +34,15 @@ struct Proposal<const N: usize> {
     violation: f64,
 }
 
-/// A variational integrator for one system, one quadrature and one step size.
+/// A variational integrator for one system, one quadrature and one step size: Newton's method on
+/// the model's [`StepEquations`] (`E`, the discrete Euler–Lagrange equations on `Rⁿ` unless
+/// chosen otherwise).
 ///
-/// Each step solves for the increments `Z_j = Q_j − q_k` of the `s` points of the step (the
-/// internal points and `q_{k+1}`) rather than the points themselves, so that velocities carry no
-/// cancellation; the momentum is advanced by the impulse `Σ_j ∂L_d/∂Q_j = h Σ_i b_i ∂_q L`, which
-/// equals `D_2 L_d` at the solution; both updates are compensated sums.
+/// Each step of a Lagrangian model solves for the chart coordinates `ξ_j` of the `s` points of
+/// the step (the internal points and `q_{k+1}`) in the chart centred at `q_k`; on `Rⁿ` these are
+/// the increments `Q_j − q_k`, so velocities carry no cancellation. On `Rⁿ` the momentum is
+/// advanced by the impulse `Σ_j ∂L_d/∂Q_j = h Σ_i b_i ∂_q L`, which equals `D_2 L_d` at the
+/// solution; both updates are compensated sums.
 ///
 /// ```
 /// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
@@ -98,37 +63,51 @@ struct Proposal<const N: usize> {
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
 #[derive(Debug, Clone)]
-pub struct Stepper<S, const N: usize> {
-    discrete: DiscreteLagrangian<S, N>,
+pub struct Stepper<S, const N: usize, E = EulerLagrange<S, N, Euclidean>> {
+    equations: E,
     newton: Newton,
     state: Option<State<N>>,
     /// Time of the initial state.
     start: f64,
     steps: u64,
-    /// Increments `Z_1, …, Z_s` of the step being solved, as vectors.
-    increments: Vec<SVector<f64, N>>,
-    /// Newton unknowns: the increments stacked (the iterate).
+    /// Newton unknowns (the iterate), laid out by the equations.
     unknowns: DVector<f64>,
-    /// The unknowns of the last accepted step (increments and multipliers): the next predictor.
+    /// The unknowns of the last accepted step: the next predictor.
     previous: Option<DVector<f64>>,
     report: Option<NewtonReport>,
-    /// Where the constraint one-forms are evaluated on a step.
-    point: ConstraintPoint,
-    /// Current values of the system's inputs.
-    inputs: Vec<f64>,
     /// Constraint violation of the last step.
     violation: f64,
     /// Multipliers of the last step (zeros before the first).
     multipliers: Vec<f64>,
-    /// `dg_b(q_k)` of the step being solved: evaluated once per step, not per Newton iteration.
-    holonomic_forms: Vec<SVector<f64, N>>,
+    system: PhantomData<fn() -> S>,
 }
 
 impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
-    /// A stepper for `system` with `quadrature` and step `h`. Fails on a non-positive or
-    /// non-finite step, a non-finite parameter, or a constrained system with a quadrature of
+    /// A stepper for `system` on `Rⁿ` with `quadrature` and step `h`. Fails on a non-positive
+    /// or non-finite step, a non-finite parameter, or a constrained system with a quadrature of
     /// degree above 1 (constraints are imposed on the step's end points only).
     pub fn new(system: S, quadrature: Quadrature, h: f64) -> Result<Self, DiracError> {
+        Self::on_space(system, Euclidean, quadrature, h)
+    }
+
+    /// A stepper with the system's own quadrature (the one named in `#[dirac_system]`).
+    pub fn from_system(system: S, h: f64) -> Result<Self, DiracError> {
+        let quadrature = system.quadrature()?;
+        Self::new(system, quadrature, h)
+    }
+}
+
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
+    Stepper<S, N, EulerLagrange<S, N, C>>
+{
+    /// A stepper for `system` whose steps work in the charts of `space` (see
+    /// [`configuration_space`](crate::configuration_space)); otherwise as [`Stepper::new`].
+    pub fn on_space(
+        system: S,
+        space: C,
+        quadrature: Quadrature,
+        h: f64,
+    ) -> Result<Self, DiracError> {
         if !(h > 0.0 && h.is_finite()) {
             return Err(DiracError::InvalidStep { h });
         }
@@ -149,44 +128,13 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 quadrature.name()
             )));
         }
-        let unknowns = N * quadrature.degree() + S::ONE_FORMS + S::HOLONOMIC;
-        let increments = vec![SVector::zeros(); quadrature.degree()];
-        let newton = Newton::new(unknowns, NewtonOptions::default())?;
-        let point = system.constraint_point();
-        Ok(Self {
-            point,
-            inputs: vec![0.0; S::INPUTS],
-            violation: 0.0,
-            multipliers: vec![0.0; S::ONE_FORMS + S::HOLONOMIC],
-            holonomic_forms: vec![SVector::zeros(); S::HOLONOMIC],
-            discrete: DiscreteLagrangian::new(system, quadrature, h),
-            newton,
-            state: None,
-            start: 0.0,
-            steps: 0,
-            increments,
-            unknowns: DVector::zeros(unknowns),
-            previous: None,
-            report: None,
-        })
-    }
-
-    /// A stepper with the system's own quadrature (the one named in `#[dirac_system]`).
-    pub fn from_system(system: S, h: f64) -> Result<Self, DiracError> {
-        let quadrature = system.quadrature()?;
-        Self::new(system, quadrature, h)
-    }
-
-    /// Replaces the Newton options (tolerances, iteration cap, root acceptance); fails on
-    /// options out of range.
-    pub fn with_newton_options(mut self, options: NewtonOptions) -> Result<Self, DiracError> {
-        self.newton = Newton::new(self.unknowns.len(), options)?;
-        Ok(self)
+        let discrete = DiscreteLagrangian::on_space(system, space, quadrature, h);
+        Self::with_equations(EulerLagrange::new(discrete))
     }
 
     /// Evaluates the constraint one-forms at `point` of each step instead of the system's default.
     pub fn with_constraint_point(mut self, point: ConstraintPoint) -> Self {
-        self.point = point;
+        self.equations.set_constraint_point(point);
         self
     }
 
@@ -198,10 +146,10 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         q0: SVector<f64, N>,
         v0: SVector<f64, N>,
     ) -> Result<(), DiracError> {
-        self.check_finite("initial position", &q0)?;
-        self.check_finite("initial velocity", &v0)?;
+        check_finite(self.system(), "initial position", &q0)?;
+        check_finite(self.system(), "initial velocity", &v0)?;
         let p0 = legendre::momentum(self.system(), &q0, &v0);
-        self.check_finite("initial momentum", &p0)?;
+        check_finite(self.system(), "initial momentum", &p0)?;
         self.start(q0, p0, v0)
     }
 
@@ -225,9 +173,9 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         p0: SVector<f64, N>,
         v_guess: SVector<f64, N>,
     ) -> Result<(), DiracError> {
-        self.check_finite("initial position", &q0)?;
-        self.check_finite("initial momentum", &p0)?;
-        self.check_finite("velocity guess", &v_guess)?;
+        check_finite(self.system(), "initial position", &q0)?;
+        check_finite(self.system(), "initial momentum", &p0)?;
+        check_finite(self.system(), "velocity guess", &v_guess)?;
         let v0 = self.velocity_at(&q0, &p0, &v_guess)?;
         self.start(q0, p0, v0)
     }
@@ -253,10 +201,109 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 value: energy,
             });
         }
-        initial_state::check(self.system(), &q0, &v0, &self.inputs)
+        initial_state::check(self.system(), &q0, &v0, self.inputs())
             .map_err(DiracError::InconsistentInitialState)?;
         self.reset(State::new(0.0, q0, p0, v0));
         Ok(())
+    }
+
+    /// Where the constraint one-forms are evaluated on a step.
+    pub fn constraint_point(&self) -> ConstraintPoint {
+        self.equations.constraint_point()
+    }
+
+    /// Sets the input called `name` (held constant over the following steps until set again).
+    pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), DiracError> {
+        let index = (0..S::INPUTS)
+            .find(|&i| self.system().input_name(i) == name)
+            .ok_or_else(|| {
+                let names: Vec<String> = (0..S::INPUTS)
+                    .map(|i| self.system().input_name(i))
+                    .collect();
+                DiracError::UnknownInput(format!(
+                    "no input called `{name}`; the inputs are {names:?}"
+                ))
+            })?;
+        if !value.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: format!("input {name}"),
+                value,
+            });
+        }
+        self.equations.inputs_mut()[index] = value;
+        Ok(())
+    }
+
+    /// Sets every input at once, in the order of the system's `inputs(...)`.
+    pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
+        if values.len() != S::INPUTS {
+            return Err(DiracError::UnknownInput(format!(
+                "the system has {} input(s), got {} value(s)",
+                S::INPUTS,
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(DiracError::NonFinite {
+                what: format!("input {}", self.system().input_name(i)),
+                value: values[i],
+            });
+        }
+        self.equations.inputs_mut().copy_from_slice(values);
+        Ok(())
+    }
+
+    /// Current input values.
+    pub fn inputs(&self) -> &[f64] {
+        self.equations.inputs()
+    }
+
+    /// The system.
+    pub fn system(&self) -> &S {
+        self.equations.discrete().system()
+    }
+
+    /// The configuration space whose charts the steps work in.
+    pub fn space(&self) -> &C {
+        self.equations.discrete().space()
+    }
+
+    /// The quadrature.
+    pub fn quadrature(&self) -> &Quadrature {
+        self.equations.discrete().quadrature()
+    }
+}
+
+impl<S, E: StepEquations<N>, const N: usize> Stepper<S, N, E> {
+    /// A stepper that solves `equations` on each step, with default Newton options.
+    pub fn with_equations(equations: E) -> Result<Self, DiracError> {
+        let unknowns = equations.unknowns();
+        let newton = Newton::new(unknowns, NewtonOptions::default())?;
+        Ok(Self {
+            multipliers: vec![0.0; equations.multipliers()],
+            equations,
+            newton,
+            state: None,
+            start: 0.0,
+            steps: 0,
+            unknowns: DVector::zeros(unknowns),
+            previous: None,
+            report: None,
+            violation: 0.0,
+            system: PhantomData,
+        })
+    }
+
+    /// Replaces the Newton options (tolerances, iteration cap, root acceptance); fails on
+    /// options out of range.
+    pub fn with_newton_options(mut self, options: NewtonOptions) -> Result<Self, DiracError> {
+        self.newton = Newton::new(self.unknowns.len(), options)?;
+        Ok(self)
+    }
+
+    /// The step equations.
+    pub fn equations(&self) -> &E {
+        &self.equations
     }
 
     /// The velocity at `(q, p)` by the globalised Legendre inversion from `guess`.
@@ -273,8 +320,9 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
             ..*self.newton.options()
         };
         let mut newton = Newton::new(N, options)?;
-        legendre::velocity(self.system(), &mut newton, q, p, guess)
-            .map_err(|f| self.failure(LEGENDRE, f))
+        self.equations
+            .velocity(&mut newton, q, p, guess)
+            .map_err(|f| self.failure(E::VELOCITY, f))
     }
 
     fn reset(&mut self, state: State<N>) {
@@ -297,85 +345,14 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     /// Solves the next step without making it current: the state is unchanged whatever happens.
     fn solve_step(&mut self) -> Result<Proposal<N>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
-        let s = self.discrete.quadrature().degree();
-        let h = self.discrete.h();
-        // Predictor: the last step's increments (constant velocity) and multipliers, or the
-        // path c h v with zero multipliers.
-        match &self.previous {
-            Some(previous) => self.unknowns.copy_from(previous),
-            None => {
-                self.unknowns.fill(0.0);
-                for j in 0..s {
-                    let c = (j + 1) as f64 / s as f64;
-                    self.unknowns
-                        .rows_mut(j * N, N)
-                        .copy_from(&(state.v_hint * (c * h)));
-                }
-            }
-        }
-        let mut impulse = SVector::zeros();
-        if S::HOLONOMIC > 0 {
-            constraint::holonomic_forms(
-                self.discrete.system(),
-                &state.q,
-                &mut self.holonomic_forms,
-            );
-        }
-        let (discrete, increments, point) = (&self.discrete, &mut self.increments, self.point);
-        let holonomic_forms = &self.holonomic_forms;
-        let (t, inputs) = (state.t, &self.inputs);
-        let result = self.newton.solve(&mut self.unknowns, |x, r, jac| {
-            for (j, z) in increments.iter_mut().enumerate() {
-                z.copy_from(&x.fixed_rows::<N>(j * N));
-            }
-            let equations = discrete.euler_lagrange(&state.q, increments, &state.p, r, jac);
-            impulse = equations.impulse;
-            let mut scale = equations.scale;
-            if S::FORCES {
-                let (forces, size) = discrete.add_forces(&state.q, increments, t, inputs, r, jac);
-                impulse += forces;
-                scale = scale.max(size);
-            }
-            if S::ONE_FORMS + S::HOLONOMIC > 0 {
-                let constraints = StepConstraints {
-                    system: discrete.system(),
-                    point,
-                    base: &state.q,
-                    holonomic_forms,
-                };
-                let (constraints, size) = constraints.add(x, N * s, r, jac);
-                impulse += constraints;
-                scale = scale.max(size);
-            }
-            scale
+        let equations = &mut self.equations;
+        equations.predict(&state, self.previous.as_ref(), &mut self.unknowns);
+        let result = self.newton.solve(&mut self.unknowns, |x, r, j| {
+            equations.assemble(&state, x, r, j)
         });
-        let report = result.map_err(|f| self.failure(EULER_LAGRANGE, f))?;
-        let step = self.unknowns.fixed_rows::<N>((s - 1) * N).into_owned();
-        let mut next = state;
-        compensated_add(&mut next.q, &mut next.q_carry, &step);
-        compensated_add(&mut next.p, &mut next.p_carry, &impulse);
-        self.check_finite("new position", &next.q)?;
-        self.check_finite("new momentum", &next.p)?;
-        next.v_hint = step / h;
-        // The quadrature may never evaluate L at q_{k+1} (the midpoint rule does not): a step
-        // that leaves the Lagrangian's domain is refused here, not found later as NaN energies.
-        let lagrangian = self.system().lagrangian(&next.q, &next.v_hint);
-        if !lagrangian.is_finite() {
-            return Err(DiracError::NonFinite {
-                what: format!(
-                    "the Lagrangian at the end of step {} (the step leaves its domain or \
-                     overflows; try a smaller step)",
-                    self.steps
-                ),
-                value: lagrangian,
-            });
-        }
-        next.t = self.start + (self.steps + 1) as f64 * h;
-        let violation = if S::ONE_FORMS + S::HOLONOMIC > 0 {
-            constraint::violation(self.system(), self.point, &state.q, &next.q)
-        } else {
-            0.0
-        };
+        let report = result.map_err(|f| self.failure(E::NAME, f))?;
+        let (mut next, violation) = self.equations.advance(&state, &self.unknowns, self.steps)?;
+        next.t = self.start + (self.steps + 1) as f64 * self.equations.h();
         Ok(Proposal {
             next,
             report,
@@ -383,14 +360,12 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         })
     }
 
-    /// Makes a solved step current; its multipliers and increments are still in `unknowns`.
+    /// Makes a solved step current; its solution is still in `unknowns`.
     fn accept(&mut self, proposal: Proposal<N>) {
-        if S::ONE_FORMS + S::HOLONOMIC > 0 {
-            let s = self.discrete.quadrature().degree();
-            let count = self.multipliers.len();
-            self.multipliers
-                .copy_from_slice(&self.unknowns.as_slice()[N * s..N * s + count]);
-        }
+        let first = self.equations.first_multiplier();
+        let count = self.multipliers.len();
+        self.multipliers
+            .copy_from_slice(&self.unknowns.as_slice()[first..first + count]);
         match &mut self.previous {
             Some(previous) => previous.copy_from(&self.unknowns),
             None => self.previous = Some(self.unknowns.clone()),
@@ -456,7 +431,9 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         state: &State<N>,
         energy: f64,
     ) -> Result<(), DiracError> {
-        if S::ONE_FORMS + S::HOLONOMIC > 0 {
+        if self.multipliers.is_empty() {
+            trajectory.push(state.t, state.q, state.p, energy)
+        } else {
             trajectory.push_constrained(
                 state.t,
                 state.q,
@@ -465,8 +442,6 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 self.violation,
                 self.multipliers(),
             )
-        } else {
-            trajectory.push(state.t, state.q, state.p, energy)
         }
     }
 
@@ -483,75 +458,19 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         self.violation
     }
 
-    /// Where the constraint one-forms are evaluated on a step.
-    pub fn constraint_point(&self) -> ConstraintPoint {
-        self.point
-    }
-
-    /// Sets the input called `name` (held constant over the following steps until set again).
-    pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), DiracError> {
-        let index = (0..S::INPUTS)
-            .find(|&i| self.system().input_name(i) == name)
-            .ok_or_else(|| {
-                let names: Vec<String> = (0..S::INPUTS)
-                    .map(|i| self.system().input_name(i))
-                    .collect();
-                DiracError::UnknownInput(format!(
-                    "no input called `{name}`; the inputs are {names:?}"
-                ))
-            })?;
-        if !value.is_finite() {
-            return Err(DiracError::NonFinite {
-                what: format!("input {name}"),
-                value,
-            });
-        }
-        self.inputs[index] = value;
-        Ok(())
-    }
-
-    /// Sets every input at once, in the order of the system's `inputs(...)`.
-    pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
-        if values.len() != S::INPUTS {
-            return Err(DiracError::UnknownInput(format!(
-                "the system has {} input(s), got {} value(s)",
-                S::INPUTS,
-                values.len()
-            )));
-        }
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(DiracError::NonFinite {
-                what: format!("input {}", self.system().input_name(i)),
-                value: values[i],
-            });
-        }
-        self.inputs.copy_from_slice(values);
-        Ok(())
-    }
-
-    /// Current input values.
-    pub fn inputs(&self) -> &[f64] {
-        &self.inputs
-    }
-
-    /// The system.
-    pub fn system(&self) -> &S {
-        self.discrete.system()
-    }
-
-    /// The quadrature.
-    pub fn quadrature(&self) -> &Quadrature {
-        self.discrete.quadrature()
-    }
-
     /// The step size.
     pub fn h(&self) -> f64 {
-        self.discrete.h()
+        self.equations.h()
     }
 
     /// Steps taken since the start.
     pub fn steps(&self) -> u64 {
         self.steps
+    }
+
+    /// The current state (`None` before the start).
+    pub fn state(&self) -> Option<&State<N>> {
+        self.state.as_ref()
     }
 
     /// Current time (0 before the start).
@@ -570,10 +489,10 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     }
 
     /// Current velocity: the solution `v` of `∂L/∂v(q, v) = p` (Newton's method with the exact
-    /// Hessian, seeded with the last step's mean velocity).
+    /// Hessian, seeded with the last step's velocity).
     pub fn v(&self) -> Result<SVector<f64, N>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
-        self.velocity_at(&state.q, &state.p, &state.v_hint)
+        self.velocity_at(&state.q, &state.p, &state.velocity)
     }
 
     /// Energy `⟨p, v⟩ − L(q, v)` of the current state, with `v` from [`v`](Self::v); an error,
@@ -585,8 +504,8 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
 
     /// The energy of `state`, reached after `steps` steps (for the error message).
     fn energy_of(&self, state: &State<N>, steps: u64) -> Result<f64, DiracError> {
-        let v = self.velocity_at(&state.q, &state.p, &state.v_hint)?;
-        let energy = legendre::energy(self.system(), &state.q, &v);
+        let v = self.velocity_at(&state.q, &state.p, &state.velocity)?;
+        let energy = self.equations.energy(&state.q, &state.p, &v);
         if !energy.is_finite() {
             return Err(DiracError::NonFinite {
                 what: format!("the energy after {steps} steps"),
@@ -604,54 +523,17 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     /// An empty trajectory with this system's coordinate (and multiplier) columns.
     pub fn trajectory(&self) -> Trajectory<N> {
         let names = self.coordinate_names();
-        if S::ONE_FORMS + S::HOLONOMIC > 0 {
-            let multipliers = (0..S::ONE_FORMS)
-                .map(|a| format!("mu_{a}"))
-                .chain((0..S::HOLONOMIC).map(|b| format!("lambda_{b}")))
-                .collect();
-            Trajectory::with_multipliers(names, multipliers)
-        } else {
+        if self.multipliers.is_empty() {
             Trajectory::new(names)
+        } else {
+            Trajectory::with_multipliers(names, self.equations.multiplier_names())
         }
         .expect("one name per coordinate, from coordinate_names")
     }
 
     /// Coordinate names, from the system.
     pub fn coordinate_names(&self) -> Vec<String> {
-        (0..N).map(|i| self.system().coordinate_name(i)).collect()
-    }
-
-    fn check_finite(&self, what: &str, x: &SVector<f64, N>) -> Result<(), DiracError> {
-        match x.iter().position(|v| !v.is_finite()) {
-            None => Ok(()),
-            Some(i) => Err(DiracError::NonFinite {
-                what: format!("{what} of {}", self.system().coordinate_name(i)),
-                value: x[i],
-            }),
-        }
-    }
-
-    /// The name of Newton unknown `column`: a coordinate of a point of the step, or a multiplier.
-    fn unknown_name(&self, legendre: bool, column: usize, s: usize) -> String {
-        if legendre {
-            return format!("{} (velocity)", self.system().coordinate_name(column));
-        }
-        if column >= N * s {
-            let c = column - N * s;
-            return if c < S::ONE_FORMS {
-                format!("the multiplier of one-form {c}")
-            } else {
-                format!(
-                    "the multiplier of holonomic constraint {}",
-                    c - S::ONE_FORMS
-                )
-            };
-        }
-        let slot = match column / N + 1 {
-            j if j == s => "q_{k+1}".to_string(),
-            j => format!("internal point {j}"),
-        };
-        format!("{} ({slot})", self.system().coordinate_name(column % N))
+        (0..N).map(|i| self.equations.coordinate_name(i)).collect()
     }
 
     /// Turns a Newton failure into an error naming the step and, if singular, the unknowns.
@@ -671,11 +553,16 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 step_tolerance: self.newton.options().step_tolerance,
             },
             NewtonFailure::Singular(pivot) => {
-                let s = self.quadrature().degree();
                 let unknowns: Vec<String> = pivot
                     .involved
                     .iter()
-                    .map(|&column| self.unknown_name(problem == LEGENDRE, column, s))
+                    .map(|&column| {
+                        if problem == E::VELOCITY {
+                            format!("{} (velocity)", self.equations.coordinate_name(column))
+                        } else {
+                            self.equations.unknown_name(column)
+                        }
+                    })
                     .collect();
                 DiracError::SingularJacobian {
                     problem,
@@ -689,7 +576,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
                 contraction,
                 max_contraction: self.newton.options().max_contraction,
             },
-            NewtonFailure::NonFinite if problem == LEGENDRE => DiracError::NonFinite {
+            NewtonFailure::NonFinite if problem == E::VELOCITY => DiracError::NonFinite {
                 what: format!(
                     "the residual of {problem} after {} steps (the velocity iterate left the \
                      Lagrangian's domain; start_from_momentum_near takes a guess inside it)",

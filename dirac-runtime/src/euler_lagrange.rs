@@ -1,0 +1,388 @@
+//! The discrete Euler–Lagrange equations of one step: with forces, the discrete
+//! Lagrange–d'Alembert equations; with constraint one-forms, the discrete
+//! Lagrange–d'Alembert–Pontryagin equations. In the chart centred at `q_k`, in position–momentum
+//! form,
+//!
+//! ```text
+//! π_k + ∂L_d/∂ξ_0 + f_0 + σ Ãᵀμ + dg̃ᵀλ = 0     (π_k = p_k read in the chart)
+//!       ∂L_d/∂ξ_j + f_j                  = 0     (internal points, j = 1..s−1)
+//!       Ã(ξ_c) ξ_s = 0,   g(R(ξ_s)) = 0          (one-forms, holonomic constraints)
+//! ```
+//!
+//! solved for `x = [ξ_1, …, ξ_s, μ, λ]` ([`Layout`]); then `q_{k+1} = R_{q_k}(ξ_s)` and the
+//! momentum advances by the configuration space from the step's covectors (on `Rⁿ`,
+//! `p_{k+1} = p_k + Σ_j (∂L_d/∂ξ_j + f_j) + Ãᵀμ + dg̃ᵀλ`, which equals
+//! `D_2 L_d + f_s + (1 − σ) Ãᵀμ` at the solution without its cancellation).
+
+use nalgebra::{DMatrix, DVector, SVector};
+
+use crate::configuration_space::{ConfigurationSpace, StepCovectors};
+use crate::constraint::{self, ConstraintPoint, StepConstraints};
+use crate::discrete_lagrangian::DiscreteLagrangian;
+use crate::error::DiracError;
+use crate::legendre;
+use crate::newton::{Newton, NewtonFailure};
+use crate::step_equations::{State, StepEquations};
+use crate::system::DiracSystem;
+
+/// Where each unknown of a step sits in `x = [ξ_1, …, ξ_s, μ, λ]`: `s` blocks of `N` chart
+/// coordinates (the internal points, then the end point), one multiplier per one-form, one per
+/// holonomic constraint. The Euler–Lagrange rows use the same blocks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Layout {
+    coordinates: usize,
+    points: usize,
+    one_forms: usize,
+    holonomic: usize,
+}
+
+impl Layout {
+    pub(crate) fn new(
+        coordinates: usize,
+        points: usize,
+        one_forms: usize,
+        holonomic: usize,
+    ) -> Self {
+        Self {
+            coordinates,
+            points,
+            one_forms,
+            holonomic,
+        }
+    }
+
+    /// Number of unknowns.
+    pub(crate) fn len(&self) -> usize {
+        self.coordinates * self.points + self.one_forms + self.holonomic
+    }
+
+    /// First column of point `j` (`1..=s`).
+    pub(crate) fn point(&self, j: usize) -> usize {
+        (j - 1) * self.coordinates
+    }
+
+    /// First column of the end point `ξ_s`.
+    pub(crate) fn end_point(&self) -> usize {
+        self.point(self.points)
+    }
+
+    /// First multiplier column.
+    pub(crate) fn multipliers(&self) -> usize {
+        self.coordinates * self.points
+    }
+
+    /// Column of the multiplier of one-form `a`.
+    pub(crate) fn one_form(&self, a: usize) -> usize {
+        self.multipliers() + a
+    }
+
+    /// Column of the multiplier of holonomic constraint `b`.
+    pub(crate) fn holonomic(&self, b: usize) -> usize {
+        self.multipliers() + self.one_forms + b
+    }
+
+    /// What unknown `column` is, with `coordinate` naming coordinates.
+    pub(crate) fn name(&self, column: usize, coordinate: impl Fn(usize) -> String) -> String {
+        if column >= self.multipliers() {
+            let c = column - self.multipliers();
+            return if c < self.one_forms {
+                format!("the multiplier of one-form {c}")
+            } else {
+                format!(
+                    "the multiplier of holonomic constraint {}",
+                    c - self.one_forms
+                )
+            };
+        }
+        let slot = match column / self.coordinates + 1 {
+            j if j == self.points => "q_{k+1}".to_string(),
+            j => format!("internal point {j}"),
+        };
+        format!("{} ({slot})", coordinate(column % self.coordinates))
+    }
+}
+
+/// The discrete Euler–Lagrange equations of a [`DiracSystem`] under a quadrature, on the
+/// configuration space `C`, with the system's forces, inputs and constraints: the
+/// [`StepEquations`] of a Lagrangian model.
+///
+/// ```
+/// use dirac_runtime::euler_lagrange::EulerLagrange;
+/// use dirac_runtime::step_equations::StepEquations;
+/// use dirac_runtime::{DiracSystem, DiscreteLagrangian, Quadrature, Scalar};
+/// use nalgebra::SVector;
+/// struct Oscillator;
+/// impl DiracSystem<1> for Oscillator {
+///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+///     }
+/// }
+/// // Galerkin with 3 points per step: two internal points and q_{k+1}, one coordinate each.
+/// let discrete = DiscreteLagrangian::new(Oscillator, Quadrature::gauss(3)?, 0.1);
+/// let equations = EulerLagrange::new(discrete);
+/// assert_eq!(equations.unknowns(), 3);
+/// assert_eq!(equations.unknown_name(2), "q0 (q_{k+1})");
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct EulerLagrange<S, const N: usize, C> {
+    discrete: DiscreteLagrangian<S, N, C>,
+    point: ConstraintPoint,
+    layout: Layout,
+    /// Current values of the system's inputs.
+    inputs: Vec<f64>,
+    /// `p_k` read in the chart at `q_k`, for the step being solved.
+    momentum: SVector<f64, N>,
+    /// The holonomic impulse directions of the step being solved (constant over the step).
+    holonomic_forms: Vec<SVector<f64, N>>,
+    /// `ξ_1, …, ξ_s` of the point being assembled.
+    increments: Vec<SVector<f64, N>>,
+    /// The step's covectors at the point assembled last.
+    covectors: StepCovectors<N>,
+}
+
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<S, N, C> {
+    /// The equations of `discrete`, with the constraint one-forms evaluated at the system's
+    /// [`constraint_point`](DiracSystem::constraint_point) and every input at 0.
+    pub fn new(discrete: DiscreteLagrangian<S, N, C>) -> Self {
+        let s = discrete.quadrature().degree();
+        let point = discrete.system().constraint_point();
+        Self {
+            point,
+            layout: Layout::new(N, s, S::ONE_FORMS, S::HOLONOMIC),
+            inputs: vec![0.0; S::INPUTS],
+            momentum: SVector::zeros(),
+            holonomic_forms: vec![SVector::zeros(); S::HOLONOMIC],
+            increments: vec![SVector::zeros(); s],
+            covectors: StepCovectors {
+                impulse: SVector::zeros(),
+                end: SVector::zeros(),
+            },
+            discrete,
+        }
+    }
+
+    /// The discrete Lagrangian.
+    pub fn discrete(&self) -> &DiscreteLagrangian<S, N, C> {
+        &self.discrete
+    }
+
+    /// Where the constraint one-forms are evaluated on a step.
+    pub fn constraint_point(&self) -> ConstraintPoint {
+        self.point
+    }
+
+    /// Evaluates the one-forms at `point` of each step.
+    pub fn set_constraint_point(&mut self, point: ConstraintPoint) {
+        self.point = point;
+    }
+
+    /// Current input values.
+    pub fn inputs(&self) -> &[f64] {
+        &self.inputs
+    }
+
+    /// Input values, in the order of the system's inputs (checked by the stepper).
+    pub(crate) fn inputs_mut(&mut self) -> &mut [f64] {
+        &mut self.inputs
+    }
+
+    fn constrained() -> bool {
+        S::ONE_FORMS + S::HOLONOMIC > 0
+    }
+}
+
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<N>
+    for EulerLagrange<S, N, C>
+{
+    const NAME: &'static str = "the discrete Euler–Lagrange equations";
+    const VELOCITY: &'static str = "the Legendre transform (velocity from momentum)";
+
+    fn h(&self) -> f64 {
+        self.discrete.h()
+    }
+
+    fn unknowns(&self) -> usize {
+        self.layout.len()
+    }
+
+    fn multipliers(&self) -> usize {
+        S::ONE_FORMS + S::HOLONOMIC
+    }
+
+    fn multiplier_names(&self) -> Vec<String> {
+        (0..S::ONE_FORMS)
+            .map(|a| format!("mu_{a}"))
+            .chain((0..S::HOLONOMIC).map(|b| format!("lambda_{b}")))
+            .collect()
+    }
+
+    fn coordinate_name(&self, i: usize) -> String {
+        self.discrete.system().coordinate_name(i)
+    }
+
+    /// The last step's solution (constant chart velocity, the same multipliers), or the path
+    /// `ξ_j = c_j h ξ̇` along the state's velocity with zero multipliers.
+    fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>) {
+        let space = self.discrete.space();
+        match previous {
+            Some(previous) => x.copy_from(previous),
+            None => {
+                x.fill(0.0);
+                let (s, h) = (self.layout.points, self.discrete.h());
+                let xi_dot = space
+                    .chart_velocity(&state.q, &state.velocity)
+                    .unwrap_or_else(SVector::zeros);
+                for j in 1..=s {
+                    let c = j as f64 / s as f64;
+                    x.rows_mut(self.layout.point(j), N)
+                        .copy_from(&(xi_dot * (c * h)));
+                }
+            }
+        }
+        self.momentum = space.pull_back(&state.q, &SVector::zeros(), &state.p);
+        if S::HOLONOMIC > 0 {
+            constraint::holonomic_forms(
+                self.discrete.system(),
+                space,
+                &state.q,
+                &mut self.holonomic_forms,
+            );
+        }
+    }
+
+    fn assemble(
+        &mut self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        residual: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> f64 {
+        for (j, z) in self.increments.iter_mut().enumerate() {
+            z.copy_from(&x.fixed_rows::<N>(self.layout.point(j + 1)));
+        }
+        let discrete = &self.discrete;
+        let (mut covectors, mut scale) = discrete.euler_lagrange(
+            &state.q,
+            &self.increments,
+            &self.momentum,
+            residual,
+            jacobian,
+        );
+        if S::FORCES {
+            let (forces, size) = discrete.add_forces(
+                &state.q,
+                &self.increments,
+                state.t,
+                &self.inputs,
+                residual,
+                jacobian,
+            );
+            covectors.impulse += forces.impulse;
+            covectors.end += forces.end;
+            scale = scale.max(size);
+        }
+        if Self::constrained() {
+            let constraints = StepConstraints {
+                system: discrete.system(),
+                space: discrete.space(),
+                point: self.point,
+                base: &state.q,
+                layout: &self.layout,
+                holonomic_forms: &self.holonomic_forms,
+            };
+            let (impulses, size) = constraints.add(x, residual, jacobian);
+            covectors.impulse += impulses.impulse;
+            covectors.end += impulses.end;
+            scale = scale.max(size);
+        }
+        self.covectors = covectors;
+        scale
+    }
+
+    fn advance(
+        &self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        step: u64,
+    ) -> Result<(State<N>, f64), DiracError> {
+        let space = self.discrete.space();
+        let system = self.discrete.system();
+        let xi = x.fixed_rows::<N>(self.layout.end_point()).into_owned();
+        let mut next = *state;
+        space.advance(&mut next.q, &mut next.q_carry, &xi);
+        space
+            .advance_momentum(
+                &state.q,
+                &xi,
+                &mut next.p,
+                &mut next.p_carry,
+                &self.covectors,
+            )
+            .ok_or_else(|| {
+                DiracError::OutsideChart(format!(
+                    "step {step} reaches a point where the retraction's tangent map is singular"
+                ))
+            })?;
+        check_finite(system, "new position", &next.q)?;
+        check_finite(system, "new momentum", &next.p)?;
+        next.velocity = space.push_forward(&state.q, &xi, &(xi / self.discrete.h()));
+        // The quadrature may never evaluate L at q_{k+1} (the midpoint rule does not): a step
+        // that leaves the Lagrangian's domain is refused here, not found later as NaN energies.
+        let lagrangian = system.lagrangian(&next.q, &next.velocity);
+        if !lagrangian.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: format!(
+                    "the Lagrangian at the end of step {step} (the step leaves its domain or \
+                     overflows; try a smaller step)"
+                ),
+                value: lagrangian,
+            });
+        }
+        let violation = if Self::constrained() {
+            // Measured on the stored points, as a user reading the trajectory would.
+            let stored = space.local(&state.q, &next.q).unwrap_or(xi);
+            constraint::violation(system, space, self.point, &state.q, &stored, &next.q)
+        } else {
+            0.0
+        };
+        Ok((next, violation))
+    }
+
+    fn first_multiplier(&self) -> usize {
+        self.layout.multipliers()
+    }
+
+    fn unknown_name(&self, column: usize) -> String {
+        self.layout.name(column, |i| self.coordinate_name(i))
+    }
+
+    fn velocity(
+        &self,
+        newton: &mut Newton,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, NewtonFailure> {
+        legendre::velocity(self.discrete.system(), newton, q, p, guess)
+    }
+
+    fn energy(&self, q: &SVector<f64, N>, _p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64 {
+        legendre::energy(self.discrete.system(), q, v)
+    }
+}
+
+/// `Err(NonFinite)` naming the first coordinate of `x` that is not finite.
+pub(crate) fn check_finite<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    what: &str,
+    x: &SVector<f64, N>,
+) -> Result<(), DiracError> {
+    match x.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(DiracError::NonFinite {
+            what: format!("{what} of {}", system.coordinate_name(i)),
+            value: x[i],
+        }),
+    }
+}

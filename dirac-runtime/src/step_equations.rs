@@ -1,0 +1,157 @@
+//! The seam between a discretisation and the [`Stepper`](crate::Stepper): the equations of one
+//! step, their unknowns, and how a solution advances the state.
+//!
+//! A step from the [`State`] `(t_k, q_k, p_k)` is a square system `F(x) = 0` in unknowns `x`
+//! whose layout belongs to the equations. The stepper asks the equations for a predictor, hands
+//! [`assemble`](StepEquations::assemble) to Newton's method, and, once Newton has accepted a
+//! root, asks [`advance`](StepEquations::advance) for the next state. It never looks inside `x`:
+//! the discrete Euler–Lagrange equations ([`EulerLagrange`](crate::euler_lagrange::EulerLagrange))
+//! are one implementation; the discrete Hamiltonian route and interconnected systems are others.
+
+use nalgebra::{DMatrix, DVector, SVector};
+
+use crate::error::DiracError;
+use crate::newton::{Newton, NewtonFailure};
+
+/// The state a stepper advances: time, position and momentum, with a velocity near the one at
+/// `(q, p)` and the round-off its compensated updates carry.
+///
+/// ```
+/// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+/// use nalgebra::{SVector, vector};
+/// struct Free;
+/// impl DiracSystem<1> for Free {
+///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+///         v[0] * v[0] * 0.5
+///     }
+/// }
+/// let mut stepper = Stepper::new(Free, Quadrature::midpoint(), 0.5)?;
+/// stepper.start_from_velocity(vector![0.0], vector![2.0])?;
+/// stepper.step()?;
+/// let state = stepper.state().expect("started");
+/// assert_eq!((state.t(), state.q()[0], state.p()[0]), (0.5, 1.0, 2.0));
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct State<const N: usize> {
+    pub(crate) t: f64,
+    pub(crate) q: SVector<f64, N>,
+    pub(crate) p: SVector<f64, N>,
+    /// A velocity near the one at `(q, p)`: the initial velocity, then the last step's velocity
+    /// at its end. It seeds the first predictor and the Legendre inversion.
+    pub(crate) velocity: SVector<f64, N>,
+    /// Round-off left out of `q` and `p` by compensated updates.
+    pub(crate) q_carry: SVector<f64, N>,
+    pub(crate) p_carry: SVector<f64, N>,
+}
+
+impl<const N: usize> State<N> {
+    pub(crate) fn new(
+        t: f64,
+        q: SVector<f64, N>,
+        p: SVector<f64, N>,
+        velocity: SVector<f64, N>,
+    ) -> Self {
+        Self {
+            t,
+            q,
+            p,
+            velocity,
+            q_carry: SVector::zeros(),
+            p_carry: SVector::zeros(),
+        }
+    }
+
+    /// Time.
+    pub fn t(&self) -> f64 {
+        self.t
+    }
+
+    /// Position.
+    pub fn q(&self) -> &SVector<f64, N> {
+        &self.q
+    }
+
+    /// Momentum.
+    pub fn p(&self) -> &SVector<f64, N> {
+        &self.p
+    }
+
+    /// A velocity near the one at `(q, p)` (the last step's velocity at its end), the seed of
+    /// the exact velocity [`Stepper::v`](crate::Stepper::v) solves for.
+    pub fn velocity_hint(&self) -> &SVector<f64, N> {
+        &self.velocity
+    }
+}
+
+/// The equations of one step of an integrator on a state of `N` coordinates.
+///
+/// Implemented by [`EulerLagrange`](crate::euler_lagrange::EulerLagrange); a
+/// [`Stepper`](crate::Stepper) drives any implementation with the same Newton solve, error
+/// handling, trajectories and guarantees (a failed step changes nothing).
+pub trait StepEquations<const N: usize> {
+    /// What the equations are, for error messages ("the discrete Euler–Lagrange equations").
+    const NAME: &'static str;
+    /// What the velocity solve is, for error messages.
+    const VELOCITY: &'static str;
+
+    /// The step size.
+    fn h(&self) -> f64;
+
+    /// Number of unknowns of a step.
+    fn unknowns(&self) -> usize;
+
+    /// Number of multipliers among the unknowns (constraint impulses).
+    fn multipliers(&self) -> usize;
+
+    /// Names of the multipliers, for trajectories.
+    fn multiplier_names(&self) -> Vec<String>;
+
+    /// The name of coordinate `i`.
+    fn coordinate_name(&self, i: usize) -> String;
+
+    /// Prepares the step from `state` and writes the predictor into `x`. `previous` holds the
+    /// solution of the last accepted step, when there is one.
+    fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>);
+
+    /// Writes the residual `F(x)` and adds its Jacobian into `jacobian` (zeroed by the caller);
+    /// returns the size of the terms summed into the residual (its round-off floor is a few ulps
+    /// of this).
+    fn assemble(
+        &mut self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        residual: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> f64;
+
+    /// The state after the step from `state` solved by `x` (the point assembled last), without
+    /// its time, and the step's constraint violation. `step` counts the steps before this one,
+    /// for error messages.
+    fn advance(
+        &self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        step: u64,
+    ) -> Result<(State<N>, f64), DiracError>;
+
+    /// Where in `x` the multipliers are: they are `x[first..first + multipliers()]`.
+    fn first_multiplier(&self) -> usize;
+
+    /// The name of unknown `column` of a step (a coordinate of a point of the step, or a
+    /// multiplier).
+    fn unknown_name(&self, column: usize) -> String;
+
+    /// The velocity at `(q, p)`, solved from `guess` by `newton` (sized for `N` unknowns) where
+    /// it is implicit.
+    fn velocity(
+        &self,
+        newton: &mut Newton,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, NewtonFailure>;
+
+    /// The energy at position `q` with velocity `v` and momentum `p`.
+    fn energy(&self, q: &SVector<f64, N>, p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64;
+}
