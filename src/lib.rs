@@ -47,8 +47,8 @@ pub mod prelude {
     pub use dirac_macros::dirac_system;
     pub use dirac_runtime::nalgebra::{SMatrix, SVector};
     pub use dirac_runtime::{
-        ConstraintPoint, DiracError, DiracSystem, DiscreteLagrangian, DualNum, NewtonOptions,
-        Quadrature, Rule, Scalar, Stepper, Trajectory,
+        ConfigurationSpace, ConstraintPoint, DiracError, DiracSystem, DiscreteLagrangian, DualNum,
+        Euclidean, NewtonOptions, Quadrature, Rule, Scalar, Stepper, Trajectory,
     };
 }
 

@@ -54,6 +54,11 @@ pub struct StepCovectors<const N: usize> {
 /// assert_eq!(Euclidean.local(&q, &moved), Some(vector![0.5, -0.5]));
 /// ```
 pub trait ConfigurationSpace<const N: usize>: Clone + Debug {
+    /// Whether `R_q(ξ) = q + ξ` with `T_ξR_q` the identity (`Rⁿ`): the Lagrangian in the chart is
+    /// then the model's at `q + ξ`, and the runtime adds `q` before it seeds the dual numbers
+    /// rather than after (the same values, with no dual-number arithmetic for the chart).
+    const TRANSLATION: bool = false;
+
     /// `R_q(ξ)`: the point at chart coordinates `ξ` of the chart centred at `q`.
     fn retract<D: Scalar>(&self, q: &SVector<f64, N>, xi: &SVector<D, N>) -> SVector<D, N>;
 
@@ -153,6 +158,8 @@ fn solve<const N: usize>(a: &SMatrix<f64, N, N>, b: &SVector<f64, N>) -> Option<
 pub struct Euclidean;
 
 impl<const N: usize> ConfigurationSpace<N> for Euclidean {
+    const TRANSLATION: bool = true;
+
     #[inline]
     fn retract<D: Scalar>(&self, q: &SVector<f64, N>, xi: &SVector<D, N>) -> SVector<D, N> {
         SVector::from_fn(|i, _| xi[i] + q[i])

@@ -117,6 +117,23 @@ pub(crate) fn seeded<F: PhaseFunction<N>, const N: usize>(
     }
 }
 
+/// `ℓ(ξ, ξ̇)` seeded along `x` and `y`: for a translation chart, `L` at `q_k + ξ` seeded
+/// directly.
+#[inline]
+pub(crate) fn seeded_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
+    chart: &InChart<'_, S, C, N>,
+    xi: &SVector<f64, N>,
+    xi_dot: &SVector<f64, N>,
+    x: Seed,
+    y: Seed,
+) -> Seeded<N> {
+    if C::TRANSLATION {
+        seeded(chart.system, &(chart.base + xi), xi_dot, x, y)
+    } else {
+        seeded(chart, xi, xi_dot, x, y)
+    }
+}
+
 type Dual<const N: usize> = DualSVec64<N>;
 
 /// `x` as first-order duals whose component `i` moves with `weight` along direction `i`:

@@ -16,7 +16,7 @@
 use nalgebra::{DMatrix, DVector, SVector};
 
 use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
-use crate::derivatives::{InChart, PhaseFunction, Seed, seeded};
+use crate::derivatives::{InChart, PhaseFunction, Seed, seeded_in_chart};
 use crate::error::DiracError;
 use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
@@ -169,7 +169,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
             let d = |j: usize| quad.ell_prime(i, j) / h;
             if s == 1 {
                 // One pair of slots: seed the directions of ξ_0 and ξ_1 themselves.
-                let l = seeded(
+                let l = seeded_in_chart(
                     &chart,
                     &xi,
                     &xi_dot,
@@ -191,9 +191,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
                 block += l.mixed * w;
             } else {
                 // Many pairs: the Hessian of ℓ at the node, then the chain rule.
-                let qv = seeded(&chart, &xi, &xi_dot, Seed::POSITION, Seed::VELOCITY);
-                let qq = seeded(&chart, &xi, &xi_dot, Seed::POSITION, Seed::POSITION).mixed;
-                let vv = seeded(&chart, &xi, &xi_dot, Seed::VELOCITY, Seed::VELOCITY).mixed;
+                let qv = seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::VELOCITY);
+                let qq =
+                    seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::POSITION).mixed;
+                let vv =
+                    seeded_in_chart(&chart, &xi, &xi_dot, Seed::VELOCITY, Seed::VELOCITY).mixed;
                 let (lq, lv, qv) = (qv.first, qv.second, qv.mixed);
                 impulse += lq * w;
                 end += (lq * a(s) + lv * d(s)) * w;
