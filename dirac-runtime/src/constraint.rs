@@ -24,7 +24,7 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
 pub use crate::constraint_point::ConstraintPoint;
 use crate::derivatives::{gradient, lift};
-use crate::euler_lagrange::Layout;
+use crate::layout::Layout;
 use crate::system::DiracSystem;
 
 /// One-form `a` read in the chart centred at `base`, at `xi`: the row `Ã_a(ξ)` and its

@@ -9,7 +9,7 @@
 //!       Ã(ξ_c) ξ_s = 0,   g(R(ξ_s)) = 0          (one-forms, holonomic constraints)
 //! ```
 //!
-//! solved for `x = [ξ_1, …, ξ_s, μ, λ]` ([`Layout`]); then `q_{k+1} = R_{q_k}(ξ_s)` and the
+//! solved for `x = [ξ_1, …, ξ_s, μ, λ]` (the `layout` module); then `q_{k+1} = R_{q_k}(ξ_s)` and the
 //! momentum advances by the configuration space from the step's covectors (on `Rⁿ`,
 //! `p_{k+1} = p_k + Σ_j (∂L_d/∂ξ_j + f_j) + Ãᵀμ + dg̃ᵀλ`, which equals
 //! `D_2 L_d + f_s + (1 − σ) Ãᵀμ` at the solution without its cancellation).
@@ -20,87 +20,12 @@ use crate::configuration_space::{ConfigurationSpace, StepCovectors};
 use crate::constraint::{self, ConstraintPoint, StepConstraints};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
+use crate::initial_state;
+use crate::layout::Layout;
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure};
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
-
-/// Where each unknown of a step sits in `x = [ξ_1, …, ξ_s, μ, λ]`: `s` blocks of `N` chart
-/// coordinates (the internal points, then the end point), one multiplier per one-form, one per
-/// holonomic constraint. The Euler–Lagrange rows use the same blocks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct Layout {
-    coordinates: usize,
-    points: usize,
-    one_forms: usize,
-    holonomic: usize,
-}
-
-impl Layout {
-    pub(crate) fn new(
-        coordinates: usize,
-        points: usize,
-        one_forms: usize,
-        holonomic: usize,
-    ) -> Self {
-        Self {
-            coordinates,
-            points,
-            one_forms,
-            holonomic,
-        }
-    }
-
-    /// Number of unknowns.
-    pub(crate) fn len(&self) -> usize {
-        self.coordinates * self.points + self.one_forms + self.holonomic
-    }
-
-    /// First column of point `j` (`1..=s`).
-    pub(crate) fn point(&self, j: usize) -> usize {
-        (j - 1) * self.coordinates
-    }
-
-    /// First column of the end point `ξ_s`.
-    pub(crate) fn end_point(&self) -> usize {
-        self.point(self.points)
-    }
-
-    /// First multiplier column.
-    pub(crate) fn multipliers(&self) -> usize {
-        self.coordinates * self.points
-    }
-
-    /// Column of the multiplier of one-form `a`.
-    pub(crate) fn one_form(&self, a: usize) -> usize {
-        self.multipliers() + a
-    }
-
-    /// Column of the multiplier of holonomic constraint `b`.
-    pub(crate) fn holonomic(&self, b: usize) -> usize {
-        self.multipliers() + self.one_forms + b
-    }
-
-    /// What unknown `column` is, with `coordinate` naming coordinates.
-    pub(crate) fn name(&self, column: usize, coordinate: impl Fn(usize) -> String) -> String {
-        if column >= self.multipliers() {
-            let c = column - self.multipliers();
-            return if c < self.one_forms {
-                format!("the multiplier of one-form {c}")
-            } else {
-                format!(
-                    "the multiplier of holonomic constraint {}",
-                    c - self.one_forms
-                )
-            };
-        }
-        let slot = match column / self.coordinates + 1 {
-            j if j == self.points => "q_{k+1}".to_string(),
-            j => format!("internal point {j}"),
-        };
-        format!("{} ({slot})", coordinate(column % self.coordinates))
-    }
-}
 
 /// The discrete Euler–Lagrange equations of a [`DiracSystem`] under a quadrature, on the
 /// configuration space `C`, with the system's forces, inputs and constraints: the
@@ -195,6 +120,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<N>
     for EulerLagrange<S, N, C>
 {
+    type System = S;
+
+    fn system(&self) -> &S {
+        self.discrete.system()
+    }
+
     const NAME: &'static str = "the discrete Euler–Lagrange equations";
     const VELOCITY: &'static str = "the Legendre transform (velocity from momentum)";
 
@@ -221,6 +152,32 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         self.discrete.system().coordinate_name(i)
     }
 
+    /// `L` and the energy finite at `(q, v)`, and the constraints, their velocity form and the
+    /// hidden constraints of coordinates without kinetic energy satisfied.
+    fn check_start(&self, state: &State<N>) -> Result<(), DiracError> {
+        let system = self.discrete.system();
+        let (q, p, v) = (&state.q, &state.p, &state.velocity);
+        check_finite(system, "initial position", q)?;
+        check_finite(system, "initial momentum", p)?;
+        check_finite(system, "initial velocity", v)?;
+        let lagrangian = system.lagrangian(q, v);
+        if !lagrangian.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: "the Lagrangian at the initial state (is (q0, v0) in its domain?)".into(),
+                value: lagrangian,
+            });
+        }
+        let energy = legendre::energy(system, q, v);
+        if !energy.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: "the initial energy".into(),
+                value: energy,
+            });
+        }
+        initial_state::check(system, q, v, &self.inputs)
+            .map_err(DiracError::InconsistentInitialState)
+    }
+
     /// The last step's solution (constant chart velocity, the same multipliers), or the path
     /// `ξ_j = c_j h ξ̇` along the state's velocity with zero multipliers.
     fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>) {
@@ -229,7 +186,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             Some(previous) => x.copy_from(previous),
             None => {
                 x.fill(0.0);
-                let (s, h) = (self.layout.points, self.discrete.h());
+                let (s, h) = (self.layout.points(), self.discrete.h());
                 let xi_dot = space
                     .chart_velocity(&state.q, &state.velocity)
                     .unwrap_or_else(SVector::zeros);

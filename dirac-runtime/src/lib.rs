@@ -19,6 +19,7 @@ pub mod error;
 pub mod euler_lagrange;
 mod force;
 mod initial_state;
+mod layout;
 pub mod legendre;
 mod lu;
 pub mod newton;

@@ -46,12 +46,9 @@ pub struct State<const N: usize> {
 }
 
 impl<const N: usize> State<N> {
-    pub(crate) fn new(
-        t: f64,
-        q: SVector<f64, N>,
-        p: SVector<f64, N>,
-        velocity: SVector<f64, N>,
-    ) -> Self {
+    /// The state at time `t`, position `q`, momentum `p`, with `velocity` a velocity near the
+    /// one at `(q, p)` (exact or approximate: it seeds solves, it is never trusted).
+    pub fn new(t: f64, q: SVector<f64, N>, p: SVector<f64, N>, velocity: SVector<f64, N>) -> Self {
         Self {
             t,
             q,
@@ -87,9 +84,19 @@ impl<const N: usize> State<N> {
 /// The equations of one step of an integrator on a state of `N` coordinates.
 ///
 /// Implemented by [`EulerLagrange`](crate::euler_lagrange::EulerLagrange); a
-/// [`Stepper`](crate::Stepper) drives any implementation with the same Newton solve, error
-/// handling, trajectories and guarantees (a failed step changes nothing).
+/// [`Stepper`](crate::Stepper) drives any implementation ([`Stepper::with_equations`]) with the
+/// same Newton solve, error handling, trajectories and guarantees (a failed step changes
+/// nothing). `tests/step_equations.rs` drives the implicit midpoint rule of a Hamiltonian this
+/// way.
+///
+/// [`Stepper::with_equations`]: crate::Stepper::with_equations
 pub trait StepEquations<const N: usize> {
+    /// The model the equations discretise.
+    type System;
+
+    /// The model.
+    fn system(&self) -> &Self::System;
+
     /// What the equations are, for error messages ("the discrete Euler–Lagrange equations").
     const NAME: &'static str;
     /// What the velocity solve is, for error messages.
@@ -109,6 +116,10 @@ pub trait StepEquations<const N: usize> {
 
     /// The name of coordinate `i`.
     fn coordinate_name(&self, i: usize) -> String;
+
+    /// Checks that `state` is a valid initial state (finite, in the model's domain, consistent
+    /// with its constraints): the error says what is violated.
+    fn check_start(&self, state: &State<N>) -> Result<(), DiracError>;
 
     /// Prepares the step from `state` and writes the predictor into `x`. `previous` holds the
     /// solution of the last accepted step, when there is one.

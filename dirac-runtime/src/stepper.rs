@@ -18,7 +18,6 @@ use crate::constraint::ConstraintPoint;
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
 use crate::euler_lagrange::{EulerLagrange, check_finite};
-use crate::initial_state;
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 use crate::quadrature::Quadrature;
@@ -150,7 +149,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         check_finite(self.system(), "initial velocity", &v0)?;
         let p0 = legendre::momentum(self.system(), &q0, &v0);
         check_finite(self.system(), "initial momentum", &p0)?;
-        self.start(q0, p0, v0)
+        self.start_from_state(State::new(0.0, q0, p0, v0))
     }
 
     /// Starts from position `q0` and momentum `p0` at `t = 0`. The velocity is found by a
@@ -177,34 +176,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         check_finite(self.system(), "initial momentum", &p0)?;
         check_finite(self.system(), "velocity guess", &v_guess)?;
         let v0 = self.velocity_at(&q0, &p0, &v_guess)?;
-        self.start(q0, p0, v0)
-    }
-
-    /// Checks a consistent, finite initial state and makes it current.
-    fn start(
-        &mut self,
-        q0: SVector<f64, N>,
-        p0: SVector<f64, N>,
-        v0: SVector<f64, N>,
-    ) -> Result<(), DiracError> {
-        let lagrangian = self.system().lagrangian(&q0, &v0);
-        if !lagrangian.is_finite() {
-            return Err(DiracError::NonFinite {
-                what: "the Lagrangian at the initial state (is (q0, v0) in its domain?)".into(),
-                value: lagrangian,
-            });
-        }
-        let energy = legendre::energy(self.system(), &q0, &v0);
-        if !energy.is_finite() {
-            return Err(DiracError::NonFinite {
-                what: "the initial energy".into(),
-                value: energy,
-            });
-        }
-        initial_state::check(self.system(), &q0, &v0, self.inputs())
-            .map_err(DiracError::InconsistentInitialState)?;
-        self.reset(State::new(0.0, q0, p0, v0));
-        Ok(())
+        self.start_from_state(State::new(0.0, q0, p0, v0))
     }
 
     /// Where the constraint one-forms are evaluated on a step.
@@ -274,7 +246,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     }
 }
 
-impl<S, E: StepEquations<N>, const N: usize> Stepper<S, N, E> {
+impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// A stepper that solves `equations` on each step, with default Newton options.
     pub fn with_equations(equations: E) -> Result<Self, DiracError> {
         let unknowns = equations.unknowns();
@@ -323,6 +295,14 @@ impl<S, E: StepEquations<N>, const N: usize> Stepper<S, N, E> {
         self.equations
             .velocity(&mut newton, q, p, guess)
             .map_err(|f| self.failure(E::VELOCITY, f))
+    }
+
+    /// Starts from `state` after the equations have checked it (see
+    /// [`StepEquations::check_start`]); on error nothing changes.
+    pub fn start_from_state(&mut self, state: State<N>) -> Result<(), DiracError> {
+        self.equations.check_start(&state)?;
+        self.reset(state);
+        Ok(())
     }
 
     fn reset(&mut self, state: State<N>) {

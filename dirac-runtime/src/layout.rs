@@ -1,0 +1,83 @@
+//! The unknowns of a Lagrangian step and the rows of its equations, in one order.
+
+/// Where each unknown of a step sits in `x = [ξ_1, …, ξ_s, μ, λ]`: `s` blocks of `N` chart
+/// coordinates (the internal points, then the end point), one multiplier per one-form, one per
+/// holonomic constraint. The Euler–Lagrange rows use the same blocks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Layout {
+    coordinates: usize,
+    points: usize,
+    one_forms: usize,
+    holonomic: usize,
+}
+
+impl Layout {
+    pub(crate) fn new(
+        coordinates: usize,
+        points: usize,
+        one_forms: usize,
+        holonomic: usize,
+    ) -> Self {
+        Self {
+            coordinates,
+            points,
+            one_forms,
+            holonomic,
+        }
+    }
+
+    /// Number of unknowns.
+    pub(crate) fn len(&self) -> usize {
+        self.coordinates * self.points + self.one_forms + self.holonomic
+    }
+
+    /// Number of points solved for, `s` (the internal points and the end point).
+    pub(crate) fn points(&self) -> usize {
+        self.points
+    }
+
+    /// First column of point `j` (`1..=s`).
+    pub(crate) fn point(&self, j: usize) -> usize {
+        (j - 1) * self.coordinates
+    }
+
+    /// First column of the end point `ξ_s`.
+    pub(crate) fn end_point(&self) -> usize {
+        self.point(self.points)
+    }
+
+    /// First multiplier column.
+    pub(crate) fn multipliers(&self) -> usize {
+        self.coordinates * self.points
+    }
+
+    /// Column of the multiplier of one-form `a`.
+    pub(crate) fn one_form(&self, a: usize) -> usize {
+        self.multipliers() + a
+    }
+
+    /// Column of the multiplier of holonomic constraint `b`.
+    pub(crate) fn holonomic(&self, b: usize) -> usize {
+        self.multipliers() + self.one_forms + b
+    }
+
+    /// What unknown `column` is, with `coordinate` naming coordinates.
+    pub(crate) fn name(&self, column: usize, coordinate: impl Fn(usize) -> String) -> String {
+        if column >= self.multipliers() {
+            let c = column - self.multipliers();
+            return if c < self.one_forms {
+                format!("the multiplier of one-form {c}")
+            } else {
+                format!(
+                    "the multiplier of holonomic constraint {}",
+                    c - self.one_forms
+                )
+            };
+        }
+        let slot = match column / self.coordinates + 1 {
+            j if j == self.points => "q_{k+1}".to_string(),
+            j => format!("internal point {j}"),
+        };
+        format!("{} ({slot})", coordinate(column % self.coordinates))
+    }
+}

@@ -1,0 +1,212 @@
+//! The step equations as a seam: a `Stepper` drives equations written outside the library with
+//! the same Newton solve, trajectories and error guarantees as its own. Here the implicit
+//! midpoint rule of the harmonic oscillator `H = (p² + ω² q²)/2`, in unknowns `x = [q1, p1]`:
+//!
+//! ```text
+//! q1 − q0 − h (p0 + p1)/2 = 0,      p1 − p0 + h ω² (q0 + q1)/2 = 0.
+//! ```
+//!
+//! Its step is the Cayley transform of the generator, a rotation of `(ω q, p)` by
+//! `θ = 2 atan(hω/2)`: after `n` steps the state is known in closed form, and `H` is conserved.
+
+use dirac::nalgebra::{DMatrix, DVector};
+use dirac::newton::{Newton, NewtonFailure};
+use dirac::prelude::*;
+use dirac::{State, StepEquations};
+
+#[derive(Debug, Clone)]
+struct Oscillator {
+    omega: f64,
+}
+
+#[derive(Debug, Clone)]
+struct ImplicitMidpoint {
+    oscillator: Oscillator,
+    h: f64,
+}
+
+impl StepEquations<1> for ImplicitMidpoint {
+    type System = Oscillator;
+    const NAME: &'static str = "the implicit midpoint rule";
+    const VELOCITY: &'static str = "v = ∂H/∂p";
+
+    fn system(&self) -> &Oscillator {
+        &self.oscillator
+    }
+
+    fn h(&self) -> f64 {
+        self.h
+    }
+
+    fn unknowns(&self) -> usize {
+        2
+    }
+
+    fn multipliers(&self) -> usize {
+        0
+    }
+
+    fn multiplier_names(&self) -> Vec<String> {
+        Vec::new()
+    }
+
+    fn coordinate_name(&self, _i: usize) -> String {
+        "x".into()
+    }
+
+    fn check_start(&self, state: &State<1>) -> Result<(), DiracError> {
+        if state.q()[0].is_finite() && state.p()[0].is_finite() {
+            Ok(())
+        } else {
+            Err(DiracError::InconsistentInitialState("not finite".into()))
+        }
+    }
+
+    fn predict(
+        &mut self,
+        state: &State<1>,
+        _previous: Option<&DVector<f64>>,
+        x: &mut DVector<f64>,
+    ) {
+        let w2 = self.oscillator.omega.powi(2);
+        x[0] = state.q()[0] + self.h * state.p()[0];
+        x[1] = state.p()[0] - self.h * w2 * state.q()[0];
+    }
+
+    fn assemble(
+        &mut self,
+        state: &State<1>,
+        x: &DVector<f64>,
+        residual: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> f64 {
+        let (q0, p0, h) = (state.q()[0], state.p()[0], self.h);
+        let w2 = self.oscillator.omega.powi(2);
+        residual[0] = x[0] - q0 - h * (p0 + x[1]) / 2.0;
+        residual[1] = x[1] - p0 + h * w2 * (q0 + x[0]) / 2.0;
+        jacobian[(0, 0)] = 1.0;
+        jacobian[(0, 1)] = -h / 2.0;
+        jacobian[(1, 0)] = h * w2 / 2.0;
+        jacobian[(1, 1)] = 1.0;
+        q0.abs().max(p0.abs()).max(1.0)
+    }
+
+    fn advance(
+        &self,
+        state: &State<1>,
+        x: &DVector<f64>,
+        _step: u64,
+    ) -> Result<(State<1>, f64), DiracError> {
+        let next = State::new(state.t(), vector![x[0]], vector![x[1]], vector![x[1]]);
+        Ok((next, 0.0))
+    }
+
+    fn first_multiplier(&self) -> usize {
+        2
+    }
+
+    fn unknown_name(&self, column: usize) -> String {
+        ["q1", "p1"][column].into()
+    }
+
+    fn velocity(
+        &self,
+        _newton: &mut Newton,
+        _q: &SVector<f64, 1>,
+        p: &SVector<f64, 1>,
+        _guess: &SVector<f64, 1>,
+    ) -> Result<SVector<f64, 1>, NewtonFailure> {
+        Ok(*p)
+    }
+
+    fn energy(&self, q: &SVector<f64, 1>, p: &SVector<f64, 1>, _v: &SVector<f64, 1>) -> f64 {
+        0.5 * (p[0] * p[0] + self.oscillator.omega.powi(2) * q[0] * q[0])
+    }
+}
+
+fn stepper(omega: f64, h: f64) -> Stepper<Oscillator, 1, ImplicitMidpoint> {
+    let equations = ImplicitMidpoint {
+        oscillator: Oscillator { omega },
+        h,
+    };
+    Stepper::with_equations(equations).expect("valid equations")
+}
+
+#[test]
+fn a_stepper_drives_equations_written_outside_the_library() {
+    let (omega, h, n) = (2.0, 0.05, 1000);
+    let mut stepper = stepper(omega, h);
+    stepper
+        .start_from_state(State::new(0.5, vector![1.0], vector![0.5], vector![0.5]))
+        .expect("finite start");
+    let trajectory = stepper.run(n).expect("linear steps converge");
+    let theta = 2.0 * (h * omega / 2.0).atan();
+    let (q0, p0) = (1.0, 0.5);
+    for (k, (q, p)) in trajectory.q().iter().zip(trajectory.p()).enumerate() {
+        let angle = k as f64 * theta;
+        let q_exact = q0 * angle.cos() + p0 / omega * angle.sin();
+        let p_exact = -omega * q0 * angle.sin() + p0 * angle.cos();
+        assert!((q[0] - q_exact).abs() < 1e-12, "q at step {k}");
+        assert!((p[0] - p_exact).abs() < 1e-12, "p at step {k}");
+    }
+    // The run starts at the state's own time, and H is conserved to round-off.
+    assert!((stepper.t() - (0.5 + n as f64 * h)).abs() < 1e-12);
+    assert!(trajectory.max_energy_error() < 1e-14);
+    assert!(stepper.last_report().expect("stepped").iterations <= 3);
+}
+
+#[test]
+fn a_failed_custom_step_leaves_the_stepper_as_it_was() {
+    let mut stepper = stepper(f64::NAN, 0.05);
+    assert!(
+        stepper
+            .start_from_state(State::new(
+                0.0,
+                vector![f64::INFINITY],
+                vector![0.0],
+                vector![0.0]
+            ))
+            .is_err()
+    );
+    stepper
+        .start_from_state(State::new(0.0, vector![1.0], vector![0.0], vector![0.0]))
+        .expect("finite start");
+    let error = stepper.step().expect_err("ω = NaN gives a NaN residual");
+    assert!(matches!(error, DiracError::NonFinite { .. }), "{error}");
+    assert!(
+        error.to_string().contains("the implicit midpoint rule"),
+        "{error}"
+    );
+    assert_eq!(
+        (stepper.steps(), stepper.q()[0], stepper.t()),
+        (0, 1.0, 0.0)
+    );
+}
+
+/// A unit pendulum, `L = v²/2 + cos q`.
+struct Pendulum;
+
+impl DiracSystem<1> for Pendulum {
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+        v[0] * v[0] * 0.5 + q[0].cos()
+    }
+}
+
+#[test]
+fn a_lagrangian_stepper_continues_from_another_steppers_state() {
+    let mut first = Stepper::new(Pendulum, Quadrature::gauss(2).unwrap(), 0.1).unwrap();
+    first
+        .start_from_velocity(vector![1.0], vector![0.0])
+        .unwrap();
+    first.run(50).unwrap();
+    let mut second = Stepper::new(Pendulum, Quadrature::gauss(2).unwrap(), 0.1).unwrap();
+    second
+        .start_from_state(*first.state().expect("started"))
+        .expect("a running stepper's state is a valid start");
+    first.run(100).unwrap();
+    second.run(100).unwrap();
+    // Only the predictor of the first step differs: the same steps to solver tolerance.
+    assert!((first.q() - second.q()).amax() < 1e-12);
+    assert!((first.p() - second.p()).amax() < 1e-12);
+    assert_eq!(first.t(), second.t());
+}
