@@ -1,7 +1,8 @@
 //! The seam for configuration spaces, exercised by a space with a nonlinear retraction: the
-//! positive orthant as the multiplicative group `R₊ⁿ`, `R_q(ξ) = q ⊙ exp(ξ)` (left trivialised,
-//! abelian), implemented here from its three defining maps only (`retract`, `push_forward`,
-//! `local`); the pull-back, the chart velocity and the momentum update are the trait's defaults.
+//! positive orthant as the multiplicative group `R₊ⁿ`, `R_q(ξ) = q ⊙ exp(ξ)` (`Positive`, left
+//! trivialised, abelian), which defines only the three maps a space must (`retract`,
+//! `push_forward`, `local`); the pull-back, the chart velocity and the momentum update are the
+//! trait's defaults.
 //!
 //! On this space every step's points are positive by construction, and the charts differ from
 //! `Rⁿ`'s at second order, so a scheme that ignored the retraction anywhere (the Lagrangian's
@@ -13,30 +14,6 @@ mod support;
 
 use dirac::prelude::*;
 use support::slope;
-
-/// `R₊ⁿ` with `R_q(ξ) = q ⊙ exp(ξ)`: positions stay positive whatever the step.
-#[derive(Debug, Clone, Copy)]
-struct Positive;
-
-impl<const N: usize> ConfigurationSpace<N> for Positive {
-    fn retract<D: Scalar>(&self, q: &SVector<f64, N>, xi: &SVector<D, N>) -> SVector<D, N> {
-        SVector::from_fn(|i, _| xi[i].exp() * q[i])
-    }
-
-    fn push_forward<D: Scalar>(
-        &self,
-        q: &SVector<f64, N>,
-        xi: &SVector<D, N>,
-        xi_dot: &SVector<D, N>,
-    ) -> SVector<D, N> {
-        SVector::from_fn(|i, _| xi[i].exp() * xi_dot[i] * q[i])
-    }
-
-    fn local(&self, q: &SVector<f64, N>, q1: &SVector<f64, N>) -> Option<SVector<f64, N>> {
-        let ratio = q1.component_div(q);
-        ratio.iter().all(|r| *r > 0.0).then(|| ratio.map(f64::ln))
-    }
-}
 
 /// A particle against an inverse-square wall, `L = v²/2 − 1/(2q²)`, with optional damping
 /// `F = −c v`. Undamped, `q(t)² = q0² + 2 q0 v0 t + 2E t²` (since `(q²)'' = 4E`).

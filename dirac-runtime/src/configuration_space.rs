@@ -210,6 +210,49 @@ impl<const N: usize> ConfigurationSpace<N> for Euclidean {
     }
 }
 
+/// The positive orthant as the multiplicative group `R₊ⁿ`, with `R_q(ξ) = q ⊙ exp(ξ)` (left
+/// trivialised, abelian): every point of every step is positive, whatever the step size, for
+/// models whose coordinates must stay positive (concentrations, populations, radii). It defines
+/// only the three maps a space must; the pull-back, chart velocity and momentum update are the
+/// trait's defaults.
+///
+/// ```
+/// use dirac_runtime::configuration_space::{ConfigurationSpace, Positive};
+/// use nalgebra::vector;
+///
+/// let q = vector![2.0, 0.5];
+/// let moved = Positive.retract(&q, &vector![-30.0, 0.0]);
+/// assert!(moved[0] > 0.0 && moved[1] == 0.5);
+/// let back = Positive.local(&q, &moved).expect("positive points");
+/// assert!((back[0] + 30.0).abs() < 1e-12);
+/// assert_eq!(Positive.local(&q, &vector![-1.0, 1.0]), None);
+/// ```
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Positive;
+
+impl<const N: usize> ConfigurationSpace<N> for Positive {
+    fn retract<D: Scalar>(&self, q: &SVector<f64, N>, xi: &SVector<D, N>) -> SVector<D, N> {
+        SVector::from_fn(|i, _| xi[i].exp() * q[i])
+    }
+
+    fn push_forward<D: Scalar>(
+        &self,
+        q: &SVector<f64, N>,
+        xi: &SVector<D, N>,
+        xi_dot: &SVector<D, N>,
+    ) -> SVector<D, N> {
+        SVector::from_fn(|i, _| xi[i].exp() * xi_dot[i] * q[i])
+    }
+
+    fn local(&self, q: &SVector<f64, N>, q1: &SVector<f64, N>) -> Option<SVector<f64, N>> {
+        let ratio = q1.component_div(q);
+        ratio
+            .iter()
+            .all(|r| *r > 0.0 && r.is_finite())
+            .then(|| ratio.map(f64::ln))
+    }
+}
+
 /// `sum += increment` with Kahan compensation.
 fn compensated_add<const N: usize>(
     sum: &mut SVector<f64, N>,

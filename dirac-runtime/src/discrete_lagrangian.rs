@@ -223,6 +223,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::configuration_space::Positive;
     use crate::scalar::Scalar;
     use nalgebra::vector;
 
@@ -235,69 +236,105 @@ mod tests {
         }
     }
 
-    /// Central finite difference of `f` in the `c`-th component of point `j`.
+    /// `L_d` as a function of all `s + 1` chart points `ξ_0, …, ξ_s` in the chart fixed at `base`
+    /// (`ξ_0` free too), summed from the quadrature's basis independently of `node`.
+    fn in_fixed_chart<C: ConfigurationSpace<2>>(
+        ld: &DiscreteLagrangian<Coupled, 2, C>,
+        base: &SVector<f64, 2>,
+        xis: &[SVector<f64, 2>],
+    ) -> f64 {
+        let (quad, h) = (ld.quadrature(), ld.h());
+        let chart = ld.in_chart(base);
+        (0..quad.nodes().len())
+            .map(|i| {
+                let xi: SVector<f64, 2> = (0..xis.len())
+                    .map(|j| xis[j] * quad.basis(i, j).unwrap())
+                    .sum();
+                let xi_dot: SVector<f64, 2> = (0..xis.len())
+                    .map(|j| xis[j] * (quad.basis_derivative(i, j).unwrap() / h))
+                    .sum();
+                h * quad.weights()[i] * chart.value(&xi, &xi_dot)
+            })
+            .sum()
+    }
+
+    /// Central difference of `f` in component `c` of chart point `j`.
     fn fd(
-        ld: &DiscreteLagrangian<Coupled, 2>,
-        points: &[SVector<f64, 2>],
+        f: &dyn Fn(&[SVector<f64, 2>]) -> f64,
+        xis: &[SVector<f64, 2>],
         j: usize,
         c: usize,
     ) -> f64 {
         let eps = 1e-6;
-        let mut plus = points.to_vec();
-        let mut minus = points.to_vec();
+        let mut plus = xis.to_vec();
+        let mut minus = xis.to_vec();
         plus[j][c] += eps;
         minus[j][c] -= eps;
-        (ld.value(&plus).unwrap() - ld.value(&minus).unwrap()) / (2.0 * eps)
+        (f(&plus) - f(&minus)) / (2.0 * eps)
     }
 
-    fn check(quadrature: Quadrature) {
+    /// The residual, slot covectors and Jacobian of `euler_lagrange` against central
+    /// differences of `L_d` in the chart at `base`, and `value` against the chart sum.
+    fn check<C: ConfigurationSpace<2>>(space: C, quadrature: Quadrature) {
         let s = quadrature.degree();
-        let ld = DiscreteLagrangian::new(Coupled, quadrature, 0.1);
-        let points: Vec<_> = (0..=s)
-            .map(|j| vector![0.3 + 0.05 * j as f64, -0.2 + 0.03 * (j * j) as f64])
+        let name = quadrature.name();
+        let ld = DiscreteLagrangian::on_space(Coupled, space, quadrature, 0.1);
+        let base = vector![0.3, 0.4];
+        let xis: Vec<_> = (0..=s)
+            .map(|j| vector![0.05 * j as f64, -0.1 + 0.03 * (j * j) as f64] * (j.min(1) as f64))
             .collect();
+        let f = |xis: &[SVector<f64, 2>]| in_fixed_chart(&ld, &base, xis);
         let p = vector![0.7, -0.4];
         let mut r = DVector::zeros(2 * s);
         let mut jac = DMatrix::zeros(2 * s, 2 * s);
-        let increments = |points: &[SVector<f64, 2>]| -> Vec<SVector<f64, 2>> {
-            points[1..].iter().map(|q| q - points[0]).collect()
-        };
-        let (covectors, _) =
-            ld.euler_lagrange(&points[0], &increments(&points), &p, &mut r, &mut jac);
-        let impulse = covectors.impulse;
+        let (covectors, _) = ld.euler_lagrange(&base, &xis[1..], &p, &mut r, &mut jac);
         for c in 0..2 {
-            assert!((r[c] - p[c] - fd(&ld, &points, 0, c)).abs() < 1e-8);
+            assert!((r[c] - p[c] - fd(&f, &xis, 0, c)).abs() < 1e-8, "{name}");
             for j in 1..s {
-                assert!((r[j * 2 + c] - fd(&ld, &points, j, c)).abs() < 1e-8);
+                assert!((r[j * 2 + c] - fd(&f, &xis, j, c)).abs() < 1e-8, "{name}");
             }
-            let total: f64 = (0..=s).map(|j| fd(&ld, &points, j, c)).sum();
-            assert!((impulse[c] - total).abs() < 1e-8);
-            assert!((covectors.end[c] - fd(&ld, &points, s, c)).abs() < 1e-8);
+            let total: f64 = (0..=s).map(|j| fd(&f, &xis, j, c)).sum();
+            assert!((covectors.impulse[c] - total).abs() < 1e-8, "{name}");
+            assert!(
+                (covectors.end[c] - fd(&f, &xis, s, c)).abs() < 1e-8,
+                "{name}"
+            );
         }
+        // The public value at the points R_base(ξ_j) is the chart sum.
+        let points: Vec<_> = xis.iter().map(|xi| ld.space().retract(&base, xi)).collect();
+        assert!(
+            (ld.value(&points).unwrap() - f(&xis)).abs() < 1e-14,
+            "{name}"
+        );
         // Jacobian columns against differences of the residual.
         let eps = 1e-6;
         for k in 1..=s {
             for c in 0..2 {
-                let mut plus = points.clone();
-                let mut minus = points.clone();
+                let mut plus = xis.clone();
+                let mut minus = xis.clone();
                 plus[k][c] += eps;
                 minus[k][c] -= eps;
                 let (mut rp, mut rm) = (DVector::zeros(2 * s), DVector::zeros(2 * s));
                 let mut scratch = DMatrix::zeros(2 * s, 2 * s);
-                ld.euler_lagrange(&plus[0], &increments(&plus), &p, &mut rp, &mut scratch);
-                ld.euler_lagrange(&minus[0], &increments(&minus), &p, &mut rm, &mut scratch);
+                ld.euler_lagrange(&base, &plus[1..], &p, &mut rp, &mut scratch);
+                ld.euler_lagrange(&base, &minus[1..], &p, &mut rm, &mut scratch);
                 let column = (rp - rm) / (2.0 * eps);
                 let exact = jac.column((k - 1) * 2 + c);
-                assert!((column - exact).amax() < 1e-6, "column {k},{c}");
+                assert!((column - exact).amax() < 1e-6, "{name}: column {k},{c}");
             }
         }
     }
 
     #[test]
     fn slot_derivatives_match_finite_differences() {
-        check(Quadrature::midpoint());
-        check(Quadrature::trapezoid());
-        check(Quadrature::gauss(2).unwrap());
-        check(Quadrature::gauss(3).unwrap());
+        for quadrature in [
+            Quadrature::midpoint(),
+            Quadrature::trapezoid(),
+            Quadrature::gauss(2).unwrap(),
+            Quadrature::gauss(3).unwrap(),
+        ] {
+            check(Euclidean, quadrature.clone());
+            check(Positive, quadrature);
+        }
     }
 }

@@ -30,7 +30,7 @@ pub mod stepper;
 pub mod system;
 pub mod trajectory;
 
-pub use configuration_space::{ConfigurationSpace, Euclidean};
+pub use configuration_space::{ConfigurationSpace, Euclidean, Positive};
 pub use constraint::ConstraintPoint;
 pub use discrete_lagrangian::DiscreteLagrangian;
 pub use error::DiracError;
