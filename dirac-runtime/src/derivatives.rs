@@ -134,7 +134,8 @@ pub(crate) fn seeded_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const
     }
 }
 
-type Dual<const N: usize> = DualSVec64<N>;
+/// First-order dual numbers with `N` directions.
+pub(crate) type Dual<const N: usize> = DualSVec64<N>;
 
 /// `x` as first-order duals whose component `i` moves with `weight` along direction `i`:
 /// functions of it return their value and their derivative along `weight · δx`.

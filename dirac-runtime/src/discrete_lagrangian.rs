@@ -13,7 +13,7 @@
 //! along `(α_x, β_x)` and `(α_y, β_y)` in `(ξ, ξ̇)` yields both gradients along those directions
 //! and the mixed second derivative in one pass.
 
-use nalgebra::{DMatrix, DVector, SVector};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
 use crate::derivatives::{InChart, PhaseFunction, Seed, seeded_in_chart};
@@ -217,6 +217,40 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
             }
         }
         (StepCovectors { impulse, end }, magnitude.amax())
+    }
+}
+
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagrangian<S, N, C> {
+    /// Every second slot derivative `∂²L_d/∂ξ_j∂ξ_m` (`j, m = 0..=s`, `ξ_0 = 0`) at the step
+    /// with points `ξ_1..ξ_s` from `base`, as blocks `[j][m]` (rows: the components of `ξ_j`).
+    pub(crate) fn slot_hessian(
+        &self,
+        base: &SVector<f64, N>,
+        increments: &[SVector<f64, N>],
+    ) -> Vec<Vec<SMatrix<f64, N, N>>> {
+        let (quad, h) = (&self.quadrature, self.h);
+        let s = quad.degree();
+        let mut blocks = vec![vec![SMatrix::<f64, N, N>::zeros(); s + 1]; s + 1];
+        let chart = self.in_chart(base);
+        for (i, &b) in quad.weights().iter().enumerate() {
+            let w = h * b;
+            let (xi, xi_dot) = self.node(i, increments);
+            let qv = seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::VELOCITY).mixed;
+            let qq = seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::POSITION).mixed;
+            let vv = seeded_in_chart(&chart, &xi, &xi_dot, Seed::VELOCITY, Seed::VELOCITY).mixed;
+            let a = |j: usize| quad.ell(i, j);
+            let d = |j: usize| quad.ell_prime(i, j) / h;
+            for (j, row) in blocks.iter_mut().enumerate() {
+                for (m, block) in row.iter_mut().enumerate() {
+                    *block += (qq * (a(j) * a(m))
+                        + qv * (a(j) * d(m))
+                        + qv.transpose() * (d(j) * a(m))
+                        + vv * (d(j) * d(m)))
+                        * w;
+                }
+            }
+        }
+        blocks
     }
 }
 

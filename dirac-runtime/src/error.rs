@@ -95,6 +95,9 @@ pub enum DiracError {
     /// A vector or a table index of the wrong size.
     #[error("{0}")]
     Dimension(String),
+    /// A capability that does not cover this model yet (the message says which and why).
+    #[error("not supported: {0}")]
+    Unsupported(String),
     /// A step left the region where the configuration space's chart is defined or invertible.
     #[error("{0}; nothing was changed (try a smaller step)")]
     OutsideChart(String),

@@ -14,7 +14,7 @@
 //! `p_{k+1} = p_k + Σ_j (∂L_d/∂ξ_j + f_j) + Ãᵀμ + dg̃ᵀλ`, which equals
 //! `D_2 L_d + f_s + (1 − σ) Ãᵀμ` at the solution without its cancellation).
 
-use nalgebra::{DMatrix, DVector, SVector};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::configuration_space::{ConfigurationSpace, StepCovectors};
 use crate::constraint::{self, ConstraintPoint, StepConstraints};
@@ -24,6 +24,7 @@ use crate::initial_state;
 use crate::layout::Layout;
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure};
+use crate::step_derivatives::StepDerivatives;
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
 
@@ -326,6 +327,85 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
 
     fn energy(&self, q: &SVector<f64, N>, _p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64 {
         legendre::energy(self.discrete.system(), q, v)
+    }
+
+    /// By the implicit function theorem on the rows `R_j = δ_j0 p_k + ∂L_d/∂ξ_j + f_j`
+    /// (`j < s`) with `G_jm = ∂(∂L_d/∂ξ_j + f_j)/∂ξ_m` (`j, m = 0..=s`): moving `q_k` at fixed
+    /// `ξ` moves every point of the step, so `∂R_j/∂q_k = Σ_m G_jm`, and `∂R_j/∂p_k = δ_j0 I`.
+    /// Then `q_{k+1} = q_k + ξ_s` and `p_{k+1} = ∂L_d/∂ξ_s + f_s` are differentiated along.
+    /// On `Rⁿ` for models without constraints; others are refused with `Unsupported`.
+    fn linearise(
+        &self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        newton: &Newton,
+    ) -> Result<StepDerivatives<N>, DiracError> {
+        if Self::constrained() {
+            return Err(DiracError::Unsupported(
+                "derivatives of the step map of a constrained model (they need the projection \
+                 onto the constraint manifold, not written yet)"
+                    .into(),
+            ));
+        }
+        if !C::TRANSLATION {
+            return Err(DiracError::Unsupported(
+                "derivatives of the step map on a configuration space other than Rⁿ".into(),
+            ));
+        }
+        let discrete = &self.discrete;
+        let s = self.layout.points();
+        let increments: Vec<SVector<f64, N>> = (1..=s)
+            .map(|j| x.fixed_rows::<N>(self.layout.point(j)).into_owned())
+            .collect();
+        let mut g = discrete.slot_hessian(&state.q, &increments);
+        if S::FORCES {
+            let forces =
+                discrete.force_slot_derivatives(&state.q, &increments, state.t, &self.inputs);
+            for (row, force_row) in g.iter_mut().zip(forces) {
+                for (block, force) in row.iter_mut().zip(force_row) {
+                    *block += force;
+                }
+            }
+        }
+        let moving_all = |j: usize| -> SMatrix<f64, N, N> { g[j].iter().sum() };
+        // ∂ξ/∂q_k and ∂ξ/∂p_k, one column at a time: −J⁻¹ ∂R/∂(q_k, p_k).
+        let mut xi_q = vec![SMatrix::<f64, N, N>::zeros(); s + 1];
+        let mut xi_p = vec![SMatrix::<f64, N, N>::zeros(); s + 1];
+        let mut column = DVector::zeros(self.layout.len());
+        for c in 0..2 * N {
+            column.fill(0.0);
+            for j in 0..s {
+                let rows = self.layout.point(j + 1);
+                if c < N {
+                    column.rows_mut(rows, N).copy_from(&moving_all(j).column(c));
+                } else if j == 0 {
+                    column[c - N] = 1.0;
+                }
+            }
+            newton.solve_factorised(&mut column);
+            for m in 1..=s {
+                let target = if c < N { &mut xi_q[m] } else { &mut xi_p[m] };
+                target
+                    .column_mut(c % N)
+                    .copy_from(&(-column.fixed_rows::<N>(self.layout.point(m))));
+            }
+        }
+        let q_q = SMatrix::identity() + xi_q[s];
+        let q_p = xi_p[s];
+        let along = |xi: &[SMatrix<f64, N, N>]| -> SMatrix<f64, N, N> {
+            (1..=s).map(|m| g[s][m] * xi[m]).sum()
+        };
+        let p_q = moving_all(s) + along(&xi_q);
+        let p_p = along(&xi_p);
+        let derivatives = StepDerivatives { q_q, q_p, p_q, p_p };
+        if derivatives.matrix().iter().all(|v| v.is_finite()) {
+            Ok(derivatives)
+        } else {
+            Err(DiracError::NonFinite {
+                what: "a derivative of the step map".into(),
+                value: f64::NAN,
+            })
+        }
     }
 }
 

@@ -6,7 +6,7 @@
 use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
 
 use crate::configuration_space::{ConfigurationSpace, StepCovectors};
-use crate::derivatives::lift;
+use crate::derivatives::{Dual, lift};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::system::DiracSystem;
 
@@ -60,5 +60,46 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
             }
         }
         (StepCovectors { impulse, end }, scale)
+    }
+
+    /// The forces' slot derivatives `∂f_j/∂ξ_m` (`j, m = 0..=s`, `ξ_0 = 0`) as blocks `[j][m]`:
+    /// `h Σ_i b_i ℓ_j(c_i) (∂_q F ℓ_m(c_i) + ∂_v F ℓ'_m(c_i)/h)` at the nodes, on a translation
+    /// chart (`Rⁿ`).
+    pub(crate) fn force_slot_derivatives(
+        &self,
+        base: &SVector<f64, N>,
+        increments: &[SVector<f64, N>],
+        t: f64,
+        inputs: &[f64],
+    ) -> Vec<Vec<SMatrix<f64, N, N>>> {
+        let quad = self.quadrature();
+        let (h, s) = (self.h(), quad.degree());
+        let mut blocks = vec![vec![SMatrix::<f64, N, N>::zeros(); s + 1]; s + 1];
+        let jacobian = |f: SVector<Dual<N>, N>| {
+            SMatrix::<f64, N, N>::from_fn(|m, l| f[m].eps.unwrap_generic(Const::<N>, U1)[l])
+        };
+        for (i, (&b, &c)) in quad.weights().iter().zip(quad.nodes()).enumerate() {
+            let w = h * b;
+            let (xi, xi_dot) = self.node(i, increments);
+            let q = base + xi;
+            let time = t + c * h;
+            let f_q =
+                jacobian(
+                    self.system()
+                        .force(&lift(&q, 1.0), &lift(&xi_dot, 0.0), time, inputs),
+                );
+            let f_v =
+                jacobian(
+                    self.system()
+                        .force(&lift(&q, 0.0), &lift(&xi_dot, 1.0), time, inputs),
+                );
+            for (j, row) in blocks.iter_mut().enumerate() {
+                for (m, block) in row.iter_mut().enumerate() {
+                    *block += (f_q * quad.ell(i, m) + f_v * (quad.ell_prime(i, m) / h))
+                        * (w * quad.ell(i, j));
+                }
+            }
+        }
+        blocks
     }
 }

@@ -198,6 +198,12 @@ impl Newton {
         })
     }
 
+    /// Solves `J y = b` in place with the Jacobian factorised at the root of the last successful
+    /// [`solve`](Self::solve) (the implicit function theorem's solves reuse it).
+    pub(crate) fn solve_factorised(&self, b: &mut DVector<f64>) {
+        lu::solve(&self.jacobian, &self.pivots, b);
+    }
+
     /// The options in force.
     pub fn options(&self) -> &NewtonOptions {
         &self.options

@@ -12,6 +12,7 @@ use nalgebra::{DMatrix, DVector, SVector};
 
 use crate::error::DiracError;
 use crate::newton::{Newton, NewtonFailure};
+use crate::step_derivatives::StepDerivatives;
 
 /// The state a stepper advances: time, position and momentum, with a velocity near the one at
 /// `(q, p)` and the round-off its compensated updates carry.
@@ -165,4 +166,20 @@ pub trait StepEquations<const N: usize> {
 
     /// The energy at position `q` with velocity `v` and momentum `p`.
     fn energy(&self, q: &SVector<f64, N>, p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64;
+
+    /// The derivatives of the step from `state` solved by `x` (the point assembled last) with
+    /// respect to `(q_k, p_k)`; `newton` holds the Jacobian factorised at `x`. The default
+    /// refuses: equations that can differentiate their step override it.
+    fn linearise(
+        &self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        newton: &Newton,
+    ) -> Result<StepDerivatives<N>, DiracError> {
+        let _ = (state, x, newton);
+        Err(DiracError::Unsupported(format!(
+            "derivatives of the step map of {}",
+            Self::NAME
+        )))
+    }
 }

@@ -21,6 +21,7 @@ use crate::euler_lagrange::{EulerLagrange, check_finite};
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 use crate::quadrature::Quadrature;
+use crate::step_derivatives::StepDerivatives;
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
 use crate::trajectory::{Interrupted, Trajectory};
@@ -320,6 +321,19 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let proposal = self.solve_step()?;
         self.accept(proposal);
         Ok(())
+    }
+
+    /// Advances one step and returns the derivatives of the step map at the state it started
+    /// from, `∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)` (see [`StepDerivatives`]). On error (including
+    /// `Unsupported` for models the derivatives do not cover yet) the state is unchanged.
+    pub fn step_linearised(&mut self) -> Result<StepDerivatives<N>, DiracError> {
+        let proposal = self.solve_step()?;
+        let state = self.state.ok_or(DiracError::NotStarted)?;
+        let derivatives = self
+            .equations
+            .linearise(&state, &self.unknowns, &self.newton)?;
+        self.accept(proposal);
+        Ok(derivatives)
     }
 
     /// Solves the next step without making it current: the state is unchanged whatever happens.

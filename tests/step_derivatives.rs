@@ -1,0 +1,178 @@
+//! Exact derivatives of the step map, `A = ∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)`, against central
+//! differences (δ = 1e-5, as trep checks its derivatives) of the step itself, and the structure
+//! they must have: `AᵀJA = J` for conservative models, `det A = 1` for one degree of freedom.
+
+#[path = "../examples/scenes/mod.rs"]
+mod scenes;
+
+use dirac::StepDerivatives;
+use dirac::nalgebra::DMatrix;
+use dirac::prelude::*;
+use scenes::{double_pendulum, knife_edge};
+
+/// One step from `(q, p)` as a map, and its matrix of central differences with step `delta`.
+fn central_differences<S: DiracSystem<N>, const N: usize>(
+    make: &dyn Fn() -> Stepper<S, N>,
+    q: SVector<f64, N>,
+    p: SVector<f64, N>,
+    delta: f64,
+) -> DMatrix<f64> {
+    let step = |q: SVector<f64, N>, p: SVector<f64, N>| -> Vec<f64> {
+        let mut stepper = make();
+        stepper.start_from_momentum(q, p).expect("a valid state");
+        stepper.step().expect("step");
+        stepper
+            .q()
+            .iter()
+            .chain(stepper.p().iter())
+            .copied()
+            .collect()
+    };
+    let mut a = DMatrix::zeros(2 * N, 2 * N);
+    for c in 0..2 * N {
+        let (mut qp, mut pp, mut qm, mut pm) = (q, p, q, p);
+        if c < N {
+            qp[c] += delta;
+            qm[c] -= delta;
+        } else {
+            pp[c - N] += delta;
+            pm[c - N] -= delta;
+        }
+        let (plus, minus) = (step(qp, pp), step(qm, pm));
+        for r in 0..2 * N {
+            a[(r, c)] = (plus[r] - minus[r]) / (2.0 * delta);
+        }
+    }
+    a
+}
+
+/// The exact derivatives at `(q, p)` and their largest difference from central differences.
+fn compare<S: DiracSystem<N>, const N: usize>(
+    make: &dyn Fn() -> Stepper<S, N>,
+    q: SVector<f64, N>,
+    p: SVector<f64, N>,
+) -> (StepDerivatives<N>, f64) {
+    let mut stepper = make();
+    stepper.start_from_momentum(q, p).expect("a valid state");
+    let exact = stepper.step_linearised().expect("derivatives");
+    let differences = central_differences(make, q, p, 1e-5);
+    (exact, (exact.matrix() - differences).amax())
+}
+
+/// A state of the double pendulum with large velocities (150 steps from the scene's start).
+fn double_pendulum_state() -> (SVector<f64, 2>, SVector<f64, 2>) {
+    let mut stepper = double_pendulum::stepper(Quadrature::midpoint(), 0.01).unwrap();
+    stepper.run(150).unwrap();
+    (stepper.q(), stepper.p())
+}
+
+#[test]
+fn double_pendulum_derivatives_match_central_differences_and_are_symplectic() {
+    let (q, p) = double_pendulum_state();
+    for quadrature in scenes::quadratures() {
+        let make = || Stepper::new(double_pendulum::SCENE, quadrature.clone(), 0.05).unwrap();
+        let (exact, difference) = compare(&make, q, p);
+        let name = quadrature.name();
+        // Central differences at δ = 1e-5 are good to ~δ² |A'''| + ε/δ ≈ 1e-9 here.
+        assert!(difference < 1e-7, "{name}: {difference:e}");
+        // The map is far from the identity, so both checks can fail.
+        assert!(
+            (exact.matrix() - DMatrix::identity(4, 4)).amax() > 1e-2,
+            "{name}"
+        );
+        let defect = exact.symplecticity_defect();
+        assert!(defect < 1e-12, "{name}: ‖AᵀJA − J‖ = {defect:e}");
+    }
+}
+
+/// A pendulum with viscous damping `−c v` and a constant torque `u`.
+struct DampedPendulum {
+    c: f64,
+}
+
+impl DiracSystem<1> for DampedPendulum {
+    const FORCES: bool = true;
+    const INPUTS: usize = 1;
+
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+        v[0] * v[0] * 0.5 + q[0].cos()
+    }
+
+    fn force<D: Scalar>(
+        &self,
+        q: &SVector<D, 1>,
+        v: &SVector<D, 1>,
+        _t: f64,
+        u: &[f64],
+    ) -> SVector<D, 1> {
+        // Depends on q too, so that ∂F/∂q enters.
+        SVector::from([v[0] * (-self.c) * (q[0].cos() * 0.5 + 1.0) + u[0]])
+    }
+}
+
+#[test]
+fn forced_derivatives_match_central_differences() {
+    for quadrature in scenes::quadratures() {
+        let make = || {
+            let mut stepper =
+                Stepper::new(DampedPendulum { c: 0.7 }, quadrature.clone(), 0.1).unwrap();
+            stepper.set_input("u0", 0.3).unwrap();
+            stepper
+        };
+        let (exact, difference) = compare(&make, vector![0.8], vector![-1.2]);
+        let name = quadrature.name();
+        assert!(difference < 1e-7, "{name}: {difference:e}");
+        // Damping contracts phase-space area: det A < 1, by more than the differences' error.
+        let det = exact.matrix().determinant();
+        assert!(det < 1.0 - 1e-3, "{name}: det A = {det}");
+    }
+}
+
+#[test]
+fn one_degree_of_freedom_preserves_area() {
+    for quadrature in scenes::quadratures() {
+        let make = || Stepper::new(DampedPendulum { c: 0.0 }, quadrature.clone(), 0.2).unwrap();
+        let (exact, difference) = compare(&make, vector![2.5], vector![0.4]);
+        let det = exact.matrix().determinant();
+        assert!(difference < 1e-7, "{}: {difference:e}", quadrature.name());
+        assert!(
+            (det - 1.0).abs() < 1e-14,
+            "{}: det A = {det}",
+            quadrature.name()
+        );
+    }
+}
+
+#[test]
+fn a_linearised_step_is_the_same_step() {
+    let mut plain = double_pendulum::stepper(Quadrature::gauss(2).unwrap(), 0.01).unwrap();
+    let mut linearised = plain.clone();
+    for _ in 0..100 {
+        plain.step().unwrap();
+        linearised.step_linearised().unwrap();
+    }
+    assert_eq!((plain.q(), plain.p()), (linearised.q(), linearised.p()));
+}
+
+#[test]
+fn models_not_covered_yet_are_refused_and_keep_their_state() {
+    let mut knife = knife_edge::stepper(ConstraintPoint::Midpoint, 0.01).unwrap();
+    let before = (knife.q(), knife.p(), knife.steps());
+    let error = knife.step_linearised().expect_err("constrained");
+    assert!(matches!(error, DiracError::Unsupported(_)), "{error}");
+    assert!(error.to_string().contains("constrained"), "{error}");
+    assert_eq!(before, (knife.q(), knife.p(), knife.steps()));
+    let mut positive = Stepper::on_space(
+        DampedPendulum { c: 0.0 },
+        Positive,
+        Quadrature::midpoint(),
+        0.1,
+    )
+    .unwrap();
+    positive
+        .start_from_velocity(vector![1.0], vector![0.0])
+        .unwrap();
+    let error = positive.step_linearised().expect_err("not Rⁿ");
+    assert!(matches!(error, DiracError::Unsupported(_)), "{error}");
+    assert_eq!(positive.steps(), 0);
+}
