@@ -210,3 +210,20 @@ fn constraints_are_read_in_the_chart() {
     constrained_order_in_the_chart(|| Hyperbola, "holonomic");
     constrained_order_in_the_chart(|| HyperbolaOneForm, "one-form");
 }
+
+#[test]
+fn a_start_outside_the_space_is_refused() {
+    let mut stepper =
+        Stepper::on_space(Wall { c: 0.0 }, Positive, Quadrature::midpoint(), 0.01).unwrap();
+    for q0 in [-1.0, 0.0] {
+        let error = stepper
+            .start_from_velocity(vector![q0], vector![1.0])
+            .expect_err("not in R₊");
+        assert!(
+            matches!(error, DiracError::InconsistentInitialState(_)),
+            "{error}"
+        );
+        assert!(error.to_string().contains("Positive"), "{error}");
+    }
+    assert!(stepper.state().is_none());
+}

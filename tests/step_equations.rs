@@ -9,6 +9,9 @@
 //! Its step is the Cayley transform of the generator, a rotation of `(ω q, p)` by
 //! `θ = 2 atan(hω/2)`: after `n` steps the state is known in closed form, and `H` is conserved.
 
+#[path = "../examples/scenes/mod.rs"]
+mod scenes;
+
 use dirac::nalgebra::{DMatrix, DVector};
 use dirac::newton::{Newton, NewtonFailure};
 use dirac::prelude::*;
@@ -209,4 +212,22 @@ fn a_lagrangian_stepper_continues_from_another_steppers_state() {
     assert!((first.q() - second.q()).amax() < 1e-12);
     assert!((first.p() - second.p()).amax() < 1e-12);
     assert_eq!(first.t(), second.t());
+}
+
+#[test]
+fn the_lagrangian_equations_validate_what_the_stepper_would() {
+    use dirac::euler_lagrange::EulerLagrange;
+    // A constrained model with internal points, and a negative step, are refused by the
+    // equations themselves, so Stepper::with_equations cannot bypass the checks.
+    let discrete =
+        DiscreteLagrangian::new(scenes::circuit::LC, Quadrature::gauss(2).unwrap(), 0.01);
+    assert!(matches!(
+        EulerLagrange::new(discrete),
+        Err(DiracError::InvalidQuadrature(_))
+    ));
+    let discrete = DiscreteLagrangian::new(Pendulum, Quadrature::midpoint(), -0.1);
+    assert!(matches!(
+        EulerLagrange::new(discrete),
+        Err(DiracError::InvalidStep { .. })
+    ));
 }

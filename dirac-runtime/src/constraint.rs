@@ -142,8 +142,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraint
             }
             let (g, form) = holonomic_in_chart(system, space, base, &step, b);
             residual[col] = g;
+            // Round-off of g at q_{k+1}: |dg(q_{k+1})| |q_{k+1}| in the model's coordinates.
             let end_point = space.retract(base, &step);
-            scale = scale.max(form.abs().dot(&end_point.abs()).max(g.abs()));
+            let model_form = if C::TRANSLATION {
+                form
+            } else {
+                holonomic(system, &end_point, b).1
+            };
+            scale = scale.max(model_form.abs().dot(&end_point.abs()).max(g.abs()));
             for j in 0..N {
                 jacobian[(col, step_col + j)] = form[j];
             }

@@ -127,7 +127,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
             .map(|q| self.space.local(&points[0], q))
             .collect::<Option<Vec<_>>>()
             .ok_or_else(|| {
-                DiracError::Dimension("a point of the step lies outside the chart at Q_0".into())
+                DiracError::OutsideChart("a point of the step lies outside the chart at Q_0".into())
             })?;
         let chart = self.in_chart(&points[0]);
         Ok((0..self.quadrature.nodes().len())

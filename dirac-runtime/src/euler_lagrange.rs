@@ -45,7 +45,7 @@ use crate::system::DiracSystem;
 /// }
 /// // Galerkin with 3 points per step: two internal points and q_{k+1}, one coordinate each.
 /// let discrete = DiscreteLagrangian::new(Oscillator, Quadrature::gauss(3)?, 0.1);
-/// let equations = EulerLagrange::new(discrete);
+/// let equations = EulerLagrange::new(discrete)?;
 /// assert_eq!(equations.unknowns(), 3);
 /// assert_eq!(equations.unknown_name(2), "q0 (q_{k+1})");
 /// # Ok::<(), dirac_runtime::DiracError>(())
@@ -69,11 +69,36 @@ pub struct EulerLagrange<S, const N: usize, C> {
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<S, N, C> {
     /// The equations of `discrete`, with the constraint one-forms evaluated at the system's
-    /// [`constraint_point`](DiracSystem::constraint_point) and every input at 0.
-    pub fn new(discrete: DiscreteLagrangian<S, N, C>) -> Self {
-        let s = discrete.quadrature().degree();
+    /// [`constraint_point`](DiracSystem::constraint_point) and every input at 0. Fails on a
+    /// non-positive or non-finite step, a non-finite parameter, or a constrained system with a
+    /// quadrature of degree above 1 (constraints are imposed on the step's end points only).
+    pub fn new(discrete: DiscreteLagrangian<S, N, C>) -> Result<Self, DiracError> {
+        let h = discrete.h();
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(DiracError::InvalidStep { h });
+        }
+        if let Some((name, value)) = discrete
+            .system()
+            .parameters()
+            .into_iter()
+            .find(|(_, v)| !v.is_finite())
+        {
+            return Err(DiracError::NonFinite {
+                what: format!("parameter {name}"),
+                value,
+            });
+        }
+        let quadrature = discrete.quadrature();
+        if Self::constrained() && quadrature.degree() > 1 {
+            return Err(DiracError::InvalidQuadrature(format!(
+                "{} has internal points, but constraints are imposed on a step's end points only; \
+                 use a degree-1 quadrature (midpoint or trapezoid) for a constrained system",
+                quadrature.name()
+            )));
+        }
+        let s = quadrature.degree();
         let point = discrete.system().constraint_point();
-        Self {
+        Ok(Self {
             point,
             layout: Layout::new(N, s, S::ONE_FORMS, S::HOLONOMIC),
             inputs: vec![0.0; S::INPUTS],
@@ -85,7 +110,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
                 end: SVector::zeros(),
             },
             discrete,
-        }
+        })
     }
 
     /// The discrete Lagrangian.
@@ -159,6 +184,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         let system = self.discrete.system();
         let (q, p, v) = (&state.q, &state.p, &state.velocity);
         check_finite(system, "initial position", q)?;
+        let space = self.discrete.space();
+        if !space.contains(q) {
+            return Err(DiracError::InconsistentInitialState(format!(
+                "the initial position {:?} is not a point of the configuration space {space:?}",
+                q.as_slice()
+            )));
+        }
         check_finite(system, "initial momentum", p)?;
         check_finite(system, "initial velocity", v)?;
         let lagrangian = system.lagrangian(q, v);

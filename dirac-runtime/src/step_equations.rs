@@ -88,7 +88,8 @@ impl<const N: usize> State<N> {
 /// [`Stepper`](crate::Stepper) drives any implementation ([`Stepper::with_equations`]) with the
 /// same Newton solve, error handling, trajectories and guarantees (a failed step changes
 /// nothing). `tests/step_equations.rs` drives the implicit midpoint rule of a Hamiltonian this
-/// way.
+/// way. The guarantee holds as long as `predict` and `assemble` keep only per-step scratch in
+/// `&mut self`: anything that must survive a step belongs in the [`State`].
 ///
 /// [`Stepper::with_equations`]: crate::Stepper::with_equations
 pub trait StepEquations<const N: usize> {

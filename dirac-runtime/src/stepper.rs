@@ -26,6 +26,15 @@ use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
 use crate::trajectory::{Interrupted, Trajectory};
 
+/// Which solve a Newton failure comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Problem {
+    /// The step equations.
+    Step,
+    /// The velocity at a state (the Legendre inversion).
+    Velocity,
+}
+
 /// A solved step, not yet current: the new state, how Newton went, the constraint violation.
 #[derive(Debug, Clone, Copy)]
 struct Proposal<const N: usize> {
@@ -108,28 +117,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         quadrature: Quadrature,
         h: f64,
     ) -> Result<Self, DiracError> {
-        if !(h > 0.0 && h.is_finite()) {
-            return Err(DiracError::InvalidStep { h });
-        }
-        if let Some((name, value)) = system
-            .parameters()
-            .into_iter()
-            .find(|(_, v)| !v.is_finite())
-        {
-            return Err(DiracError::NonFinite {
-                what: format!("parameter {name}"),
-                value,
-            });
-        }
-        if S::ONE_FORMS + S::HOLONOMIC > 0 && quadrature.degree() > 1 {
-            return Err(DiracError::InvalidQuadrature(format!(
-                "{} has internal points, but constraints are imposed on a step's end points only; \
-                 use a degree-1 quadrature (midpoint or trapezoid) for a constrained system",
-                quadrature.name()
-            )));
-        }
         let discrete = DiscreteLagrangian::on_space(system, space, quadrature, h);
-        Self::with_equations(EulerLagrange::new(discrete))
+        Self::with_equations(EulerLagrange::new(discrete)?)
     }
 
     /// Evaluates the constraint one-forms at `point` of each step instead of the system's default.
@@ -251,6 +240,14 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// A stepper that solves `equations` on each step, with default Newton options.
     pub fn with_equations(equations: E) -> Result<Self, DiracError> {
         let unknowns = equations.unknowns();
+        if equations.first_multiplier() + equations.multipliers() > unknowns {
+            return Err(DiracError::Dimension(format!(
+                "{}: multipliers {}..{} outside the {unknowns} unknowns",
+                E::NAME,
+                equations.first_multiplier(),
+                equations.first_multiplier() + equations.multipliers()
+            )));
+        }
         let newton = Newton::new(unknowns, NewtonOptions::default())?;
         Ok(Self {
             multipliers: vec![0.0; equations.multipliers()],
@@ -295,12 +292,18 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let mut newton = Newton::new(N, options)?;
         self.equations
             .velocity(&mut newton, q, p, guess)
-            .map_err(|f| self.failure(E::VELOCITY, f))
+            .map_err(|f| self.failure(Problem::Velocity, f))
     }
 
     /// Starts from `state` after the equations have checked it (see
     /// [`StepEquations::check_start`]); on error nothing changes.
     pub fn start_from_state(&mut self, state: State<N>) -> Result<(), DiracError> {
+        if !state.t.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: "the initial time".into(),
+                value: state.t,
+            });
+        }
         self.equations.check_start(&state)?;
         self.reset(state);
         Ok(())
@@ -344,7 +347,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let result = self.newton.solve(&mut self.unknowns, |x, r, j| {
             equations.assemble(&state, x, r, j)
         });
-        let report = result.map_err(|f| self.failure(E::NAME, f))?;
+        let report = result.map_err(|f| self.failure(Problem::Step, f))?;
         let (mut next, violation) = self.equations.advance(&state, &self.unknowns, self.steps)?;
         next.t = self.start + (self.steps + 1) as f64 * self.equations.h();
         Ok(Proposal {
@@ -440,14 +443,16 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// Multipliers of the last step: one per constraint one-form, then one per holonomic
-    /// constraint. `A(q_c)ᵀ μ + dg(q_k)ᵀ λ` is the constraint impulse over the step (the
-    /// constraint force times `h`). Empty for an unconstrained system; zeros before the first step.
+    /// constraint. `Ãᵀ μ + dg̃ᵀ λ` is the constraint impulse over the step (the constraint force
+    /// times `h`) in the chart at `q_k`; on `Rⁿ`, `A(q_c)ᵀ μ + dg(q_k)ᵀ λ`. Empty for an
+    /// unconstrained system; zeros before the first step.
     pub fn multipliers(&self) -> &[f64] {
         &self.multipliers
     }
 
-    /// Largest constraint violation of the last step: `|A(q_c)(q_{k+1} − q_k)|` over the
-    /// one-forms and `|g(q_{k+1})|` over the holonomic constraints (0 before the first step).
+    /// Largest constraint violation of the last step: `|Ã(ξ_c) ξ|` over the one-forms, with
+    /// `ξ = R_{q_k}⁻¹(q_{k+1})` the stored step in the chart (on `Rⁿ`, `|A(q_c)(q_{k+1} − q_k)|`),
+    /// and `|g(q_{k+1})|` over the holonomic constraints (0 before the first step).
     pub fn constraint_violation(&self) -> f64 {
         self.violation
     }
@@ -531,7 +536,11 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// Turns a Newton failure into an error naming the step and, if singular, the unknowns.
-    fn failure(&self, problem: &'static str, failure: NewtonFailure) -> DiracError {
+    fn failure(&self, which: Problem, failure: NewtonFailure) -> DiracError {
+        let problem = match which {
+            Problem::Step => E::NAME,
+            Problem::Velocity => E::VELOCITY,
+        };
         match failure {
             NewtonFailure::NoConvergence {
                 residual,
@@ -551,7 +560,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                     .involved
                     .iter()
                     .map(|&column| {
-                        if problem == E::VELOCITY {
+                        if which == Problem::Velocity {
                             format!("{} (velocity)", self.equations.coordinate_name(column))
                         } else {
                             self.equations.unknown_name(column)
@@ -570,7 +579,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                 contraction,
                 max_contraction: self.newton.options().max_contraction,
             },
-            NewtonFailure::NonFinite if problem == E::VELOCITY => DiracError::NonFinite {
+            NewtonFailure::NonFinite if which == Problem::Velocity => DiracError::NonFinite {
                 what: format!(
                     "the residual of {problem} after {} steps (the velocity iterate left the \
                      Lagrangian's domain; start_from_momentum_near takes a guess inside it)",
