@@ -33,7 +33,7 @@ impl DiracSystem<1> for Wall {
         _q: &SVector<D, 1>,
         v: &SVector<D, 1>,
         _t: f64,
-        _inputs: &[f64],
+        _inputs: &[D],
     ) -> SVector<D, 1> {
         v.map(|x| x * (-self.c))
     }

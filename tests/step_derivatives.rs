@@ -56,7 +56,8 @@ fn compare<S: DiracSystem<N>, const N: usize>(
     stepper.start_from_momentum(q, p).expect("a valid state");
     let exact = stepper.step_linearised().expect("derivatives");
     let differences = central_differences(make, q, p, 1e-5);
-    (exact, (exact.matrix() - differences).amax())
+    let difference = (exact.matrix() - differences).amax();
+    (exact, difference)
 }
 
 /// A state of the double pendulum with large velocities (150 steps from the scene's start).
@@ -85,7 +86,8 @@ fn double_pendulum_derivatives_match_central_differences_and_are_symplectic() {
     }
 }
 
-/// A pendulum with viscous damping `−c v` and a constant torque `u`.
+/// A pendulum with position-dependent viscous damping and a torque `u · (1 + q²/4)` (an input
+/// that enters nonlinearly through the state).
 struct DampedPendulum {
     c: f64,
 }
@@ -103,10 +105,12 @@ impl DiracSystem<1> for DampedPendulum {
         q: &SVector<D, 1>,
         v: &SVector<D, 1>,
         _t: f64,
-        u: &[f64],
+        u: &[D],
     ) -> SVector<D, 1> {
         // Depends on q too, so that ∂F/∂q enters.
-        SVector::from([v[0] * (-self.c) * (q[0].cos() * 0.5 + 1.0) + u[0]])
+        SVector::from([
+            v[0] * (-self.c) * (q[0].cos() * 0.5 + 1.0) + u[0] * (q[0] * q[0] * 0.25 + 1.0)
+        ])
     }
 }
 
@@ -122,6 +126,29 @@ fn forced_derivatives_match_central_differences() {
         let (exact, difference) = compare(&make, vector![0.8], vector![-1.2]);
         let name = quadrature.name();
         assert!(difference < 1e-7, "{name}: {difference:e}");
+        // B = ∂(q_{k+1}, p_{k+1})/∂u against central differences in the input.
+        let step_with = |u: f64| {
+            let mut stepper = make();
+            stepper.set_input("u0", u).unwrap();
+            stepper
+                .start_from_momentum(vector![0.8], vector![-1.2])
+                .unwrap();
+            stepper.step().unwrap();
+            vector![stepper.q()[0], stepper.p()[0]]
+        };
+        let delta = 1e-5;
+        let b = (step_with(0.3 + delta) - step_with(0.3 - delta)) / (2.0 * delta);
+        let exact_b = exact.input_matrix();
+        assert_eq!(exact_b.shape(), (2, 1));
+        assert!(
+            (exact_b[(0, 0)] - b[0]).abs() < 1e-8,
+            "{name}: {exact_b} vs {b}"
+        );
+        assert!(
+            (exact_b[(1, 0)] - b[1]).abs() < 1e-8,
+            "{name}: {exact_b} vs {b}"
+        );
+        assert!(b[1].abs() > 1e-2, "the input moves the state");
         // Damping contracts phase-space area: det A < 1, by more than the differences' error.
         let det = exact.matrix().determinant();
         assert!(det < 1.0 - 1e-3, "{name}: det A = {det}");

@@ -153,7 +153,7 @@ fn input_bindings(model: &Model) -> TokenStream {
         .inputs
         .iter()
         .enumerate()
-        .map(|(i, u)| quote!(let #u: f64 = __inputs[#i];));
+        .map(|(i, u)| quote!(let #u: __D = __inputs[#i];));
     quote!(#(#inputs)*)
 }
 
@@ -171,7 +171,7 @@ fn parts(model: &Model, n: &TokenStream, bindings: &dyn Fn(bool) -> TokenStream)
                 let state = bindings(true);
                 let inputs = input_bindings(model);
                 (
-                    quote!(__q: #vector, __v: #vector, t: f64, __inputs: &[f64],),
+                    quote!(__q: #vector, __v: #vector, t: f64, __inputs: &[__D],),
                     quote!(#state #inputs),
                 )
             }
@@ -279,7 +279,7 @@ fn dirac_items(
                 __q: &::dirac::nalgebra::SVector<__D, #n>,
                 __v: &::dirac::nalgebra::SVector<__D, #n>,
                 t: f64,
-                __inputs: &[f64],
+                __inputs: &[__D],
             ) -> ::dirac::nalgebra::SVector<__D, #n> {
                 #state
                 #inputs

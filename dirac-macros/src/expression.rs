@@ -66,6 +66,9 @@ pub enum Class {
 /// Where an expression stands.
 pub struct Scope<'a> {
     pub coordinates: &'a [Coordinate],
+    /// The model's inputs where they may appear (forces), as dual numbers: the step's
+    /// derivatives with respect to them are exact.
+    pub inputs: &'a [Ident],
     /// The struct's fields (a reserved one is reported on the field, not where it is used).
     pub fields: &'a [Ident],
     /// `None` where velocities are allowed, else what to say when `dot(...)` appears.
@@ -692,8 +695,8 @@ impl<'a> Rewriter<'a> {
         }
     }
 
-    /// A coordinate is a dual number; every other name or path (parameters, `const`s,
-    /// `std::f64::consts::PI`, inputs, `t`) a constant.
+    /// A coordinate or an input is a dual number; every other name or path (parameters,
+    /// `const`s, `std::f64::consts::PI`, `t`) a constant.
     fn path(&mut self, p: &syn::ExprPath, expr: &Expr) -> Piece {
         let tokens = p.to_token_stream();
         let span = bounds(expr).0;
@@ -708,6 +711,9 @@ impl<'a> Rewriter<'a> {
                 ident.span(),
                 "write a parameter by its name, e.g. `m` for the field `m`",
             );
+        }
+        if self.scope.inputs.contains(ident) {
+            return Piece::atom(tokens, Class::Dual, span);
         }
         match self.coordinate(ident).map(|c| &c.length) {
             None => Piece::atom(tokens, Class::Constant, span),

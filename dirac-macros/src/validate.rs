@@ -243,6 +243,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         Some(coordinates) => {
             let positions = Scope {
                 coordinates,
+                inputs: &[],
                 fields: &fields,
                 no_velocities: Some(
                     "constraints depend on positions only: dot(...) cannot appear here",
@@ -265,6 +266,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 .collect();
             let state = Scope {
                 coordinates,
+                inputs: &inputs,
                 fields: &fields,
                 no_velocities: None,
                 elsewhere: "",
@@ -365,6 +367,7 @@ fn lagrangian_of(
     let fields: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
     let scope = Scope {
         coordinates,
+        inputs: &[],
         fields: &fields,
         no_velocities: None,
         elsewhere: "; for other code write a generic function and give \

@@ -353,7 +353,7 @@ mod tests {
             q: &SVector<D, 2>,
             v: &SVector<D, 2>,
             _t: f64,
-            _inputs: &[f64],
+            _inputs: &[D],
         ) -> SVector<D, 2> {
             SVector::from([v[0] * (q[1] * -0.2), v[1] * -0.1 + q[0] * 0.05])
         }

@@ -18,6 +18,7 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::configuration_space::{ConfigurationSpace, StepCovectors};
 use crate::constraint::{self, ConstraintPoint, StepConstraints};
+use crate::derivatives::Dual;
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
 use crate::initial_state;
@@ -57,6 +58,8 @@ pub struct EulerLagrange<S, const N: usize, C> {
     layout: Layout,
     /// Current values of the system's inputs.
     inputs: Vec<f64>,
+    /// The inputs as constant dual numbers, for the step's force evaluations (set per step).
+    lifted_inputs: Vec<Dual<N>>,
     /// `p_k` read in the chart at `q_k`, for the step being solved.
     momentum: SVector<f64, N>,
     /// The holonomic impulse directions of the step being solved (constant over the step).
@@ -102,6 +105,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
             point,
             layout: Layout::new(N, s, S::ONE_FORMS, S::HOLONOMIC),
             inputs: vec![0.0; S::INPUTS],
+            lifted_inputs: vec![Dual::from(0.0); S::INPUTS],
             momentum: SVector::zeros(),
             holonomic_forms: vec![SVector::zeros(); S::HOLONOMIC],
             increments: vec![SVector::zeros(); s],
@@ -231,6 +235,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             }
         }
         self.momentum = space.pull_back(&state.q, &SVector::zeros(), &state.p);
+        for (lifted, &u) in self.lifted_inputs.iter_mut().zip(&self.inputs) {
+            *lifted = Dual::from(u);
+        }
         if S::HOLONOMIC > 0 {
             constraint::holonomic_forms(
                 self.discrete.system(),
@@ -264,7 +271,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 &state.q,
                 &self.increments,
                 state.t,
-                &self.inputs,
+                &self.lifted_inputs,
                 residual,
                 jacobian,
             );
@@ -364,7 +371,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     /// By the implicit function theorem on the rows `R_j = δ_j0 p_k + ∂L_d/∂ξ_j + f_j`
     /// (`j < s`) with `G_jm = ∂(∂L_d/∂ξ_j + f_j)/∂ξ_m` (`j, m = 0..=s`): moving `q_k` at fixed
     /// `ξ` moves every point of the step, so `∂R_j/∂q_k = Σ_m G_jm`, and `∂R_j/∂p_k = δ_j0 I`.
-    /// Then `q_{k+1} = q_k + ξ_s` and `p_{k+1} = ∂L_d/∂ξ_s + f_s` are differentiated along.
+    /// Then `q_{k+1} = q_k + ξ_s` and `p_{k+1} = ∂L_d/∂ξ_s + f_s` are differentiated along. The
+    /// inputs enter through the forces only: `∂R_j/∂u = ∂f_j/∂u`.
     /// On `Rⁿ` for models without constraints; others are refused with `Unsupported`.
     fn linearise(
         &self,
@@ -422,6 +430,34 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                     .copy_from(&(-column.fixed_rows::<N>(self.layout.point(m))));
             }
         }
+        // ∂ξ/∂u: −J⁻¹ ∂R/∂u, with ∂R_j/∂u the forces' input derivatives.
+        let inputs = self.inputs.len();
+        let force_u = if S::FORCES && inputs > 0 {
+            discrete.force_input_derivatives(&state.q, &increments, state.t, &self.inputs)
+        } else {
+            vec![DMatrix::zeros(N, inputs); s + 1]
+        };
+        let mut xi_u = vec![DMatrix::zeros(N, inputs); s + 1];
+        for m in 0..inputs {
+            column.fill(0.0);
+            for (j, force) in force_u.iter().take(s).enumerate() {
+                column
+                    .rows_mut(self.layout.point(j + 1), N)
+                    .copy_from(&force.column(m));
+            }
+            newton.solve_factorised(&mut column);
+            for (k, target) in xi_u.iter_mut().enumerate().skip(1) {
+                target
+                    .column_mut(m)
+                    .copy_from(&(-column.fixed_rows::<N>(self.layout.point(k))));
+            }
+        }
+        let q_u = xi_u[s].clone();
+        let mut p_u = force_u[s].clone();
+        for m in 1..=s {
+            let g_sm = DMatrix::from_column_slice(N, N, g[s][m].as_slice());
+            p_u += g_sm * &xi_u[m];
+        }
         let q_q = SMatrix::identity() + xi_q[s];
         let q_p = xi_p[s];
         let along = |xi: &[SMatrix<f64, N, N>]| -> SMatrix<f64, N, N> {
@@ -429,8 +465,16 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         };
         let p_q = moving_all(s) + along(&xi_q);
         let p_p = along(&xi_p);
-        let derivatives = StepDerivatives { q_q, q_p, p_q, p_p };
-        if derivatives.matrix().iter().all(|v| v.is_finite()) {
+        let derivatives = StepDerivatives {
+            q_q,
+            q_p,
+            p_q,
+            p_p,
+            q_u,
+            p_u,
+        };
+        let finite = |m: &DMatrix<f64>| m.iter().all(|v| v.is_finite());
+        if finite(&derivatives.matrix()) && finite(&derivatives.input_matrix()) {
             Ok(derivatives)
         } else {
             Err(DiracError::NonFinite {

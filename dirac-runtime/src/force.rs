@@ -6,6 +6,8 @@
 use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
 
 use crate::configuration_space::{ConfigurationSpace, StepCovectors};
+use num_dual::Dual64;
+
 use crate::derivatives::{Dual, lift};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::system::DiracSystem;
@@ -19,7 +21,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         base: &SVector<f64, N>,
         increments: &[SVector<f64, N>],
         t: f64,
-        inputs: &[f64],
+        inputs: &[Dual<N>],
         residual: &mut DVector<f64>,
         jacobian: &mut DMatrix<f64>,
     ) -> (StepCovectors<N>, f64) {
@@ -75,6 +77,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         let quad = self.quadrature();
         let (h, s) = (self.h(), quad.degree());
         let mut blocks = vec![vec![SMatrix::<f64, N, N>::zeros(); s + 1]; s + 1];
+        let inputs: Vec<Dual<N>> = inputs.iter().map(|&u| Dual::from(u)).collect();
+        let inputs = &inputs[..];
         let jacobian = |f: SVector<Dual<N>, N>| {
             SMatrix::<f64, N, N>::from_fn(|m, l| f[m].eps.unwrap_generic(Const::<N>, U1)[l])
         };
@@ -97,6 +101,40 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
                 for (m, block) in row.iter_mut().enumerate() {
                     *block += (f_q * quad.ell(i, m) + f_v * (quad.ell_prime(i, m) / h))
                         * (w * quad.ell(i, j));
+                }
+            }
+        }
+        blocks
+    }
+
+    /// The forces' derivatives in the inputs, `∂f_j/∂u` (`j = 0..=s`, `N × inputs` each):
+    /// `h Σ_i b_i ℓ_j(c_i) ∂F/∂u` at the nodes, one input direction at a time.
+    pub(crate) fn force_input_derivatives(
+        &self,
+        base: &SVector<f64, N>,
+        increments: &[SVector<f64, N>],
+        t: f64,
+        inputs: &[f64],
+    ) -> Vec<DMatrix<f64>> {
+        let quad = self.quadrature();
+        let (h, s) = (self.h(), quad.degree());
+        let mut blocks = vec![DMatrix::zeros(N, inputs.len()); s + 1];
+        for (i, (&b, &c)) in quad.weights().iter().zip(quad.nodes()).enumerate() {
+            let w = h * b;
+            let (xi, xi_dot) = self.node(i, increments);
+            let q = (base + xi).map(Dual64::from);
+            let v = xi_dot.map(Dual64::from);
+            for m in 0..inputs.len() {
+                let seeded: Vec<Dual64> = inputs
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &u)| Dual64::new(u, if k == m { 1.0 } else { 0.0 }))
+                    .collect();
+                let f = self.system().force(&q, &v, t + c * h, &seeded);
+                for (j, block) in blocks.iter_mut().enumerate() {
+                    for r in 0..N {
+                        block[(r, m)] += f[r].eps * (w * quad.ell(i, j));
+                    }
                 }
             }
         }

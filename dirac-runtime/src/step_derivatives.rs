@@ -8,7 +8,8 @@
 
 use nalgebra::{DMatrix, SMatrix};
 
-/// `A_k = ∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)` of one step, by blocks.
+/// `A_k = ∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)` of one step, by blocks, and
+/// `B_k = ∂(q_{k+1}, p_{k+1})/∂u_k` for the model's inputs (held over the step).
 ///
 /// ```
 /// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
@@ -31,7 +32,7 @@ use nalgebra::{DMatrix, SMatrix};
 /// assert!(a.symplecticity_defect() < 1e-15);
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct StepDerivatives<const N: usize> {
     /// `∂q_{k+1}/∂q_k`.
     pub q_q: SMatrix<f64, N, N>,
@@ -41,6 +42,10 @@ pub struct StepDerivatives<const N: usize> {
     pub p_q: SMatrix<f64, N, N>,
     /// `∂p_{k+1}/∂p_k`.
     pub p_p: SMatrix<f64, N, N>,
+    /// `∂q_{k+1}/∂u` (`N × inputs`).
+    pub q_u: DMatrix<f64>,
+    /// `∂p_{k+1}/∂u` (`N × inputs`).
+    pub p_u: DMatrix<f64>,
 }
 
 impl<const N: usize> StepDerivatives<N> {
@@ -52,6 +57,15 @@ impl<const N: usize> StepDerivatives<N> {
         a.view_mut((N, 0), (N, N)).copy_from(&self.p_q);
         a.view_mut((N, N), (N, N)).copy_from(&self.p_p);
         a
+    }
+
+    /// The `2N × inputs` matrix `B = [[q_u], [p_u]]`.
+    pub fn input_matrix(&self) -> DMatrix<f64> {
+        let inputs = self.q_u.ncols();
+        let mut b = DMatrix::zeros(2 * N, inputs);
+        b.view_mut((0, 0), (N, inputs)).copy_from(&self.q_u);
+        b.view_mut((N, 0), (N, inputs)).copy_from(&self.p_u);
+        b
     }
 
     /// `‖AᵀJA − J‖∞` with `J = [[0, I], [−I, 0]]`: zero to round-off for a symplectic step (a

@@ -63,13 +63,14 @@ pub trait DiracSystem<const N: usize> {
     }
 
     /// The force one-form `F(q, v, t, u)` (generalised forces, e.g. `−r q̇_l dq_l` for a
-    /// resistor), with the inputs' current values in `inputs`.
+    /// resistor), with the inputs' current values in `inputs`. The inputs are of the same scalar
+    /// type as `q` and `v`, so that the derivatives of a step with respect to them are exact.
     fn force<D: Scalar>(
         &self,
         q: &SVector<D, N>,
         v: &SVector<D, N>,
         t: f64,
-        inputs: &[f64],
+        inputs: &[D],
     ) -> SVector<D, N> {
         let _ = (q, v, t, inputs);
         SVector::zeros()
