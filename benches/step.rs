@@ -97,11 +97,43 @@ fn constrained(c: &mut Criterion) {
     group.finish();
 }
 
+/// trep's double pendulum (m = l = 1, g = 9.81, both links horizontal at rest, midpoint,
+/// h = 0.01): a step, and a step with the first derivatives of the step map (`A` by the implicit
+/// function theorem), beside `../shared/peers/trep/double_pendulum.sh`'s step + first derivatives.
+fn step_derivatives(c: &mut Criterion) {
+    let mut group = c.benchmark_group("double_pendulum_trep_scene");
+    let model = double_pendulum::DoublePendulum {
+        m1: 1.0,
+        m2: 1.0,
+        l1: 1.0,
+        l2: 1.0,
+        g: 9.81,
+    };
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    let start = |stepper: &mut Stepper<double_pendulum::DoublePendulum, 2>| {
+        stepper
+            .start_from_velocity(vector![half_pi, half_pi], SVector::zeros())
+            .expect("finite start");
+    };
+    let mut plain = Stepper::new(model, Quadrature::midpoint(), 0.01).expect("valid scene");
+    start(&mut plain);
+    group.bench_function("step", |b| {
+        b.iter(|| black_box(plain.step()).expect("step"))
+    });
+    let mut linearised = Stepper::new(model, Quadrature::midpoint(), 0.01).expect("valid scene");
+    start(&mut linearised);
+    group.bench_function("step_and_first_derivatives", |b| {
+        b.iter(|| black_box(linearised.step_linearised()).expect("step"))
+    });
+    group.finish();
+}
+
 criterion_group!(
     benches,
     generated_vs_hand,
     quadratures,
     chain_growth,
-    constrained
+    constrained,
+    step_derivatives
 );
 criterion_main!(benches);

@@ -407,7 +407,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 }
             }
         }
-        let moving_all = |j: usize| -> SMatrix<f64, N, N> { g[j].iter().sum() };
+        let moving_all: Vec<SMatrix<f64, N, N>> = g.iter().map(|row| row.iter().sum()).collect();
         // ∂ξ/∂q_k and ∂ξ/∂p_k, one column at a time: −J⁻¹ ∂R/∂(q_k, p_k).
         let mut xi_q = vec![SMatrix::<f64, N, N>::zeros(); s + 1];
         let mut xi_p = vec![SMatrix::<f64, N, N>::zeros(); s + 1];
@@ -417,7 +417,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             for j in 0..s {
                 let rows = self.layout.point(j + 1);
                 if c < N {
-                    column.rows_mut(rows, N).copy_from(&moving_all(j).column(c));
+                    column.rows_mut(rows, N).copy_from(&moving_all[j].column(c));
                 } else if j == 0 {
                     column[c - N] = 1.0;
                 }
@@ -432,38 +432,38 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         }
         // ∂ξ/∂u: −J⁻¹ ∂R/∂u, with ∂R_j/∂u the forces' input derivatives.
         let inputs = self.inputs.len();
-        let force_u = if S::FORCES && inputs > 0 {
-            discrete.force_input_derivatives(&state.q, &increments, state.t, &self.inputs)
-        } else {
-            vec![DMatrix::zeros(N, inputs); s + 1]
-        };
-        let mut xi_u = vec![DMatrix::zeros(N, inputs); s + 1];
-        for m in 0..inputs {
-            column.fill(0.0);
-            for (j, force) in force_u.iter().take(s).enumerate() {
-                column
-                    .rows_mut(self.layout.point(j + 1), N)
-                    .copy_from(&force.column(m));
+        let (mut q_u, mut p_u) = (DMatrix::zeros(N, inputs), DMatrix::zeros(N, inputs));
+        if S::FORCES && inputs > 0 {
+            let force_u =
+                discrete.force_input_derivatives(&state.q, &increments, state.t, &self.inputs);
+            let mut xi_u = vec![DMatrix::zeros(N, inputs); s + 1];
+            for m in 0..inputs {
+                column.fill(0.0);
+                for (j, force) in force_u.iter().take(s).enumerate() {
+                    column
+                        .rows_mut(self.layout.point(j + 1), N)
+                        .copy_from(&force.column(m));
+                }
+                newton.solve_factorised(&mut column);
+                for (k, target) in xi_u.iter_mut().enumerate().skip(1) {
+                    target
+                        .column_mut(m)
+                        .copy_from(&(-column.fixed_rows::<N>(self.layout.point(k))));
+                }
             }
-            newton.solve_factorised(&mut column);
-            for (k, target) in xi_u.iter_mut().enumerate().skip(1) {
-                target
-                    .column_mut(m)
-                    .copy_from(&(-column.fixed_rows::<N>(self.layout.point(k))));
+            q_u.copy_from(&xi_u[s]);
+            p_u.copy_from(&force_u[s]);
+            for (m, xi) in xi_u.iter().enumerate().skip(1) {
+                let g_sm = DMatrix::from_column_slice(N, N, g[s][m].as_slice());
+                p_u += g_sm * xi;
             }
-        }
-        let q_u = xi_u[s].clone();
-        let mut p_u = force_u[s].clone();
-        for m in 1..=s {
-            let g_sm = DMatrix::from_column_slice(N, N, g[s][m].as_slice());
-            p_u += g_sm * &xi_u[m];
         }
         let q_q = SMatrix::identity() + xi_q[s];
         let q_p = xi_p[s];
         let along = |xi: &[SMatrix<f64, N, N>]| -> SMatrix<f64, N, N> {
             (1..=s).map(|m| g[s][m] * xi[m]).sum()
         };
-        let p_q = moving_all(s) + along(&xi_q);
+        let p_q = moving_all[s] + along(&xi_q);
         let p_p = along(&xi_p);
         let derivatives = StepDerivatives {
             q_q,
@@ -473,8 +473,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             q_u,
             p_u,
         };
-        let finite = |m: &DMatrix<f64>| m.iter().all(|v| v.is_finite());
-        if finite(&derivatives.matrix()) && finite(&derivatives.input_matrix()) {
+        let blocks = [&q_q, &q_p, &p_q, &p_p];
+        let finite = blocks.iter().all(|b| b.iter().all(|v| v.is_finite()))
+            && derivatives
+                .q_u
+                .iter()
+                .chain(derivatives.p_u.iter())
+                .all(|v| v.is_finite());
+        if finite {
             Ok(derivatives)
         } else {
             Err(DiracError::NonFinite {
