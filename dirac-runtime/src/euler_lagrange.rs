@@ -414,13 +414,15 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         let mut column = DVector::zeros(self.layout.len());
         for c in 0..2 * N {
             column.fill(0.0);
-            for j in 0..s {
-                let rows = self.layout.point(j + 1);
-                if c < N {
-                    column.rows_mut(rows, N).copy_from(&moving_all[j].column(c));
-                } else if j == 0 {
-                    column[c - N] = 1.0;
+            if c < N {
+                // ∂R_j/∂q_k: every point of the step moves with q_k.
+                for (j, total) in moving_all.iter().take(s).enumerate() {
+                    let rows = self.layout.point(j + 1);
+                    column.rows_mut(rows, N).copy_from(&total.column(c));
                 }
+            } else {
+                // ∂R_0/∂p_k = I.
+                column[c - N] = 1.0;
             }
             newton.solve_factorised(&mut column);
             for m in 1..=s {
