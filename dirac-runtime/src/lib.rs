@@ -6,7 +6,8 @@
 //! [`quadrature`] → [`discrete_lagrangian`] (slot derivatives in the chart), `force` (discrete
 //! Lagrange–d'Alembert forces) and [`constraint`] (multiplier rows) → [`euler_lagrange`] (the
 //! step's residual, unknowns and update, behind the [`step_equations`] seam) → [`newton`] →
-//! [`stepper`] → [`trajectory`]. Every derivative of the model's functions is taken by dual
+//! [`stepper`] → [`trajectory`], with [`step_derivatives`] (the step map's derivatives by the
+//! implicit function theorem). Every derivative of the model's functions is taken by dual
 //! numbers in one private module, `derivatives`.
 #![warn(missing_docs)]
 
