@@ -5,9 +5,11 @@
 #[path = "../examples/scenes/mod.rs"]
 mod scenes;
 
-use dirac::StepDerivatives;
-use dirac::nalgebra::DMatrix;
+use dirac::euler_lagrange::EulerLagrange;
+use dirac::nalgebra::{DMatrix, DVector};
+use dirac::newton::Newton;
 use dirac::prelude::*;
+use dirac::{State, StepDerivatives, StepEquations};
 use scenes::{double_pendulum, knife_edge};
 
 /// One step from `(q, p)` as a map, and its matrix of central differences with step `delta`.
@@ -181,14 +183,154 @@ fn a_linearised_step_is_the_same_step() {
     assert_eq!((plain.q(), plain.p()), (linearised.q(), linearised.p()));
 }
 
+/// One step of `equations` from any `(q, p)`, through the public step-equations API (no start
+/// checks, so perturbations off the constraint manifold are allowed): the new state, and the
+/// exact derivatives at the solution.
+fn raw_step<S: DiracSystem<N>, const N: usize>(
+    equations: &mut EulerLagrange<S, N, Euclidean>,
+    q: SVector<f64, N>,
+    p: SVector<f64, N>,
+    v: SVector<f64, N>,
+) -> (SVector<f64, N>, SVector<f64, N>, StepDerivatives<N>) {
+    let state = State::new(0.0, q, p, v);
+    let mut x = DVector::zeros(equations.unknowns());
+    equations.predict(&state, None, &mut x);
+    let options = NewtonOptions {
+        max_contraction: f64::INFINITY,
+        ..Default::default()
+    };
+    let mut newton = Newton::new(equations.unknowns(), options).unwrap();
+    newton
+        .solve(&mut x, |x, r, j| equations.assemble(&state, x, r, j))
+        .expect("step");
+    let (next, _) = equations.advance(&state, &x, 0).unwrap();
+    let derivatives = equations.linearise(&state, &x, &newton).unwrap();
+    (*next.q(), *next.p(), derivatives)
+}
+
+/// The exact A (and B, for one input `u`) of a constrained model at a state of its own run,
+/// against central differences of raw steps.
+fn constrained_case<S: DiracSystem<N> + Clone, const N: usize>(
+    name: &str,
+    system: S,
+    mut stepper: Stepper<S, N>,
+    u: Option<f64>,
+) {
+    stepper.run(40).unwrap();
+    let state = *stepper.state().unwrap();
+    let (q, p, v) = (*state.q(), *state.p(), *state.velocity_hint());
+    let point = stepper.constraint_point();
+    let make = |u: f64| {
+        let discrete = DiscreteLagrangian::new(system.clone(), Quadrature::midpoint(), stepper.h());
+        let mut equations = EulerLagrange::new(discrete).unwrap();
+        equations.set_constraint_point(point);
+        if S::INPUTS > 0 {
+            equations.set_inputs(&[u]).unwrap();
+        }
+        equations
+    };
+    let u0 = u.unwrap_or(0.0);
+    let (_, _, exact) = raw_step(&mut make(u0), q, p, v);
+    let delta = 1e-5;
+    let mut worst = 0.0_f64;
+    let a = exact.matrix();
+    for c in 0..2 * N {
+        let (mut qp, mut pp, mut qm, mut pm) = (q, p, q, p);
+        if c < N {
+            qp[c] += delta;
+            qm[c] -= delta;
+        } else {
+            pp[c - N] += delta;
+            pm[c - N] -= delta;
+        }
+        let (q1p, p1p, _) = raw_step(&mut make(u0), qp, pp, v);
+        let (q1m, p1m, _) = raw_step(&mut make(u0), qm, pm, v);
+        for r in 0..N {
+            worst = worst.max((a[(r, c)] - (q1p[r] - q1m[r]) / (2.0 * delta)).abs());
+            worst = worst.max((a[(N + r, c)] - (p1p[r] - p1m[r]) / (2.0 * delta)).abs());
+        }
+    }
+    assert!(
+        worst < 1e-7,
+        "{name} ({point:?}): A differs from central differences by {worst:e}"
+    );
+    assert!(
+        (a.clone() - DMatrix::identity(2 * N, 2 * N)).amax() > 1e-3,
+        "{name}"
+    );
+    if let Some(u) = u {
+        let (q1p, p1p, _) = raw_step(&mut make(u + delta), q, p, v);
+        let (q1m, p1m, _) = raw_step(&mut make(u - delta), q, p, v);
+        let b = exact.input_matrix();
+        for r in 0..N {
+            let dq = (q1p[r] - q1m[r]) / (2.0 * delta);
+            let dp = (p1p[r] - p1m[r]) / (2.0 * delta);
+            assert!((b[(r, 0)] - dq).abs() < 1e-7, "{name}: B row {r}");
+            assert!((b[(N + r, 0)] - dp).abs() < 1e-7, "{name}: B row {}", N + r);
+        }
+        assert!(b.amax() > 1e-3, "{name}: the input moves the state");
+    }
+}
+
+#[test]
+fn constrained_derivatives_match_central_differences() {
+    use scenes::{cartesian_pendulum, circuit};
+    for point in [
+        ConstraintPoint::Start,
+        ConstraintPoint::Midpoint,
+        ConstraintPoint::End,
+    ] {
+        // Each stepper evaluates the one-form at its own point; the raw steps use the same.
+        let stepper = knife_edge::stepper(point, 0.01).unwrap();
+        if point == stepper.constraint_point() {
+            constrained_case("knife edge", knife_edge::SCENE, stepper, None);
+        }
+    }
+    let mut pendulum =
+        Stepper::new(cartesian_pendulum::SCENE, Quadrature::midpoint(), 0.05).unwrap();
+    pendulum
+        .start_from_velocity(cartesian_pendulum::q0(1.0), SVector::zeros())
+        .unwrap();
+    constrained_case(
+        "Cartesian pendulum",
+        cartesian_pendulum::SCENE,
+        pendulum,
+        None,
+    );
+    let mut lc = Stepper::new(circuit::LC, Quadrature::midpoint(), 0.05).unwrap();
+    lc.start_from_velocity(circuit::q0(), SVector::zeros())
+        .unwrap();
+    constrained_case("LC circuit", circuit::LC, lc, None);
+    let mut rlc = Stepper::new(circuit::RLC, Quadrature::midpoint(), 0.05).unwrap();
+    rlc.start_from_velocity(circuit::q0(), SVector::zeros())
+        .unwrap();
+    rlc.set_input("u", 0.4).unwrap();
+    constrained_case("RLC circuit", circuit::RLC, rlc, Some(0.4));
+}
+
+#[test]
+fn holonomic_steps_keep_the_constraint_to_first_order() {
+    // g(q_{k+1}) = 0 whatever (q_k, p_k): dg(q_{k+1}) ∂q_{k+1}/∂(q_k, p_k) = 0.
+    use scenes::cartesian_pendulum;
+    let mut stepper =
+        Stepper::new(cartesian_pendulum::SCENE, Quadrature::midpoint(), 0.05).unwrap();
+    stepper
+        .start_from_velocity(cartesian_pendulum::q0(1.0), SVector::zeros())
+        .unwrap();
+    stepper.run(10).unwrap();
+    let a = stepper.step_linearised().unwrap();
+    let q = stepper.q();
+    let dg = vector![2.0 * q[0], 2.0 * q[1]];
+    let along = dg.transpose() * a.q_q;
+    let across = dg.transpose() * a.q_p;
+    assert!(
+        along.amax() < 1e-12 && across.amax() < 1e-12,
+        "{along} {across}"
+    );
+}
+
 #[test]
 fn models_not_covered_yet_are_refused_and_keep_their_state() {
-    let mut knife = knife_edge::stepper(ConstraintPoint::Midpoint, 0.01).unwrap();
-    let before = (knife.q(), knife.p(), knife.steps());
-    let error = knife.step_linearised().expect_err("constrained");
-    assert!(matches!(error, DiracError::Unsupported(_)), "{error}");
-    assert!(error.to_string().contains("constrained"), "{error}");
-    assert_eq!(before, (knife.q(), knife.p(), knife.steps()));
     let mut positive = Stepper::on_space(
         DampedPendulum { c: 0.0 },
         Positive,

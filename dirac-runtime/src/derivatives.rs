@@ -117,6 +117,29 @@ pub(crate) fn seeded<F: PhaseFunction<N>, const N: usize>(
     }
 }
 
+/// The Hessian `∂²g_b/∂q²` of holonomic constraint `b` at `q`, by hyper-dual numbers.
+pub(crate) fn holonomic_hessian<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    b: usize,
+) -> SMatrix<f64, N, N> {
+    type H<const N: usize> = HyperDualSVec64<N, N>;
+    let lifted = SVector::<H<N>, N>::from_fn(|c, _| {
+        let eps1 = SVector::<f64, N>::from_fn(|i, _| if i == c { 1.0 } else { 0.0 });
+        let eps2 = SMatrix::<f64, 1, N>::from_fn(|_, i| if i == c { 1.0 } else { 0.0 });
+        H::<N>::new(
+            q[c],
+            Derivative::some(eps1),
+            Derivative::some(eps2),
+            Derivative::none(),
+        )
+    });
+    system
+        .holonomic(&lifted, b)
+        .eps1eps2
+        .unwrap_generic(Const::<N>, Const::<N>)
+}
+
 /// `ℓ(ξ, ξ̇)` seeded along `x` and `y`: for a translation chart, `L` at `q_k + ξ` seeded
 /// directly.
 #[inline]

@@ -137,6 +137,26 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         &self.inputs
     }
 
+    /// Sets every input, in the order of the system's inputs; fails on the wrong number of
+    /// values or a value that is not finite, and then changes nothing.
+    pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
+        if values.len() != S::INPUTS {
+            return Err(DiracError::UnknownInput(format!(
+                "the system has {} input(s), got {} value(s)",
+                S::INPUTS,
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(DiracError::NonFinite {
+                what: format!("input {}", self.discrete.system().input_name(i)),
+                value: values[i],
+            });
+        }
+        self.inputs.copy_from_slice(values);
+        Ok(())
+    }
+
     /// Input values, in the order of the system's inputs (checked by the stepper).
     pub(crate) fn inputs_mut(&mut self) -> &mut [f64] {
         &mut self.inputs
@@ -368,34 +388,34 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         legendre::energy(self.discrete.system(), q, v)
     }
 
-    /// By the implicit function theorem on the rows `R_j = δ_j0 p_k + ∂L_d/∂ξ_j + f_j`
-    /// (`j < s`) with `G_jm = ∂(∂L_d/∂ξ_j + f_j)/∂ξ_m` (`j, m = 0..=s`): moving `q_k` at fixed
-    /// `ξ` moves every point of the step, so `∂R_j/∂q_k = Σ_m G_jm`, and `∂R_j/∂p_k = δ_j0 I`.
-    /// Then `q_{k+1} = q_k + ξ_s` and `p_{k+1} = ∂L_d/∂ξ_s + f_s` are differentiated along. The
-    /// inputs enter through the forces only: `∂R_j/∂u = ∂f_j/∂u`.
-    /// On `Rⁿ` for models without constraints; others are refused with `Unsupported`.
+    /// By the implicit function theorem on the step's rows `R(x; q_k, p_k, u) = 0` with
+    /// `x = [ξ_1..ξ_s, μ, λ]` and Newton's factorised KKT matrix `J = ∂R/∂x`:
+    /// `∂x/∂z = −J⁻¹ ∂R/∂z` for `z = (q_k, p_k, u)`. With `G_jm = ∂(∂L_d/∂ξ_j + f_j)/∂ξ_m`
+    /// (`j, m = 0..=s`), moving `q_k` at fixed `ξ` moves every point of the step, so the
+    /// Euler–Lagrange rows have `∂R_j/∂q_k = Σ_m G_jm`; row 0 also carries the constraint
+    /// impulses `σ A(q_c)ᵀμ + dg(q_k)ᵀλ`, whose `q_k`-derivatives are `σ Σ μ_a ∂A_a` and
+    /// `Σ λ_b ∂²g_b`; the one-form rows `A(q_c) ξ_s` give `ξ_sᵀ ∂A_a`, the holonomic rows
+    /// `g(q_k + ξ_s)` give `dg`; `∂R_0/∂p_k = I`; the inputs enter through the forces,
+    /// `∂R_j/∂u = ∂f_j/∂u`. Then `q_{k+1} = q_k + ξ_s` and
+    /// `p_{k+1} = ∂L_d/∂ξ_s + f_s + (1 − σ) A(q_c)ᵀμ` are differentiated along. On `Rⁿ`;
+    /// other spaces are refused with `Unsupported`.
     fn linearise(
         &self,
         state: &State<N>,
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<StepDerivatives<N>, DiracError> {
-        if Self::constrained() {
-            return Err(DiracError::Unsupported(
-                "derivatives of the step map of a constrained model (they need the projection \
-                 onto the constraint manifold, not written yet)"
-                    .into(),
-            ));
-        }
         if !C::TRANSLATION {
             return Err(DiracError::Unsupported(
                 "derivatives of the step map on a configuration space other than Rⁿ".into(),
             ));
         }
         let discrete = &self.discrete;
-        let s = self.layout.points();
+        let system = discrete.system();
+        let layout = &self.layout;
+        let s = layout.points();
         let increments: Vec<SVector<f64, N>> = (1..=s)
-            .map(|j| x.fixed_rows::<N>(self.layout.point(j)).into_owned())
+            .map(|j| x.fixed_rows::<N>(layout.point(j)).into_owned())
             .collect();
         let mut g = discrete.slot_hessian(&state.q, &increments);
         if S::FORCES {
@@ -408,88 +428,110 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             }
         }
         let moving_all: Vec<SMatrix<f64, N, N>> = g.iter().map(|row| row.iter().sum()).collect();
-        // ∂ξ/∂q_k and ∂ξ/∂p_k, one column at a time: −J⁻¹ ∂R/∂(q_k, p_k).
-        let mut xi_q = vec![SMatrix::<f64, N, N>::zeros(); s + 1];
-        let mut xi_p = vec![SMatrix::<f64, N, N>::zeros(); s + 1];
-        let mut column = DVector::zeros(self.layout.len());
-        for c in 0..2 * N {
-            column.fill(0.0);
-            if c < N {
-                // ∂R_j/∂q_k: every point of the step moves with q_k.
-                for (j, total) in moving_all.iter().take(s).enumerate() {
-                    let rows = self.layout.point(j + 1);
-                    column.rows_mut(rows, N).copy_from(&total.column(c));
-                }
-            } else {
-                // ∂R_0/∂p_k = I.
-                column[c - N] = 1.0;
-            }
-            newton.solve_factorised(&mut column);
-            for m in 1..=s {
-                let target = if c < N { &mut xi_q[m] } else { &mut xi_p[m] };
-                target
-                    .column_mut(c % N)
-                    .copy_from(&(-column.fixed_rows::<N>(self.layout.point(m))));
-            }
-        }
-        // ∂ξ/∂u: −J⁻¹ ∂R/∂u, with ∂R_j/∂u the forces' input derivatives.
         let inputs = self.inputs.len();
-        let (mut q_u, mut p_u) = (DMatrix::zeros(N, inputs), DMatrix::zeros(N, inputs));
-        if S::FORCES && inputs > 0 {
-            let force_u =
-                discrete.force_input_derivatives(&state.q, &increments, state.t, &self.inputs);
-            let mut xi_u = vec![DMatrix::zeros(N, inputs); s + 1];
-            for m in 0..inputs {
-                column.fill(0.0);
-                for (j, force) in force_u.iter().take(s).enumerate() {
-                    column
-                        .rows_mut(self.layout.point(j + 1), N)
-                        .copy_from(&force.column(m));
-                }
-                newton.solve_factorised(&mut column);
-                for (k, target) in xi_u.iter_mut().enumerate().skip(1) {
-                    target
-                        .column_mut(m)
-                        .copy_from(&(-column.fixed_rows::<N>(self.layout.point(k))));
-                }
-            }
-            q_u.copy_from(&xi_u[s]);
-            p_u.copy_from(&force_u[s]);
-            for (m, xi) in xi_u.iter().enumerate().skip(1) {
-                let g_sm = DMatrix::from_column_slice(N, N, g[s][m].as_slice());
-                p_u += g_sm * xi;
-            }
-        }
-        let q_q = SMatrix::identity() + xi_q[s];
-        let q_p = xi_p[s];
-        let along = |xi: &[SMatrix<f64, N, N>]| -> SMatrix<f64, N, N> {
-            (1..=s).map(|m| g[s][m] * xi[m]).sum()
-        };
-        let p_q = moving_all[s] + along(&xi_q);
-        let p_p = along(&xi_p);
-        let derivatives = StepDerivatives {
-            q_q,
-            q_p,
-            p_q,
-            p_p,
-            q_u,
-            p_u,
-        };
-        let blocks = [&q_q, &q_p, &p_q, &p_p];
-        let finite = blocks.iter().all(|b| b.iter().all(|v| v.is_finite()))
-            && derivatives
-                .q_u
-                .iter()
-                .chain(derivatives.p_u.iter())
-                .all(|v| v.is_finite());
-        if finite {
-            Ok(derivatives)
+        let force_u = if S::FORCES && inputs > 0 {
+            discrete.force_input_derivatives(&state.q, &increments, state.t, &self.inputs)
         } else {
-            Err(DiracError::NonFinite {
+            Vec::new()
+        };
+        // The constraints at the solution: A_a(q_c), ∂A_a(q_c), μ, and dg_b, ∂²g_b, λ.
+        let (theta, share) = (self.point.theta(), self.point.share());
+        let xi_s = increments[s - 1];
+        let q_c = state.q + xi_s * theta;
+        let one_forms: Vec<_> = (0..S::ONE_FORMS)
+            .map(|a| constraint::one_form(system, &q_c, a))
+            .collect();
+        let mu: Vec<f64> = (0..S::ONE_FORMS).map(|a| x[layout.one_form(a)]).collect();
+        let lambda: Vec<f64> = (0..S::HOLONOMIC).map(|b| x[layout.holonomic(b)]).collect();
+        // Σ_a μ_a ∂A_a(q_c): how the one-form impulse turns with q_c.
+        let turning: SMatrix<f64, N, N> = one_forms
+            .iter()
+            .zip(&mu)
+            .map(|((_, derivative), mu)| derivative * *mu)
+            .sum();
+        let curvature: SMatrix<f64, N, N> = (0..S::HOLONOMIC)
+            .map(|b| crate::derivatives::holonomic_hessian(system, &state.q, b) * lambda[b])
+            .sum();
+        // ∂R/∂z, one column per parameter: q_k (N), p_k (N), u (inputs).
+        let n = layout.len();
+        let parameters = 2 * N + inputs;
+        let mut dr = DMatrix::zeros(n, parameters);
+        for (j, total) in moving_all.iter().take(s).enumerate() {
+            let mut block = total.clone_owned();
+            if j == 0 {
+                block += turning * share + curvature;
+            }
+            dr.view_mut((layout.point(j + 1), 0), (N, N))
+                .copy_from(&block);
+        }
+        for i in 0..N {
+            dr[(i, N + i)] = 1.0;
+        }
+        for (j, force) in force_u.iter().take(s).enumerate() {
+            dr.view_mut((layout.point(j + 1), 2 * N), (N, inputs))
+                .copy_from(force);
+        }
+        for (a, (_, derivative)) in one_forms.iter().enumerate() {
+            let row = derivative.transpose() * xi_s;
+            dr.view_mut((layout.one_form(a), 0), (1, N))
+                .copy_from(&row.transpose());
+        }
+        for b in 0..S::HOLONOMIC {
+            let (_, form) = constraint::holonomic(system, &(state.q + xi_s), b);
+            dr.view_mut((layout.holonomic(b), 0), (1, N))
+                .copy_from(&form.transpose());
+        }
+        // ∂x/∂z = −J⁻¹ ∂R/∂z.
+        let mut dx = DMatrix::zeros(n, parameters);
+        let mut column = DVector::zeros(n);
+        for c in 0..parameters {
+            column.copy_from(&dr.column(c));
+            newton.solve_factorised(&mut column);
+            dx.set_column(c, &(-&column));
+        }
+        // q_{k+1} = q_k + ξ_s.
+        let mut dq = dx.rows(layout.end_point(), N).clone_owned();
+        for i in 0..N {
+            dq[(i, i)] += 1.0;
+        }
+        // p_{k+1} = ∂L_d/∂ξ_s + f_s + (1 − σ) A(q_c)ᵀμ.
+        let mut dp = DMatrix::zeros(N, parameters);
+        let to_dynamic = |m: &SMatrix<f64, N, N>| DMatrix::from_column_slice(N, N, m.as_slice());
+        let end_turning = turning * (1.0 - share);
+        dp.view_mut((0, 0), (N, N))
+            .copy_from(&(moving_all[s] + end_turning));
+        if let Some(force) = force_u.get(s) {
+            dp.view_mut((0, 2 * N), (N, inputs)).copy_from(force);
+        }
+        for (m, g_sm) in g[s].iter().enumerate().skip(1) {
+            // q_c moves with the end point by θ.
+            let block = if m == s {
+                g_sm + end_turning * theta
+            } else {
+                *g_sm
+            };
+            dp += to_dynamic(&block) * dx.rows(layout.point(m), N);
+        }
+        for (a, (row, _)) in one_forms.iter().enumerate() {
+            dp += (row * (1.0 - share)) * dx.row(layout.one_form(a));
+        }
+        if !(dq.iter().chain(dp.iter()).all(|v| v.is_finite())) {
+            return Err(DiracError::NonFinite {
                 what: "a derivative of the step map".into(),
                 value: f64::NAN,
-            })
+            });
         }
+        let block = |m: &DMatrix<f64>, c: usize| -> SMatrix<f64, N, N> {
+            SMatrix::from_fn(|i, j| m[(i, c + j)])
+        };
+        Ok(StepDerivatives {
+            q_q: block(&dq, 0),
+            q_p: block(&dq, N),
+            p_q: block(&dp, 0),
+            p_p: block(&dp, N),
+            q_u: dq.columns(2 * N, inputs).clone_owned(),
+            p_u: dp.columns(2 * N, inputs).clone_owned(),
+        })
     }
 }
 

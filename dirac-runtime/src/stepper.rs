@@ -198,21 +198,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
 
     /// Sets every input at once, in the order of the system's `inputs(...)`.
     pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
-        if values.len() != S::INPUTS {
-            return Err(DiracError::UnknownInput(format!(
-                "the system has {} input(s), got {} value(s)",
-                S::INPUTS,
-                values.len()
-            )));
-        }
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(DiracError::NonFinite {
-                what: format!("input {}", self.system().input_name(i)),
-                value: values[i],
-            });
-        }
-        self.equations.inputs_mut().copy_from_slice(values);
-        Ok(())
+        self.equations.set_inputs(values)
     }
 
     /// Current input values.
