@@ -345,3 +345,57 @@ fn models_not_covered_yet_are_refused_and_keep_their_state() {
     assert!(matches!(error, DiracError::Unsupported(_)), "{error}");
     assert_eq!(positive.steps(), 0);
 }
+
+#[test]
+fn the_cart_pole_linearisation_is_the_cayley_transform_and_lqr_balances_it() {
+    use scenes::cart_pole::{self, SCENE};
+    let h = 0.01;
+    let cart_pole::Lqr { a, b, k } = cart_pole::linearisation_and_gain(h, 0.1).unwrap();
+    // At rest upright the midpoint step of the linearised Lagrangian (mass matrix M, stiffness
+    // m g l on θ, force u on x) is the implicit midpoint rule of ż = F z + G u:
+    // A = (I − hF/2)⁻¹ (I + hF/2), B = (I − hF/2)⁻¹ h G.
+    let mass = DMatrix::from_row_slice(
+        2,
+        2,
+        &[
+            SCENE.cart + SCENE.bob,
+            SCENE.bob * SCENE.l,
+            SCENE.bob * SCENE.l,
+            SCENE.bob * SCENE.l * SCENE.l,
+        ],
+    );
+    let mut f = DMatrix::zeros(4, 4);
+    f.view_mut((0, 2), (2, 2))
+        .copy_from(&mass.try_inverse().unwrap());
+    f[(3, 1)] = SCENE.bob * SCENE.g * SCENE.l;
+    let identity = DMatrix::<f64>::identity(4, 4);
+    let implicit = (&identity - &f * (h / 2.0)).try_inverse().unwrap();
+    let cayley = &implicit * (&identity + &f * (h / 2.0));
+    let mut g = DMatrix::zeros(4, 1);
+    g[(2, 0)] = h;
+    assert!((&a - &cayley).amax() < 1e-13, "A {a} vs {cayley}");
+    assert!((&b - &implicit * g).amax() < 1e-13, "B {b}");
+    // Upright is unstable open loop and stable with the gain.
+    let radius = |m: &DMatrix<f64>| {
+        m.complex_eigenvalues()
+            .iter()
+            .map(|e| e.norm())
+            .fold(0.0, f64::max)
+    };
+    assert!(radius(&a) > 1.05, "open loop {}", radius(&a));
+    assert!(
+        radius(&(&a - &b * &k)) < 0.999,
+        "closed loop {}",
+        radius(&(&a - &b * &k))
+    );
+    // The nonlinear closed loop from a 0.3 rad tilt settles.
+    let samples = cart_pole::closed_loop(h, 0.3, 1000).unwrap();
+    let last = samples.last().unwrap();
+    let (x, theta) = (last.x, last.theta);
+    assert!(theta.abs() < 1e-3 && x.abs() < 1e-2, "x = {x}, θ = {theta}");
+    let peak = samples.iter().map(|s| s.theta.abs()).fold(0.0, f64::max);
+    assert!(
+        (peak - 0.3).abs() < 1e-12,
+        "the tilt only decreases from its start: {peak}"
+    );
+}

@@ -1,12 +1,13 @@
 //! The tour's pictures: orders of convergence, energy errors over time, the knife edge's paths
-//! under the three discrete constraints, and the LC circuit against its closed form.
+//! under the three discrete constraints, the LC circuit against its closed form, and the
+//! cart-pole balanced by LQR on the step map's derivatives.
 
 use std::error::Error;
 
 use dirac::prelude::*;
 
 use super::plot::{Series, line_chart};
-use super::{circuit, double_pendulum, knife_edge, pendulum};
+use super::{cart_pole, circuit, double_pendulum, knife_edge, pendulum};
 
 /// Writes every figure to `output/` and returns their paths.
 pub fn draw_all() -> Result<Vec<&'static str>, Box<dyn Error>> {
@@ -16,7 +17,29 @@ pub fn draw_all() -> Result<Vec<&'static str>, Box<dyn Error>> {
         energy()?,
         knife_edge_paths()?,
         lc_circuit()?,
+        cart_pole_lqr()?,
     ])
+}
+
+/// The cart-pole from a 0.3 rad tilt under LQR feedback (midpoint, h = 0.01, T = 10).
+pub fn cart_pole_lqr() -> Result<&'static str, Box<dyn Error>> {
+    let path = "output/cart_pole_lqr.png";
+    let samples = cart_pole::closed_loop(0.01, 0.3, 1000)?;
+    let series = |label: &str, f: fn(&cart_pole::Sample) -> f64| Series {
+        label: label.into(),
+        points: samples.iter().map(|s| (s.t, f(s))).collect(),
+    };
+    line_chart(
+        path,
+        "Cart-pole balanced by LQR on the exact step derivatives (midpoint, h = 0.01)",
+        ("t", "state and input"),
+        &[
+            series("θ (rad)", |s| s.theta),
+            series("x (m)", |s| s.x),
+            series("u / 10 (N)", |s| s.u / 10.0),
+        ],
+    )?;
+    Ok(path)
 }
 
 /// log10 |error at T = 5| against log10 h for the pendulum, every quadrature.

@@ -2,6 +2,7 @@
 //! benches so that each model is written once.
 #![allow(dead_code)]
 
+pub mod cart_pole;
 pub mod cartesian_pendulum;
 pub mod chain;
 pub mod circuit;
