@@ -98,8 +98,9 @@ fn constrained(c: &mut Criterion) {
 }
 
 /// trep's double pendulum (m = l = 1, g = 9.81, both links horizontal at rest, midpoint,
-/// h = 0.01): a step, and a step with the first derivatives of the step map (`A` by the implicit
-/// function theorem), beside `../shared/peers/trep/double_pendulum.sh`'s step + first derivatives.
+/// h = 0.01): a step, a step with the first derivatives of the step map (`A` by the implicit
+/// function theorem), and with the first and second, beside
+/// `../shared/peers/trep/double_pendulum.sh`'s same three figures.
 fn step_derivatives(c: &mut Criterion) {
     let mut group = c.benchmark_group("double_pendulum_trep_scene");
     let model = double_pendulum::DoublePendulum {
@@ -124,6 +125,11 @@ fn step_derivatives(c: &mut Criterion) {
     start(&mut linearised);
     group.bench_function("step_and_first_derivatives", |b| {
         b.iter(|| black_box(linearised.step_linearised()).expect("step"))
+    });
+    let mut second = Stepper::new(model, Quadrature::midpoint(), 0.01).expect("valid scene");
+    start(&mut second);
+    group.bench_function("step_and_second_derivatives", |b| {
+        b.iter(|| black_box(second.step_second_order()).expect("step"))
     });
     group.finish();
 }

@@ -7,7 +7,7 @@
 //! configuration space ([`InChart`]), through the same [`PhaseFunction`].
 
 use nalgebra::{Const, SMatrix, SVector, U1};
-use num_dual::{Derivative, DualSVec64, HyperDualSVec64};
+use num_dual::{Derivative, DualSVec64, HyperDualSVec64, HyperHyperDual64};
 
 use crate::configuration_space::ConfigurationSpace;
 use crate::scalar::Scalar;
@@ -138,6 +138,25 @@ pub(crate) fn holonomic_hessian<S: DiracSystem<N>, const N: usize>(
         .holonomic(&lifted, b)
         .eps1eps2
         .unwrap_generic(Const::<N>, Const::<N>)
+}
+
+/// `D³L(q, v)` along three directions `(δq, δv)`, by hyper-hyper-dual numbers.
+pub(crate) fn third_derivative<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+    directions: [(SVector<f64, N>, SVector<f64, N>); 3],
+) -> f64 {
+    let [(q1, v1), (q2, v2), (q3, v3)] = directions;
+    let lift =
+        |x: &SVector<f64, N>, d1: &SVector<f64, N>, d2: &SVector<f64, N>, d3: &SVector<f64, N>| {
+            SVector::<HyperHyperDual64, N>::from_fn(|i, _| {
+                HyperHyperDual64::new(x[i], d1[i], d2[i], d3[i], 0.0, 0.0, 0.0, 0.0)
+            })
+        };
+    system
+        .lagrangian(&lift(q, &q1, &q2, &q3), &lift(v, &v1, &v2, &v3))
+        .eps1eps2eps3
 }
 
 /// `ℓ(ξ, ξ̇)` seeded along `x` and `y`: for a translation chart, `L` at `q_k + ξ` seeded

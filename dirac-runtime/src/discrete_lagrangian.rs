@@ -16,7 +16,7 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
-use crate::derivatives::{InChart, PhaseFunction, Seed, seeded_in_chart};
+use crate::derivatives::{InChart, PhaseFunction, Seed, seeded_in_chart, third_derivative};
 use crate::error::DiracError;
 use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
@@ -221,6 +221,34 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
 }
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagrangian<S, N, C> {
+    /// `D³L_d` along three displacements of the step's points (`d[k][m]` moves point `m`,
+    /// `m = 0..=s`), on a translation chart: `h Σ_i b_i D³L(q_i, v_i)` along the node
+    /// displacements `(Σ_m ℓ_m(c_i) d_m, Σ_m ℓ'_m(c_i) d_m / h)`.
+    pub(crate) fn slot_third(
+        &self,
+        base: &SVector<f64, N>,
+        increments: &[SVector<f64, N>],
+        d: [&[SVector<f64, N>]; 3],
+    ) -> f64 {
+        let (quad, h) = (&self.quadrature, self.h);
+        let mut total = 0.0;
+        for (i, &b) in quad.weights().iter().enumerate() {
+            let (xi, xi_dot) = self.node(i, increments);
+            let at_node = |points: &[SVector<f64, N>]| {
+                let mut dq = SVector::zeros();
+                let mut dv = SVector::zeros();
+                for (m, point) in points.iter().enumerate() {
+                    dq += point * quad.ell(i, m);
+                    dv += point * (quad.ell_prime(i, m) / h);
+                }
+                (dq, dv)
+            };
+            let directions = [at_node(d[0]), at_node(d[1]), at_node(d[2])];
+            total += h * b * third_derivative(&self.system, &(base + xi), &xi_dot, directions);
+        }
+        total
+    }
+
     /// Every second slot derivative `∂²L_d/∂ξ_j∂ξ_m` (`j, m = 0..=s`, `ξ_0 = 0`) at the step
     /// with points `ξ_1..ξ_s` from `base`, as blocks `[j][m]` (rows: the components of `ξ_j`).
     pub(crate) fn slot_hessian(

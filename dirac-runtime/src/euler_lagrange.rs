@@ -25,7 +25,7 @@ use crate::initial_state;
 use crate::layout::Layout;
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure};
-use crate::step_derivatives::StepDerivatives;
+use crate::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
 
@@ -164,6 +164,199 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
 
     fn constrained() -> bool {
         S::ONE_FORMS + S::HOLONOMIC > 0
+    }
+
+    /// Second derivatives of the step from `state` solved by `x` with respect to `(q_k, p_k)`,
+    /// `newton` holding the Jacobian factorised at `x`: for models on `Rⁿ` without constraints
+    /// or forces (others are refused with `Unsupported`). The step's points `Q_m` depend on
+    /// `z = (q_k, p_k)` through `Q_0 = q_k`, `Q_m = q_k + ξ_m`, and the rows
+    /// `R_j = δ_j0 p_k + ∂L_d/∂Q_j = 0` hold for every `z`; differentiating twice,
+    /// `D³L_d[e_j, dQ_a, dQ_b] + Σ_m G_jm ∂²ξ_m/∂z_a∂z_b = 0`, so
+    /// `∂²ξ = −J⁻¹ D³L_d[e_·, dQ_a, dQ_b]`, and `p_{k+1} = ∂L_d/∂Q_s` gives
+    /// `∂²p_{k+1} = D³L_d[e_s, dQ_a, dQ_b] + Σ_m G_sm ∂²ξ_m`.
+    pub fn second_derivatives(
+        &self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        newton: &Newton,
+    ) -> Result<StepHessians<N>, DiracError> {
+        if Self::constrained() || S::FORCES || !C::TRANSLATION {
+            return Err(DiracError::Unsupported(
+                "second derivatives of the step map of a model with constraints or forces, or \
+                 on a space other than Rⁿ"
+                    .into(),
+            ));
+        }
+        let Sensitivity {
+            g, dx, increments, ..
+        } = self.sensitivity(state, x, newton)?;
+        let layout = &self.layout;
+        let s = layout.points();
+        let unit = |i: usize| SVector::<f64, N>::from_fn(|r, _| if r == i { 1.0 } else { 0.0 });
+        // dQ_m/dz_a for every point m = 0..=s.
+        let moves: Vec<Vec<SVector<f64, N>>> = (0..2 * N)
+            .map(|a| {
+                let base = if a < N { unit(a) } else { SVector::zeros() };
+                (0..=s)
+                    .map(|m| match m {
+                        0 => base,
+                        _ => base + dx.column(a).fixed_rows::<N>(layout.point(m)),
+                    })
+                    .collect()
+            })
+            .collect();
+        // Point m moved along its component r.
+        let nudge = |m: usize, r: usize| -> Vec<SVector<f64, N>> {
+            (0..=s)
+                .map(|k| if k == m { unit(r) } else { SVector::zeros() })
+                .collect()
+        };
+        let discrete = &self.discrete;
+        let mut q = vec![DMatrix::zeros(2 * N, 2 * N); N];
+        let mut p = vec![DMatrix::zeros(2 * N, 2 * N); N];
+        let mut column = DVector::zeros(layout.len());
+        for a in 0..2 * N {
+            for b in a..2 * N {
+                let third = |m: usize, r: usize| {
+                    discrete.slot_third(&state.q, &increments, [&nudge(m, r), &moves[a], &moves[b]])
+                };
+                for j in 0..s {
+                    for r in 0..N {
+                        column[layout.point(j + 1) + r] = third(j, r);
+                    }
+                }
+                newton.solve_factorised(&mut column);
+                column.neg_mut();
+                let mut end = SVector::<f64, N>::from_fn(|r, _| third(s, r));
+                for (m, g_sm) in g[s].iter().enumerate().skip(1) {
+                    end += g_sm * column.fixed_rows::<N>(layout.point(m));
+                }
+                for r in 0..N {
+                    let q_ab = column[layout.end_point() + r];
+                    q[r][(a, b)] = q_ab;
+                    q[r][(b, a)] = q_ab;
+                    p[r][(a, b)] = end[r];
+                    p[r][(b, a)] = end[r];
+                }
+            }
+        }
+        if q.iter().chain(&p).all(|m| m.iter().all(|v| v.is_finite())) {
+            Ok(StepHessians { q, p })
+        } else {
+            Err(DiracError::NonFinite {
+                what: "a second derivative of the step map".into(),
+                value: f64::NAN,
+            })
+        }
+    }
+
+    /// The implicit function theorem's first half: `∂x/∂(q_k, p_k, u) = −J⁻¹ ∂R/∂(q_k, p_k, u)`
+    /// at the solution `x`, with what the new state's derivatives need besides (see
+    /// [`StepEquations::linearise`] for the terms).
+    fn sensitivity(
+        &self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        newton: &Newton,
+    ) -> Result<Sensitivity<N>, DiracError> {
+        if !C::TRANSLATION {
+            return Err(DiracError::Unsupported(
+                "derivatives of the step map on a configuration space other than Rⁿ".into(),
+            ));
+        }
+        let discrete = &self.discrete;
+        let system = discrete.system();
+        let layout = &self.layout;
+        let s = layout.points();
+        let increments: Vec<SVector<f64, N>> = (1..=s)
+            .map(|j| x.fixed_rows::<N>(layout.point(j)).into_owned())
+            .collect();
+        let mut g = discrete.slot_hessian(&state.q, &increments);
+        if S::FORCES {
+            let forces =
+                discrete.force_slot_derivatives(&state.q, &increments, state.t, &self.inputs);
+            for (row, force_row) in g.iter_mut().zip(forces) {
+                for (block, force) in row.iter_mut().zip(force_row) {
+                    *block += force;
+                }
+            }
+        }
+        let moving_all: Vec<SMatrix<f64, N, N>> = g.iter().map(|row| row.iter().sum()).collect();
+        let inputs = self.inputs.len();
+        let force_u = if S::FORCES && inputs > 0 {
+            discrete.force_input_derivatives(&state.q, &increments, state.t, &self.inputs)
+        } else {
+            Vec::new()
+        };
+        // The constraints at the solution: A_a(q_c), ∂A_a(q_c), μ, and dg_b, ∂²g_b, λ.
+        let (theta, share) = (self.point.theta(), self.point.share());
+        let xi_s = increments[s - 1];
+        let q_c = state.q + xi_s * theta;
+        let one_forms: Vec<_> = (0..S::ONE_FORMS)
+            .map(|a| constraint::one_form(system, &q_c, a))
+            .collect();
+        let mu: Vec<f64> = (0..S::ONE_FORMS).map(|a| x[layout.one_form(a)]).collect();
+        let lambda: Vec<f64> = (0..S::HOLONOMIC).map(|b| x[layout.holonomic(b)]).collect();
+        // Σ_a μ_a ∂A_a(q_c): how the one-form impulse turns with q_c.
+        let turning: SMatrix<f64, N, N> = one_forms
+            .iter()
+            .zip(&mu)
+            .map(|((_, derivative), mu)| derivative * *mu)
+            .sum();
+        let curvature: SMatrix<f64, N, N> = (0..S::HOLONOMIC)
+            .map(|b| crate::derivatives::holonomic_hessian(system, &state.q, b) * lambda[b])
+            .sum();
+        // ∂R/∂z, one column per parameter: q_k (N), p_k (N), u (inputs).
+        let n = layout.len();
+        let parameters = 2 * N + inputs;
+        let mut dr = DMatrix::zeros(n, parameters);
+        for (j, total) in moving_all.iter().take(s).enumerate() {
+            let mut block = total.clone_owned();
+            if j == 0 {
+                block += turning * share + curvature;
+            }
+            dr.view_mut((layout.point(j + 1), 0), (N, N))
+                .copy_from(&block);
+        }
+        for i in 0..N {
+            dr[(i, N + i)] = 1.0;
+        }
+        for (j, force) in force_u.iter().take(s).enumerate() {
+            dr.view_mut((layout.point(j + 1), 2 * N), (N, inputs))
+                .copy_from(force);
+        }
+        for (a, (_, derivative)) in one_forms.iter().enumerate() {
+            let row = derivative.transpose() * xi_s;
+            dr.view_mut((layout.one_form(a), 0), (1, N))
+                .copy_from(&row.transpose());
+        }
+        for b in 0..S::HOLONOMIC {
+            let (_, form) = constraint::holonomic(system, &(state.q + xi_s), b);
+            dr.view_mut((layout.holonomic(b), 0), (1, N))
+                .copy_from(&form.transpose());
+        }
+        // ∂x/∂z = −J⁻¹ ∂R/∂z.
+        let mut dx = DMatrix::zeros(n, parameters);
+        let mut column = DVector::zeros(n);
+        for c in 0..parameters {
+            column.copy_from(&dr.column(c));
+            newton.solve_factorised(&mut column);
+            dx.set_column(c, &(-&column));
+        }
+        Ok(Sensitivity {
+            g,
+            moving_all,
+            dx,
+            increments,
+            force_u,
+            end_rows: one_forms
+                .iter()
+                .map(|(row, _)| row * (1.0 - share))
+                .collect(),
+            end_turning: turning * (1.0 - share),
+            theta,
+            inputs,
+        })
     }
 }
 
@@ -405,90 +598,20 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<StepDerivatives<N>, DiracError> {
-        if !C::TRANSLATION {
-            return Err(DiracError::Unsupported(
-                "derivatives of the step map on a configuration space other than Rⁿ".into(),
-            ));
-        }
-        let discrete = &self.discrete;
-        let system = discrete.system();
+        let Sensitivity {
+            g,
+            moving_all,
+            dx,
+            force_u,
+            end_rows,
+            end_turning,
+            theta,
+            inputs,
+            ..
+        } = self.sensitivity(state, x, newton)?;
         let layout = &self.layout;
         let s = layout.points();
-        let increments: Vec<SVector<f64, N>> = (1..=s)
-            .map(|j| x.fixed_rows::<N>(layout.point(j)).into_owned())
-            .collect();
-        let mut g = discrete.slot_hessian(&state.q, &increments);
-        if S::FORCES {
-            let forces =
-                discrete.force_slot_derivatives(&state.q, &increments, state.t, &self.inputs);
-            for (row, force_row) in g.iter_mut().zip(forces) {
-                for (block, force) in row.iter_mut().zip(force_row) {
-                    *block += force;
-                }
-            }
-        }
-        let moving_all: Vec<SMatrix<f64, N, N>> = g.iter().map(|row| row.iter().sum()).collect();
-        let inputs = self.inputs.len();
-        let force_u = if S::FORCES && inputs > 0 {
-            discrete.force_input_derivatives(&state.q, &increments, state.t, &self.inputs)
-        } else {
-            Vec::new()
-        };
-        // The constraints at the solution: A_a(q_c), ∂A_a(q_c), μ, and dg_b, ∂²g_b, λ.
-        let (theta, share) = (self.point.theta(), self.point.share());
-        let xi_s = increments[s - 1];
-        let q_c = state.q + xi_s * theta;
-        let one_forms: Vec<_> = (0..S::ONE_FORMS)
-            .map(|a| constraint::one_form(system, &q_c, a))
-            .collect();
-        let mu: Vec<f64> = (0..S::ONE_FORMS).map(|a| x[layout.one_form(a)]).collect();
-        let lambda: Vec<f64> = (0..S::HOLONOMIC).map(|b| x[layout.holonomic(b)]).collect();
-        // Σ_a μ_a ∂A_a(q_c): how the one-form impulse turns with q_c.
-        let turning: SMatrix<f64, N, N> = one_forms
-            .iter()
-            .zip(&mu)
-            .map(|((_, derivative), mu)| derivative * *mu)
-            .sum();
-        let curvature: SMatrix<f64, N, N> = (0..S::HOLONOMIC)
-            .map(|b| crate::derivatives::holonomic_hessian(system, &state.q, b) * lambda[b])
-            .sum();
-        // ∂R/∂z, one column per parameter: q_k (N), p_k (N), u (inputs).
-        let n = layout.len();
         let parameters = 2 * N + inputs;
-        let mut dr = DMatrix::zeros(n, parameters);
-        for (j, total) in moving_all.iter().take(s).enumerate() {
-            let mut block = total.clone_owned();
-            if j == 0 {
-                block += turning * share + curvature;
-            }
-            dr.view_mut((layout.point(j + 1), 0), (N, N))
-                .copy_from(&block);
-        }
-        for i in 0..N {
-            dr[(i, N + i)] = 1.0;
-        }
-        for (j, force) in force_u.iter().take(s).enumerate() {
-            dr.view_mut((layout.point(j + 1), 2 * N), (N, inputs))
-                .copy_from(force);
-        }
-        for (a, (_, derivative)) in one_forms.iter().enumerate() {
-            let row = derivative.transpose() * xi_s;
-            dr.view_mut((layout.one_form(a), 0), (1, N))
-                .copy_from(&row.transpose());
-        }
-        for b in 0..S::HOLONOMIC {
-            let (_, form) = constraint::holonomic(system, &(state.q + xi_s), b);
-            dr.view_mut((layout.holonomic(b), 0), (1, N))
-                .copy_from(&form.transpose());
-        }
-        // ∂x/∂z = −J⁻¹ ∂R/∂z.
-        let mut dx = DMatrix::zeros(n, parameters);
-        let mut column = DVector::zeros(n);
-        for c in 0..parameters {
-            column.copy_from(&dr.column(c));
-            newton.solve_factorised(&mut column);
-            dx.set_column(c, &(-&column));
-        }
         // q_{k+1} = q_k + ξ_s.
         let mut dq = dx.rows(layout.end_point(), N).clone_owned();
         for i in 0..N {
@@ -497,7 +620,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         // p_{k+1} = ∂L_d/∂ξ_s + f_s + (1 − σ) A(q_c)ᵀμ.
         let mut dp = DMatrix::zeros(N, parameters);
         let to_dynamic = |m: &SMatrix<f64, N, N>| DMatrix::from_column_slice(N, N, m.as_slice());
-        let end_turning = turning * (1.0 - share);
         dp.view_mut((0, 0), (N, N))
             .copy_from(&(moving_all[s] + end_turning));
         if let Some(force) = force_u.get(s) {
@@ -512,8 +634,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             };
             dp += to_dynamic(&block) * dx.rows(layout.point(m), N);
         }
-        for (a, (row, _)) in one_forms.iter().enumerate() {
-            dp += (row * (1.0 - share)) * dx.row(layout.one_form(a));
+        for (a, row) in end_rows.iter().enumerate() {
+            dp += row * dx.row(layout.one_form(a));
         }
         if !(dq.iter().chain(dp.iter()).all(|v| v.is_finite())) {
             return Err(DiracError::NonFinite {
@@ -533,6 +655,23 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             p_u: dp.columns(2 * N, inputs).clone_owned(),
         })
     }
+}
+
+/// What [`EulerLagrange::linearise`](StepEquations::linearise) and the second derivatives share:
+/// the slot Hessian `G_jm` (forces included), its row sums (`q_k` moves every point), the
+/// unknowns' derivatives `dx` (columns `q_k`, `p_k`, `u`), and the end point's constraint terms.
+struct Sensitivity<const N: usize> {
+    g: Vec<Vec<SMatrix<f64, N, N>>>,
+    moving_all: Vec<SMatrix<f64, N, N>>,
+    dx: DMatrix<f64>,
+    increments: Vec<SVector<f64, N>>,
+    force_u: Vec<DMatrix<f64>>,
+    /// `(1 − σ) A_a(q_c)`: the end point's share of each one-form impulse direction.
+    end_rows: Vec<SVector<f64, N>>,
+    /// `(1 − σ) Σ_a μ_a ∂A_a(q_c)`.
+    end_turning: SMatrix<f64, N, N>,
+    theta: f64,
+    inputs: usize,
 }
 
 /// `Err(NonFinite)` naming the first coordinate of `x` that is not finite.

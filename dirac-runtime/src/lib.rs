@@ -40,7 +40,7 @@ pub use lu::SingularPivot;
 pub use newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 pub use quadrature::{Quadrature, Rule};
 pub use scalar::Scalar;
-pub use step_derivatives::StepDerivatives;
+pub use step_derivatives::{StepDerivatives, StepHessians};
 pub use step_equations::{State, StepEquations};
 pub use stepper::Stepper;
 pub use system::DiracSystem;

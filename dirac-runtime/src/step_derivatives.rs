@@ -80,3 +80,31 @@ impl<const N: usize> StepDerivatives<N> {
         (a.transpose() * &j * &a - j).amax()
     }
 }
+
+/// Second derivatives of one step with respect to `z = (q_k, p_k)`: for each output component,
+/// its `2N × 2N` Hessian, `q[i][(a, b)] = ∂²q_{k+1,i}/∂z_a∂z_b` and likewise `p`.
+///
+/// ```
+/// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+/// use nalgebra::{SVector, vector};
+///
+/// /// A linear oscillator: its step map is linear, so every second derivative vanishes.
+/// struct Oscillator;
+/// impl DiracSystem<1> for Oscillator {
+///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+///     }
+/// }
+/// let mut stepper = Stepper::new(Oscillator, Quadrature::gauss(2)?, 0.1)?;
+/// stepper.start_from_velocity(vector![1.0], vector![0.3])?;
+/// let (_, hessians) = stepper.step_second_order()?;
+/// assert!(hessians.q[0].amax() < 1e-14 && hessians.p[0].amax() < 1e-14);
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepHessians<const N: usize> {
+    /// `∂²q_{k+1,i}/∂z²` for `i = 0..N`.
+    pub q: Vec<DMatrix<f64>>,
+    /// `∂²p_{k+1,i}/∂z²` for `i = 0..N`.
+    pub p: Vec<DMatrix<f64>>,
+}

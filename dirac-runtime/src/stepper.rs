@@ -21,7 +21,7 @@ use crate::euler_lagrange::{EulerLagrange, check_finite};
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 use crate::quadrature::Quadrature;
-use crate::step_derivatives::StepDerivatives;
+use crate::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
 use crate::trajectory::{Interrupted, Trajectory};
@@ -167,6 +167,24 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         check_finite(self.system(), "velocity guess", &v_guess)?;
         let v0 = self.velocity_at(&q0, &p0, &v_guess)?;
         self.start_from_state(State::new(0.0, q0, p0, v0))
+    }
+
+    /// Advances one step and returns the first and second derivatives of the step map at the
+    /// state it started from (see [`StepHessians`]); for models on `Rⁿ` without constraints or
+    /// forces, others are refused with `Unsupported`. On error the state is unchanged.
+    pub fn step_second_order(
+        &mut self,
+    ) -> Result<(StepDerivatives<N>, StepHessians<N>), DiracError> {
+        let proposal = self.solve_step()?;
+        let state = self.state.ok_or(DiracError::NotStarted)?;
+        let first = self
+            .equations
+            .linearise(&state, &self.unknowns, &self.newton)?;
+        let second = self
+            .equations
+            .second_derivatives(&state, &self.unknowns, &self.newton)?;
+        self.accept(proposal);
+        Ok((first, second))
     }
 
     /// Where the constraint one-forms are evaluated on a step.
