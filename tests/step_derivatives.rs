@@ -13,6 +13,23 @@ use dirac::{State, StepDerivatives, StepEquations};
 use scenes::{double_pendulum, knife_edge};
 
 /// One step from `(q, p)` as a map, and its matrix of central differences with step `delta`.
+/// The time the derivative checks start at: forces that depend on time must be read at the step's
+/// own times, not from t = 0.
+const T0: f64 = 1.3;
+
+/// Starts `stepper` at `(T0, q, p)`.
+fn start_at<S: DiracSystem<N>, const N: usize>(
+    stepper: &mut Stepper<S, N>,
+    q: SVector<f64, N>,
+    p: SVector<f64, N>,
+) {
+    stepper.start_from_momentum(q, p).expect("a valid state");
+    let v = stepper.v().expect("velocity");
+    stepper
+        .start_from_state(State::new(T0, q, p, v))
+        .expect("a valid state");
+}
+
 fn central_differences<S: DiracSystem<N>, const N: usize>(
     make: &dyn Fn() -> Stepper<S, N>,
     q: SVector<f64, N>,
@@ -21,7 +38,7 @@ fn central_differences<S: DiracSystem<N>, const N: usize>(
 ) -> DMatrix<f64> {
     let step = |q: SVector<f64, N>, p: SVector<f64, N>| -> Vec<f64> {
         let mut stepper = make();
-        stepper.start_from_momentum(q, p).expect("a valid state");
+        start_at(&mut stepper, q, p);
         stepper.step().expect("step");
         stepper
             .q()
@@ -55,7 +72,7 @@ fn compare<S: DiracSystem<N>, const N: usize>(
     p: SVector<f64, N>,
 ) -> (StepDerivatives<N>, f64) {
     let mut stepper = make();
-    stepper.start_from_momentum(q, p).expect("a valid state");
+    start_at(&mut stepper, q, p);
     let exact = stepper.step_linearised().expect("derivatives");
     let differences = central_differences(make, q, p, 1e-5);
     let difference = (exact.matrix() - differences).amax();
@@ -88,8 +105,9 @@ fn double_pendulum_derivatives_match_central_differences_and_are_symplectic() {
     }
 }
 
-/// A pendulum with position-dependent viscous damping and a torque `u · (1 + q²/4)` (an input
-/// that enters nonlinearly through the state).
+/// A pendulum with position-dependent viscous damping, a torque `u · (1 + q²/4)(1 + cos(t)/2)`
+/// (an input that enters through the state and the time) and a parametric drive `0.3 q sin 2t`
+/// (its derivatives depend on time).
 struct DampedPendulum {
     c: f64,
 }
@@ -106,13 +124,13 @@ impl DiracSystem<1> for DampedPendulum {
         &self,
         q: &SVector<D, 1>,
         v: &SVector<D, 1>,
-        _t: f64,
+        t: f64,
         u: &[D],
     ) -> SVector<D, 1> {
         // Depends on q too, so that ∂F/∂q enters.
-        SVector::from([
-            v[0] * (-self.c) * (q[0].cos() * 0.5 + 1.0) + u[0] * (q[0] * q[0] * 0.25 + 1.0)
-        ])
+        SVector::from([v[0] * (-self.c) * (q[0].cos() * 0.5 + 1.0)
+            + u[0] * (q[0] * q[0] * 0.25 + 1.0) * (t.cos() * 0.5 + 1.0)
+            + q[0] * (t * 2.0).sin() * 0.3])
     }
 }
 
@@ -132,9 +150,7 @@ fn forced_derivatives_match_central_differences() {
         let step_with = |u: f64| {
             let mut stepper = make();
             stepper.set_input("u0", u).unwrap();
-            stepper
-                .start_from_momentum(vector![0.8], vector![-1.2])
-                .unwrap();
+            start_at(&mut stepper, vector![0.8], vector![-1.2]);
             stepper.step().unwrap();
             vector![stepper.q()[0], stepper.p()[0]]
         };
@@ -188,11 +204,12 @@ fn a_linearised_step_is_the_same_step() {
 /// exact derivatives at the solution.
 fn raw_step<S: DiracSystem<N>, const N: usize>(
     equations: &mut EulerLagrange<S, N, Euclidean>,
+    t0: f64,
     q: SVector<f64, N>,
     p: SVector<f64, N>,
     v: SVector<f64, N>,
 ) -> (SVector<f64, N>, SVector<f64, N>, StepDerivatives<N>) {
-    let state = State::new(0.0, q, p, v);
+    let state = State::new(t0, q, p, v);
     let mut x = DVector::zeros(equations.unknowns());
     equations.predict(&state, None, &mut x);
     let options = NewtonOptions {
@@ -220,8 +237,9 @@ fn constrained_case<S: DiracSystem<N> + Clone, const N: usize>(
     let state = *stepper.state().unwrap();
     let (q, p, v) = (*state.q(), *state.p(), *state.velocity_hint());
     let point = stepper.constraint_point();
+    let quadrature = stepper.quadrature().clone();
     let make = |u: f64| {
-        let discrete = DiscreteLagrangian::new(system.clone(), Quadrature::midpoint(), stepper.h());
+        let discrete = DiscreteLagrangian::new(system.clone(), quadrature.clone(), stepper.h());
         let mut equations = EulerLagrange::new(discrete).unwrap();
         equations.set_constraint_point(point);
         if S::INPUTS > 0 {
@@ -230,7 +248,7 @@ fn constrained_case<S: DiracSystem<N> + Clone, const N: usize>(
         equations
     };
     let u0 = u.unwrap_or(0.0);
-    let (_, _, exact) = raw_step(&mut make(u0), q, p, v);
+    let (_, _, exact) = raw_step(&mut make(u0), T0, q, p, v);
     let delta = 1e-5;
     let mut worst = 0.0_f64;
     let a = exact.matrix();
@@ -243,8 +261,8 @@ fn constrained_case<S: DiracSystem<N> + Clone, const N: usize>(
             pp[c - N] += delta;
             pm[c - N] -= delta;
         }
-        let (q1p, p1p, _) = raw_step(&mut make(u0), qp, pp, v);
-        let (q1m, p1m, _) = raw_step(&mut make(u0), qm, pm, v);
+        let (q1p, p1p, _) = raw_step(&mut make(u0), T0, qp, pp, v);
+        let (q1m, p1m, _) = raw_step(&mut make(u0), T0, qm, pm, v);
         for r in 0..N {
             worst = worst.max((a[(r, c)] - (q1p[r] - q1m[r]) / (2.0 * delta)).abs());
             worst = worst.max((a[(N + r, c)] - (p1p[r] - p1m[r]) / (2.0 * delta)).abs());
@@ -259,8 +277,8 @@ fn constrained_case<S: DiracSystem<N> + Clone, const N: usize>(
         "{name}"
     );
     if let Some(u) = u {
-        let (q1p, p1p, _) = raw_step(&mut make(u + delta), q, p, v);
-        let (q1m, p1m, _) = raw_step(&mut make(u - delta), q, p, v);
+        let (q1p, p1p, _) = raw_step(&mut make(u + delta), T0, q, p, v);
+        let (q1m, p1m, _) = raw_step(&mut make(u - delta), T0, q, p, v);
         let b = exact.input_matrix();
         for r in 0..N {
             let dq = (q1p[r] - q1m[r]) / (2.0 * delta);
@@ -467,4 +485,73 @@ fn second_derivatives_are_refused_for_constrained_or_forced_models() {
         Err(DiracError::Unsupported(_))
     ));
     assert_eq!(damped.steps(), 0);
+}
+
+/// A unit mass on the unit circle (`FORMS = 0`: the holonomic constraint `x² + y² = 1`;
+/// `FORMS = 1`: its one-form `x dx + y dy`), under gravity, with damping that depends on the
+/// position, a time-dependent push and an input torque.
+#[derive(Debug, Clone, Copy)]
+struct Bead<const FORMS: usize>;
+
+impl<const FORMS: usize> DiracSystem<2> for Bead<FORMS> {
+    const ONE_FORMS: usize = FORMS;
+    const HOLONOMIC: usize = 1 - FORMS;
+    const FORCES: bool = true;
+    const INPUTS: usize = 1;
+
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+        v.dot(v) * 0.5 - q[1] * 9.81
+    }
+
+    fn one_form<D: Scalar>(&self, q: &SVector<D, 2>, _a: usize) -> SVector<D, 2> {
+        *q
+    }
+
+    fn holonomic<D: Scalar>(&self, q: &SVector<D, 2>, _b: usize) -> D {
+        (q.dot(q) - 1.0) * 0.5
+    }
+
+    fn force<D: Scalar>(
+        &self,
+        q: &SVector<D, 2>,
+        v: &SVector<D, 2>,
+        t: f64,
+        u: &[D],
+    ) -> SVector<D, 2> {
+        let damping = (q[0] * q[0] + 1.0) * -0.3;
+        let torque = u[0] * (t.sin() * 0.5 + 1.0);
+        SVector::from([
+            v[0] * damping - q[1] * torque + q[0] * (t * 3.0).cos() * 0.2,
+            v[1] * damping + q[0] * torque,
+        ])
+    }
+}
+
+/// Starts a bead at 0.7 rad with speed 3 along the circle, input 0.4.
+fn start_bead<const FORMS: usize>(stepper: &mut Stepper<Bead<FORMS>, 2>) {
+    let angle: f64 = 0.7;
+    let q = vector![angle.sin(), -angle.cos()];
+    let v = vector![angle.cos(), angle.sin()] * 3.0;
+    stepper.start_from_velocity(q, v).unwrap();
+    stepper.set_input("u0", 0.4).unwrap();
+}
+
+#[test]
+fn constrained_and_forced_derivatives_match_at_every_point_and_rule() {
+    for quadrature in [Quadrature::midpoint(), Quadrature::trapezoid()] {
+        let mut holonomic = Stepper::new(Bead::<0>, quadrature.clone(), 0.02).unwrap();
+        start_bead(&mut holonomic);
+        constrained_case("holonomic bead", Bead::<0>, holonomic, Some(0.4));
+        for point in [
+            ConstraintPoint::Start,
+            ConstraintPoint::Midpoint,
+            ConstraintPoint::End,
+        ] {
+            let mut one_form = Stepper::new(Bead::<1>, quadrature.clone(), 0.02)
+                .unwrap()
+                .with_constraint_point(point);
+            start_bead(&mut one_form);
+            constrained_case("one-form bead", Bead::<1>, one_form, Some(0.4));
+        }
+    }
 }

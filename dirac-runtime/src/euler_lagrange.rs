@@ -225,7 +225,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
                         column[layout.point(j + 1) + r] = third(j, r);
                     }
                 }
-                newton.solve_factorised(&mut column);
+                newton
+                    .solve_factorised(x, &mut column)
+                    .ok_or_else(stale_factorisation)?;
                 column.neg_mut();
                 let mut end = SVector::<f64, N>::from_fn(|r, _| third(s, r));
                 for (m, g_sm) in g[s].iter().enumerate().skip(1) {
@@ -340,7 +342,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         let mut column = DVector::zeros(n);
         for c in 0..parameters {
             column.copy_from(&dr.column(c));
-            newton.solve_factorised(&mut column);
+            newton
+                .solve_factorised(x, &mut column)
+                .ok_or_else(stale_factorisation)?;
             dx.set_column(c, &(-&column));
         }
         Ok(Sensitivity {
@@ -424,7 +428,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 value: energy,
             });
         }
-        initial_state::check(system, q, v, &self.inputs)
+        initial_state::check(system, state.t, q, v, &self.inputs)
             .map_err(DiracError::InconsistentInitialState)
     }
 
@@ -672,6 +676,16 @@ struct Sensitivity<const N: usize> {
     end_turning: SMatrix<f64, N, N>,
     theta: f64,
     inputs: usize,
+}
+
+/// The error for derivatives asked of a Newton solver that does not hold the factorisation at
+/// the solution (no solve, a failed one since, or another point).
+fn stale_factorisation() -> DiracError {
+    DiracError::Dimension(
+        "the Newton solver does not hold the factorisation at this solution (take the \
+         derivatives right after the solve that produced it)"
+            .into(),
+    )
 }
 
 /// `Err(NonFinite)` naming the first coordinate of `x` that is not finite.

@@ -17,6 +17,7 @@ const TOLERANCE: f64 = 1e-9;
 /// acceleration, so some multipliers must balance them at `t = 0`. Returns what is violated.
 pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
     system: &S,
+    t0: f64,
     q0: &SVector<f64, N>,
     v0: &SVector<f64, N>,
     inputs: &[f64],
@@ -54,7 +55,7 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
     }
     // Rows D of  ∂L/∂q + F − d/dt ∂L/∂v + Aᵀμ + dgᵀλ = 0, with d/dt ∂L/∂v_D = Σ_j ∂²L/∂q_j∂v_D v_j.
     let qv = seeded(system, q0, v0, Seed::POSITION, Seed::VELOCITY);
-    let force = system.force(q0, v0, 0.0, inputs);
+    let force = system.force(q0, v0, t0, inputs);
     let unbalanced: SVector<f64, N> = qv.first + force - qv.mixed.transpose() * v0;
     let mut columns: Vec<SVector<f64, N>> = forms;
     columns.extend((0..S::HOLONOMIC).map(|b| constraint::holonomic(system, q0, b).1));

@@ -175,6 +175,8 @@ pub struct Newton {
     update: DVector<f64>,
     /// The trial point of the line search.
     trial: DVector<f64>,
+    /// The root of the last successful solve, where `jacobian` holds the factorisation.
+    root: Option<DVector<f64>>,
 }
 
 /// The residual's norm at a point and the tolerance it is held to there.
@@ -195,13 +197,15 @@ impl Newton {
             pivots: vec![0; n],
             update: DVector::zeros(n),
             trial: DVector::zeros(n),
+            root: None,
         })
     }
 
-    /// Solves `J y = b` in place with the Jacobian factorised at the root of the last successful
-    /// [`solve`](Self::solve) (the implicit function theorem's solves reuse it).
-    pub(crate) fn solve_factorised(&self, b: &mut DVector<f64>) {
-        lu::solve(&self.jacobian, &self.pivots, b);
+    /// Solves `J y = b` in place with the Jacobian factorised at `root`, which must be the root
+    /// of the last successful [`solve`](Self::solve) (the implicit function theorem's solves
+    /// reuse it); `None` otherwise (no solve yet, a failed one since, or another point).
+    pub(crate) fn solve_factorised(&self, root: &DVector<f64>, b: &mut DVector<f64>) -> Option<()> {
+        (self.root.as_ref() == Some(root)).then(|| lu::solve(&self.jacobian, &self.pivots, b))
     }
 
     /// The options in force.
@@ -295,6 +299,7 @@ impl Newton {
                 got: x.len(),
             });
         }
+        self.root = None;
         let options = self.options;
         let mut at_x = self.evaluate(x, &mut evaluate)?;
         // The last full (undamped) update's size: convergence and the contraction ratio use it.
@@ -317,6 +322,10 @@ impl Newton {
             )
             .map_err(NewtonFailure::Singular)?;
             if within && settled {
+                match &mut self.root {
+                    Some(root) => root.copy_from(x),
+                    None => self.root = Some(x.clone()),
+                }
                 return Ok(NewtonReport {
                     iterations: iteration,
                     residual: at_x.residual,

@@ -1,10 +1,12 @@
 //! Exact derivatives of the step map `(q_k, p_k) ↦ (q_{k+1}, p_{k+1})`.
 //!
-//! A step solves `F(x; q_k, p_k) = 0` for its unknowns `x` by Newton's method. At the root the
-//! implicit function theorem gives `∂x/∂(q_k, p_k) = −(∂F/∂x)⁻¹ ∂F/∂(q_k, p_k)`, which reuses
-//! the factorisation Newton accepted the root with: one factorisation, `2N` solves, and the
-//! partial derivatives of the residual in `(q_k, p_k)`, which come from the same dual numbers
-//! as the Jacobian. The new state is then differentiated along.
+//! A step solves `F(x; q_k, p_k, u) = 0` for its unknowns `x` by Newton's method. At the root
+//! the implicit function theorem gives `∂x/∂(q_k, p_k, u) = −(∂F/∂x)⁻¹ ∂F/∂(q_k, p_k, u)`,
+//! which reuses the factorisation Newton accepted the root with: `2N + inputs` solves, and the
+//! partial derivatives of the residual, evaluated afresh by dual numbers (the slot Hessian of
+//! `L_d`, the forces' and the constraints' derivatives). The new state is then differentiated
+//! along. Second derivatives take the third slot derivatives of `L_d` (hyper-hyper-dual
+//! numbers) through the same factorisation.
 
 use nalgebra::{DMatrix, SMatrix};
 

@@ -169,8 +169,9 @@ pub trait StepEquations<const N: usize> {
     fn energy(&self, q: &SVector<f64, N>, p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64;
 
     /// The derivatives of the step from `state` solved by `x` (the point assembled last) with
-    /// respect to `(q_k, p_k)`; `newton` holds the Jacobian factorised at `x`. The default
-    /// refuses: equations that can differentiate their step override it.
+    /// respect to `(q_k, p_k)` and the inputs `u`; `newton` must hold the Jacobian factorised at
+    /// `x` by the solve that produced it (otherwise an error). The default refuses: equations
+    /// that can differentiate their step override it.
     fn linearise(
         &self,
         state: &State<N>,

@@ -331,7 +331,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// Advances one step and returns the derivatives of the step map at the state it started
-    /// from, `∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)` (see [`StepDerivatives`]). On error (including
+    /// from: `A = ∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)` and `B = ∂(q_{k+1}, p_{k+1})/∂u` (see
+    /// [`StepDerivatives`]). On error (including
     /// `Unsupported` for models the derivatives do not cover yet) the state is unchanged.
     pub fn step_linearised(&mut self) -> Result<StepDerivatives<N>, DiracError> {
         let proposal = self.solve_step()?;
