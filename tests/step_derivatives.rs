@@ -30,6 +30,24 @@ fn start_at<S: DiracSystem<N>, const N: usize>(
         .expect("a valid state");
 }
 
+/// `(q, p)` moved by `±delta` along phase-space coordinate `c` (`q` first, then `p`).
+fn nudged<const N: usize>(
+    q: SVector<f64, N>,
+    p: SVector<f64, N>,
+    c: usize,
+    delta: f64,
+) -> [(SVector<f64, N>, SVector<f64, N>); 2] {
+    let (mut qp, mut pp, mut qm, mut pm) = (q, p, q, p);
+    if c < N {
+        qp[c] += delta;
+        qm[c] -= delta;
+    } else {
+        pp[c - N] += delta;
+        pm[c - N] -= delta;
+    }
+    [(qp, pp), (qm, pm)]
+}
+
 fn central_differences<S: DiracSystem<N>, const N: usize>(
     make: &dyn Fn() -> Stepper<S, N>,
     q: SVector<f64, N>,
@@ -49,14 +67,7 @@ fn central_differences<S: DiracSystem<N>, const N: usize>(
     };
     let mut a = DMatrix::zeros(2 * N, 2 * N);
     for c in 0..2 * N {
-        let (mut qp, mut pp, mut qm, mut pm) = (q, p, q, p);
-        if c < N {
-            qp[c] += delta;
-            qm[c] -= delta;
-        } else {
-            pp[c - N] += delta;
-            pm[c - N] -= delta;
-        }
+        let [(qp, pp), (qm, pm)] = nudged(q, p, c, delta);
         let (plus, minus) = (step(qp, pp), step(qm, pm));
         for r in 0..2 * N {
             a[(r, c)] = (plus[r] - minus[r]) / (2.0 * delta);
@@ -253,14 +264,7 @@ fn constrained_case<S: DiracSystem<N> + Clone, const N: usize>(
     let mut worst = 0.0_f64;
     let a = exact.matrix();
     for c in 0..2 * N {
-        let (mut qp, mut pp, mut qm, mut pm) = (q, p, q, p);
-        if c < N {
-            qp[c] += delta;
-            qm[c] -= delta;
-        } else {
-            pp[c - N] += delta;
-            pm[c - N] -= delta;
-        }
+        let [(qp, pp), (qm, pm)] = nudged(q, p, c, delta);
         let (q1p, p1p, _) = raw_step(&mut make(u0), T0, qp, pp, v);
         let (q1m, p1m, _) = raw_step(&mut make(u0), T0, qm, pm, v);
         for r in 0..N {
@@ -444,14 +448,7 @@ fn second_derivatives_match_central_differences_of_the_first() {
         let mut worst = 0.0_f64;
         let mut largest = 0.0_f64;
         for b in 0..4 {
-            let (mut qp, mut pp, mut qm, mut pm) = (q, p, q, p);
-            if b < 2 {
-                qp[b] += delta;
-                qm[b] -= delta;
-            } else {
-                pp[b - 2] += delta;
-                pm[b - 2] -= delta;
-            }
+            let [(qp, pp), (qm, pm)] = nudged(q, p, b, delta);
             let column = (first_at(qp, pp) - first_at(qm, pm)) / (2.0 * delta);
             for a in 0..4 {
                 for i in 0..2 {
