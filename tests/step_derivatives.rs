@@ -422,66 +422,80 @@ fn the_cart_pole_linearisation_is_the_cayley_transform_and_lqr_balances_it() {
     );
 }
 
+/// The exact second derivatives at `(q, p)` from `T0` against central differences (step `delta`)
+/// of the exact first derivatives: the largest difference and the largest second derivative.
+fn second_order_check<S: DiracSystem<N>, const N: usize>(
+    make: &dyn Fn() -> Stepper<S, N>,
+    q: SVector<f64, N>,
+    p: SVector<f64, N>,
+    delta: f64,
+) -> (f64, f64) {
+    use dirac::StepHessians;
+    let first_at = |q: SVector<f64, N>, p: SVector<f64, N>| {
+        let mut stepper = make();
+        start_at(&mut stepper, q, p);
+        stepper.step_linearised().unwrap().matrix()
+    };
+    let mut stepper = make();
+    start_at(&mut stepper, q, p);
+    let (first, StepHessians { q: hq, p: hp }) = stepper.step_second_order().unwrap();
+    assert_eq!(first.matrix(), first_at(q, p), "the same A");
+    let (mut worst, mut largest) = (0.0_f64, 0.0_f64);
+    for b in 0..2 * N {
+        let [(qp, pp), (qm, pm)] = nudged(q, p, b, delta);
+        let column = (first_at(qp, pp) - first_at(qm, pm)) / (2.0 * delta);
+        for a in 0..2 * N {
+            for i in 0..N {
+                // Row i of A is ∂q_{k+1,i}/∂z, row N + i is ∂p_{k+1,i}/∂z.
+                worst = worst.max((hq[i][(a, b)] - column[(i, a)]).abs());
+                worst = worst.max((hp[i][(a, b)] - column[(N + i, a)]).abs());
+                largest = largest.max(hq[i][(a, b)].abs()).max(hp[i][(a, b)].abs());
+            }
+        }
+    }
+    (worst, largest)
+}
+
 #[test]
 fn second_derivatives_match_central_differences_of_the_first() {
-    use dirac::StepHessians;
     let (q, p) = double_pendulum_state();
     for quadrature in scenes::quadratures() {
         let name = quadrature.name();
         let make = || Stepper::new(double_pendulum::SCENE, quadrature.clone(), 0.05).unwrap();
-        let first_at = |q: SVector<f64, 2>, p: SVector<f64, 2>| {
-            let mut stepper = make();
-            stepper.start_from_momentum(q, p).unwrap();
-            stepper.step_linearised().unwrap().matrix()
-        };
-        let mut stepper = make();
-        stepper.start_from_momentum(q, p).unwrap();
-        let (first, StepHessians { q: hq, p: hp }) = stepper.step_second_order().unwrap();
-        assert!(
-            (first.matrix() - first_at(q, p)).amax() == 0.0,
-            "{name}: the same A"
-        );
-        // Central differences of the exact A. At δ = 1e-5 the round-off of A (~1e-12) over 2δ
-        // reaches 1.3e-7 for galerkin(3); at δ = 4e-5 the truncation error (∝ δ²) is 3–5e-8 for
-        // every rule, against second derivatives of size 5.
-        let delta = 4e-5;
-        let mut worst = 0.0_f64;
-        let mut largest = 0.0_f64;
-        for b in 0..4 {
-            let [(qp, pp), (qm, pm)] = nudged(q, p, b, delta);
-            let column = (first_at(qp, pp) - first_at(qm, pm)) / (2.0 * delta);
-            for a in 0..4 {
-                for i in 0..2 {
-                    // Row i of A is ∂q_{k+1,i}/∂z, row 2 + i is ∂p_{k+1,i}/∂z.
-                    worst = worst.max((hq[i][(a, b)] - column[(i, a)]).abs());
-                    worst = worst.max((hp[i][(a, b)] - column[(2 + i, a)]).abs());
-                    largest = largest.max(hq[i][(a, b)].abs()).max(hp[i][(a, b)].abs());
-                }
-            }
-        }
+        // At δ = 1e-5 the round-off of A (~1e-12) over 2δ reaches 1.3e-7 for galerkin(3); at
+        // δ = 4e-5 the truncation error (∝ δ²) is 3–5e-8 for every rule, against second
+        // derivatives of size 5.
+        let (worst, largest) = second_order_check(&make, q, p, 4e-5);
         assert!(
             worst < 1e-7,
             "{name}: second derivatives differ by {worst:e}"
         );
         assert!(largest > 1e-2, "{name}: the step map is not linear here");
+        // Forces that depend on the state, the time and an input add their own D²f.
+        let forced = || {
+            let mut stepper =
+                Stepper::new(DampedPendulum { c: 0.7 }, quadrature.clone(), 0.1).unwrap();
+            stepper.set_input("u0", 0.3).unwrap();
+            stepper
+        };
+        let (worst, largest) = second_order_check(&forced, vector![0.8], vector![-1.2], 4e-5);
+        assert!(
+            worst < 1e-7,
+            "{name}, forced: second derivatives differ by {worst:e}"
+        );
+        assert!(
+            largest > 1e-2,
+            "{name}, forced: the step map is not linear here"
+        );
     }
 }
 
 #[test]
-fn second_derivatives_are_refused_for_constrained_or_forced_models() {
+fn second_derivatives_are_refused_for_constrained_models() {
     let mut knife = knife_edge::stepper(ConstraintPoint::Midpoint, 0.01).unwrap();
     let error = knife.step_second_order().expect_err("constrained");
     assert!(matches!(error, DiracError::Unsupported(_)), "{error}");
     assert_eq!(knife.steps(), 0);
-    let mut damped = Stepper::new(DampedPendulum { c: 0.5 }, Quadrature::midpoint(), 0.1).unwrap();
-    damped
-        .start_from_velocity(vector![0.3], vector![0.0])
-        .unwrap();
-    assert!(matches!(
-        damped.step_second_order(),
-        Err(DiracError::Unsupported(_))
-    ));
-    assert_eq!(damped.steps(), 0);
 }
 
 /// A unit mass on the unit circle (`FORMS = 0`: the holonomic constraint `x² + y² = 1`;

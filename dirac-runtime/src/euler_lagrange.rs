@@ -168,7 +168,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
 
     /// Second derivatives of the step from `state` solved by `x` with respect to `(q_k, p_k)`,
     /// `newton` holding the Jacobian factorised at `x`: for models on `Rⁿ` without constraints
-    /// or forces (others are refused with `Unsupported`). The step's points `Q_m` depend on
+    /// (others are refused with `Unsupported`); forces add their own second derivatives
+    /// `D²f_j` to `D³L_d`. The step's points `Q_m` depend on
     /// `z = (q_k, p_k)` through `Q_0 = q_k`, `Q_m = q_k + ξ_m`, and the rows
     /// `R_j = δ_j0 p_k + ∂L_d/∂Q_j = 0` hold for every `z`; differentiating twice,
     /// `D³L_d[e_j, dQ_a, dQ_b] + Σ_m G_jm ∂²ξ_m/∂z_a∂z_b = 0`, so
@@ -180,10 +181,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<StepHessians<N>, DiracError> {
-        if Self::constrained() || S::FORCES || !C::TRANSLATION {
+        if Self::constrained() || !C::TRANSLATION {
             return Err(DiracError::Unsupported(
-                "second derivatives of the step map of a model with constraints or forces, or \
-                 on a space other than Rⁿ"
+                "second derivatives of the step map of a model with constraints, or on a space \
+                 other than Rⁿ"
                     .into(),
             ));
         }
@@ -220,16 +221,28 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
                 let third = |m: usize, r: usize| {
                     discrete.slot_third(&state.q, &increments, [&nudge(m, r), &moves[a], &moves[b]])
                 };
-                for j in 0..s {
+                // The forces' second derivatives along the same displacements (f_0..f_s).
+                let forces = if S::FORCES {
+                    discrete.force_second_derivatives(
+                        &state.q,
+                        &increments,
+                        state.t,
+                        &self.inputs,
+                        [&moves[a], &moves[b]],
+                    )
+                } else {
+                    vec![SVector::zeros(); s + 1]
+                };
+                for (j, force) in forces.iter().take(s).enumerate() {
                     for r in 0..N {
-                        column[layout.point(j + 1) + r] = third(j, r);
+                        column[layout.point(j + 1) + r] = third(j, r) + force[r];
                     }
                 }
                 newton
                     .solve_factorised(x, &mut column)
                     .ok_or_else(stale_factorisation)?;
                 column.neg_mut();
-                let mut end = SVector::<f64, N>::from_fn(|r, _| third(s, r));
+                let mut end = SVector::<f64, N>::from_fn(|r, _| third(s, r)) + forces[s];
                 for (m, g_sm) in g[s].iter().enumerate().skip(1) {
                     end += g_sm * column.fixed_rows::<N>(layout.point(m));
                 }

@@ -6,7 +6,7 @@
 use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
 
 use crate::configuration_space::{ConfigurationSpace, StepCovectors};
-use num_dual::Dual64;
+use num_dual::{Dual64, HyperDual64};
 
 use crate::derivatives::{Dual, lift};
 use crate::discrete_lagrangian::DiscreteLagrangian;
@@ -139,5 +139,51 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
             }
         }
         blocks
+    }
+
+    /// The forces' second derivatives along two displacements of the step's points (`d[k][m]`
+    /// moves point `m`, `m = 0..=s`) on a translation chart: `D²f_j[d_0, d_1]` for `j = 0..=s`,
+    /// `h Σ_i b_i ℓ_j(c_i) D²F(q_i, v_i)` along the node displacements, by hyper-dual numbers.
+    pub(crate) fn force_second_derivatives(
+        &self,
+        base: &SVector<f64, N>,
+        increments: &[SVector<f64, N>],
+        t: f64,
+        inputs: &[f64],
+        d: [&[SVector<f64, N>]; 2],
+    ) -> Vec<SVector<f64, N>> {
+        let quad = self.quadrature();
+        let (h, s) = (self.h(), quad.degree());
+        let inputs: Vec<HyperDual64> = inputs.iter().map(|&u| HyperDual64::from(u)).collect();
+        let mut out = vec![SVector::<f64, N>::zeros(); s + 1];
+        for (i, (&b, &c)) in quad.weights().iter().zip(quad.nodes()).enumerate() {
+            let w = h * b;
+            let (xi, xi_dot) = self.node(i, increments);
+            let at_node = |points: &[SVector<f64, N>]| {
+                let mut dq = SVector::<f64, N>::zeros();
+                let mut dv = SVector::<f64, N>::zeros();
+                for (m, point) in points.iter().enumerate() {
+                    dq += point * quad.ell(i, m);
+                    dv += point * (quad.ell_prime(i, m) / h);
+                }
+                (dq, dv)
+            };
+            let ((q1, v1), (q2, v2)) = (at_node(d[0]), at_node(d[1]));
+            let q = base + xi;
+            let lift = |x: &SVector<f64, N>, a: &SVector<f64, N>, b: &SVector<f64, N>| {
+                SVector::<HyperDual64, N>::from_fn(|r, _| HyperDual64::new(x[r], a[r], b[r], 0.0))
+            };
+            let f = self.system().force(
+                &lift(&q, &q1, &q2),
+                &lift(&xi_dot, &v1, &v2),
+                t + c * h,
+                &inputs,
+            );
+            let second = f.map(|x| x.eps1eps2);
+            for (j, total) in out.iter_mut().enumerate() {
+                *total += second * (w * quad.ell(i, j));
+            }
+        }
+        out
     }
 }

@@ -170,8 +170,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     }
 
     /// Advances one step and returns the first and second derivatives of the step map at the
-    /// state it started from (see [`StepHessians`]); for models on `Rⁿ` without constraints or
-    /// forces, others are refused with `Unsupported`. On error the state is unchanged.
+    /// state it started from (see [`StepHessians`]); for models on `Rⁿ` without constraints
+    /// (with forces and inputs), others are refused with `Unsupported`. On error the state is
+    /// unchanged.
     pub fn step_second_order(
         &mut self,
     ) -> Result<(StepDerivatives<N>, StepHessians<N>), DiracError> {
