@@ -168,13 +168,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
 
     /// Second derivatives of the step from `state` solved by `x` with respect to `(q_k, p_k)`,
     /// `newton` holding the Jacobian factorised at `x`: for models on `Rⁿ` without constraints
-    /// (others are refused with `Unsupported`); forces add their own second derivatives
-    /// `D²f_j` to `D³L_d`. The step's points `Q_m` depend on
-    /// `z = (q_k, p_k)` through `Q_0 = q_k`, `Q_m = q_k + ξ_m`, and the rows
-    /// `R_j = δ_j0 p_k + ∂L_d/∂Q_j = 0` hold for every `z`; differentiating twice,
-    /// `D³L_d[e_j, dQ_a, dQ_b] + Σ_m G_jm ∂²ξ_m/∂z_a∂z_b = 0`, so
-    /// `∂²ξ = −J⁻¹ D³L_d[e_·, dQ_a, dQ_b]`, and `p_{k+1} = ∂L_d/∂Q_s` gives
-    /// `∂²p_{k+1} = D³L_d[e_s, dQ_a, dQ_b] + Σ_m G_sm ∂²ξ_m`.
+    /// (others are refused with `Unsupported`).
+    ///
+    /// The step's points depend on `z = (q_k, p_k)` through `Q_0 = q_k`, `Q_m = q_k + ξ_m`, and
+    /// the rows `R_j = δ_j0 p_k + ∂L_d/∂Q_j + f_j = 0` hold for every `z`. Differentiating twice,
+    /// `D³L_d[e_j, dQ_a, dQ_b] + D²f_j[dQ_a, dQ_b] + Σ_m G_jm ∂²ξ_m/∂z_a∂z_b = 0`, so `∂²ξ` is one
+    /// solve with the factorised `J`, and `p_{k+1} = ∂L_d/∂Q_s + f_s` gives
+    /// `∂²p_{k+1} = D³L_d[e_s, dQ_a, dQ_b] + D²f_s[dQ_a, dQ_b] + Σ_m G_sm ∂²ξ_m`.
     pub fn second_derivatives(
         &self,
         state: &State<N>,
