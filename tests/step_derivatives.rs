@@ -566,3 +566,35 @@ fn constrained_and_forced_derivatives_match_at_every_point_and_rule() {
         }
     }
 }
+
+/// Two unit springs, one mass 1 and one mass `m`.
+struct Masses {
+    m: f64,
+}
+
+impl DiracSystem<2> for Masses {
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+        (v[0] * v[0] + v[1] * v[1] * self.m - q.dot(q)) * 0.5
+    }
+}
+
+#[test]
+fn the_pivot_ratio_reports_an_ill_conditioned_step() {
+    let ratio = |m: f64| {
+        let mut stepper = Stepper::new(Masses { m }, Quadrature::midpoint(), 0.01).unwrap();
+        stepper
+            .start_from_velocity(vector![1.0, 1.0], vector![0.0, 0.0])
+            .unwrap();
+        stepper.step_linearised().unwrap().pivot_ratio
+    };
+    // The midpoint step's Jacobian is −diag(m_i/h + h/4): equal masses give ratio 1, a tiny
+    // mass the ratio (1/h + h/4)/(m/h + h/4) = 4e4.
+    assert!((ratio(1.0) - 1.0).abs() < 1e-12, "{}", ratio(1.0));
+    let h = 0.01_f64;
+    let expected = (1.0 / h + h / 4.0) / (1e-9 / h + h / 4.0);
+    let stiff = ratio(1e-9);
+    assert!(
+        (stiff / expected - 1.0).abs() < 1e-9,
+        "{stiff} vs {expected}"
+    );
+}

@@ -670,6 +670,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             p_p: block(&dp, N),
             q_u: dq.columns(2 * N, inputs).clone_owned(),
             p_u: dp.columns(2 * N, inputs).clone_owned(),
+            pivot_ratio: newton.pivot_ratio(),
         })
     }
 }

@@ -208,6 +208,16 @@ impl Newton {
         (self.root.as_ref() == Some(root)).then(|| lu::solve(&self.jacobian, &self.pivots, b))
     }
 
+    /// `max |u_ii| / min |u_ii|` over the pivots of the Jacobian factorised at the last
+    /// successful solve's root: a lower bound of its condition number (infinite before any).
+    pub(crate) fn pivot_ratio(&self) -> f64 {
+        if self.root.is_none() {
+            return f64::INFINITY;
+        }
+        let pivots = self.jacobian.diagonal().map(f64::abs);
+        pivots.max() / pivots.min()
+    }
+
     /// The options in force.
     pub fn options(&self) -> &NewtonOptions {
         &self.options

@@ -48,6 +48,9 @@ pub struct StepDerivatives<const N: usize> {
     pub q_u: DMatrix<f64>,
     /// `∂p_{k+1}/∂u` (`N × inputs`).
     pub p_u: DMatrix<f64>,
+    /// `max |u_ii| / min |u_ii|` over the pivots of the step's factorised Jacobian: a lower
+    /// bound of its condition number. The derivatives lose about `log10` of it in digits.
+    pub pivot_ratio: f64,
 }
 
 impl<const N: usize> StepDerivatives<N> {
