@@ -111,6 +111,22 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         (xi, v)
     }
 
+    /// How node `i`'s position and velocity move when the step's points `0..=s` move by
+    /// `points[m]`: `(Σ_m ℓ_m(c_i) points[m], Σ_m ℓ'_m(c_i) points[m] / h)`.
+    pub(crate) fn node_displacement(
+        &self,
+        i: usize,
+        points: &[SVector<f64, N>],
+    ) -> (SVector<f64, N>, SVector<f64, N>) {
+        let mut dq = SVector::zeros();
+        let mut dv = SVector::zeros();
+        for (m, point) in points.iter().enumerate() {
+            dq += point * self.quadrature.ell(i, m);
+            dv += point * (self.quadrature.ell_prime(i, m) / self.h);
+        }
+        (dq, dv)
+    }
+
     /// `L_d(Q_0, …, Q_s)`; `points` holds the `s + 1` points of the step (an error otherwise, or
     /// when a point lies outside the chart centred at `Q_0`).
     pub fn value(&self, points: &[SVector<f64, N>]) -> Result<f64, DiracError> {
@@ -234,16 +250,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         let mut total = 0.0;
         for (i, &b) in quad.weights().iter().enumerate() {
             let (xi, xi_dot) = self.node(i, increments);
-            let at_node = |points: &[SVector<f64, N>]| {
-                let mut dq = SVector::zeros();
-                let mut dv = SVector::zeros();
-                for (m, point) in points.iter().enumerate() {
-                    dq += point * quad.ell(i, m);
-                    dv += point * (quad.ell_prime(i, m) / h);
-                }
-                (dq, dv)
-            };
-            let directions = [at_node(d[0]), at_node(d[1]), at_node(d[2])];
+            let directions = d.map(|points| self.node_displacement(i, points));
             total += h * b * third_derivative(&self.system, &(base + xi), &xi_dot, directions);
         }
         total

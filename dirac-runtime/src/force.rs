@@ -159,16 +159,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         for (i, (&b, &c)) in quad.weights().iter().zip(quad.nodes()).enumerate() {
             let w = h * b;
             let (xi, xi_dot) = self.node(i, increments);
-            let at_node = |points: &[SVector<f64, N>]| {
-                let mut dq = SVector::<f64, N>::zeros();
-                let mut dv = SVector::<f64, N>::zeros();
-                for (m, point) in points.iter().enumerate() {
-                    dq += point * quad.ell(i, m);
-                    dv += point * (quad.ell_prime(i, m) / h);
-                }
-                (dq, dv)
-            };
-            let ((q1, v1), (q2, v2)) = (at_node(d[0]), at_node(d[1]));
+            let [(q1, v1), (q2, v2)] = d.map(|points| self.node_displacement(i, points));
             let q = base + xi;
             let lift = |x: &SVector<f64, N>, a: &SVector<f64, N>, b: &SVector<f64, N>| {
                 SVector::<HyperDual64, N>::from_fn(|r, _| HyperDual64::new(x[r], a[r], b[r], 0.0))
