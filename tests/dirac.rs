@@ -174,7 +174,11 @@ fn cartesian_pendulum_keeps_its_length_and_matches_the_angle_pendulum() {
 
 /// Knife edge on an incline against its closed form at T = 2: the one-form at q_k or q_{k+1}
 /// gives order 1, at the midpoint order 2 (measured 0.99, 2.00, 1.00). Start and End lose
-/// energy (impulsive projections of the velocity); the midpoint keeps it to round-off here.
+/// energy (impulsive projections of the velocity); the midpoint keeps it bounded. The energy is
+/// that of the velocity the knife edge allows (`A(q) v = 0`, see `Stepper::v`): over T = 10 its
+/// largest error measured 4.8e-7, 3.0e-8, 1.9e-9 at h = 0.02, 0.01, 0.005 (fourth order, no
+/// drift). The velocity `p/m`, which the constraint does not allow (`A·p` = 2.3e-4 at h = 0.01),
+/// kept it to round-off.
 #[test]
 fn knife_edge_orders_and_energy_of_the_three_constraint_points() {
     let hs = [0.04, 0.02, 0.01, 0.005];
@@ -200,7 +204,10 @@ fn knife_edge_orders_and_energy_of_the_three_constraint_points() {
         let change = stepper.energy().unwrap() - e0;
         match point {
             ConstraintPoint::Midpoint => {
-                assert!(change.abs() < 1e-10, "{change:e}");
+                assert!(change.abs() < 5e-8, "{change:e}");
+                let v = stepper.v().unwrap();
+                let phi = stepper.q()[2];
+                assert!((phi.sin() * v[0] - phi.cos() * v[1]).abs() < 1e-15);
                 let exact = SVector::from(knife_edge::Q10);
                 assert!((stepper.q() - exact).amax() < 2e-3);
             }

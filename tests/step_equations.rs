@@ -57,7 +57,7 @@ impl StepEquations<1> for ImplicitMidpoint {
         "x".into()
     }
 
-    fn check_start(&self, state: &State<1>) -> Result<(), DiracError> {
+    fn check_start(&self, state: &State<1>, _tolerance: f64) -> Result<(), DiracError> {
         if state.q()[0].is_finite() && state.p()[0].is_finite() {
             Ok(())
         } else {

@@ -203,3 +203,21 @@ pub(crate) fn degenerate<S: DiracSystem<N>, const N: usize>(
         .filter(|&i| vv.row(i).iter().all(|x| *x == 0.0))
         .collect()
 }
+
+/// The force `F(q, v, t, u)` with its Jacobians `∂F/∂q` and `∂F/∂v` at one point, by dual
+/// numbers (`x` moves `q` by `position · δ` and `v` by `velocity · δ`).
+pub(crate) fn force_jacobian<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+    t: f64,
+    inputs: &[f64],
+    x: Seed,
+) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
+    let inputs: Vec<Dual<N>> = inputs.iter().map(|&u| Dual::from(u)).collect();
+    let f = system.force(&lift(q, x.position), &lift(v, x.velocity), t, &inputs);
+    (
+        f.map(|x| x.re),
+        SMatrix::from_fn(|r, c| f[r].eps.unwrap_generic(Const::<N>, U1)[c]),
+    )
+}

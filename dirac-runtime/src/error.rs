@@ -101,6 +101,16 @@ pub enum DiracError {
     /// A step left the region where the configuration space's chart is defined or invertible.
     #[error("{0}; nothing was changed (try a smaller step)")]
     OutsideChart(String),
+    /// A step's end could not be put back on a constraint the method holds there (hidden
+    /// constraints of coordinates without kinetic energy, the velocity form of holonomic
+    /// constraints).
+    #[error("step {step}: {why}; nothing was changed (try a smaller step)")]
+    Projection {
+        /// Index of the step that failed.
+        step: u64,
+        /// What could not be held.
+        why: String,
+    },
     /// Writing a trajectory failed.
     #[error("could not write the trajectory: {0}")]
     Io(String),

@@ -21,6 +21,8 @@ use crate::constraint::{self, ConstraintPoint, StepConstraints};
 use crate::derivatives::Dual;
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
+use crate::hidden_constraint::HiddenConstraints;
+use crate::holonomic_scheme::HolonomicScheme;
 use crate::initial_state;
 use crate::layout::Layout;
 use crate::legendre;
@@ -55,6 +57,9 @@ use crate::system::DiracSystem;
 pub struct EulerLagrange<S, const N: usize, C> {
     discrete: DiscreteLagrangian<S, N, C>,
     point: ConstraintPoint,
+    holonomic_scheme: HolonomicScheme,
+    /// The hidden constraints of the run (found when it begins).
+    hidden: HiddenConstraints,
     layout: Layout,
     /// Current values of the system's inputs.
     inputs: Vec<f64>,
@@ -103,6 +108,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         let point = discrete.system().constraint_point();
         Ok(Self {
             point,
+            holonomic_scheme: HolonomicScheme::default(),
+            hidden: HiddenConstraints::default(),
             layout: Layout::new(N, s, S::ONE_FORMS, S::HOLONOMIC),
             inputs: vec![0.0; S::INPUTS],
             lifted_inputs: vec![Dual::from(0.0); S::INPUTS],
@@ -130,6 +137,16 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     /// Evaluates the one-forms at `point` of each step.
     pub fn set_constraint_point(&mut self, point: ConstraintPoint) {
         self.point = point;
+    }
+
+    /// What a step does with the momentum of a model with holonomic constraints.
+    pub fn holonomic_scheme(&self) -> HolonomicScheme {
+        self.holonomic_scheme
+    }
+
+    /// Sets what a step does with the momentum of a model with holonomic constraints.
+    pub fn set_holonomic_scheme(&mut self, scheme: HolonomicScheme) {
+        self.holonomic_scheme = scheme;
     }
 
     /// Current input values.
@@ -164,6 +181,83 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
 
     fn constrained() -> bool {
         S::ONE_FORMS + S::HOLONOMIC > 0
+    }
+
+    /// The rows of the constraints on the velocity at `q`: the one-forms, the holonomic
+    /// differentials and the hidden constraints' differentials (found at `(q, guess)`, so that
+    /// the velocity of a state is solved the same way before a run begins; none where they
+    /// cannot be evaluated: the velocity solve then reports the coordinates it cannot fix).
+    fn velocity_forms(&self, q: &SVector<f64, N>, guess: &SVector<f64, N>) -> DMatrix<f64> {
+        let system = self.discrete.system();
+        let mut rows: Vec<SVector<f64, N>> = (0..S::ONE_FORMS)
+            .map(|a| constraint::one_form(system, q, a).0)
+            .chain((0..S::HOLONOMIC).map(|b| constraint::holonomic(system, q, b).1))
+            .collect();
+        // The hidden constraints do not depend on t (refused at the start otherwise).
+        let hidden = HiddenConstraints::find(system, q, guess, 0.0, &self.inputs);
+        if hidden.count() > 0 {
+            if let Ok(e) = hidden.evaluate(system, q, guess, 0.0, &self.inputs) {
+                rows.extend(
+                    e.differential
+                        .row_iter()
+                        .map(|r| SVector::<f64, N>::from_iterator(r.iter().copied())),
+                );
+            }
+        }
+        DMatrix::from_fn(rows.len(), N, |r, c| rows[r][c])
+    }
+
+    /// The velocity at `(q, p)` with the constraints' multipliers `ν` (see
+    /// [`legendre::constrained_velocity`]), or the plain Legendre inversion with no multipliers.
+    fn velocity_with_multipliers(
+        &self,
+        newton: &mut Newton,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+    ) -> Result<(SVector<f64, N>, DVector<f64>), NewtonFailure> {
+        let system = self.discrete.system();
+        let forms = self.velocity_forms(q, guess);
+        if forms.nrows() > 0 {
+            if newton.options().max_iterations > 0 && N + forms.nrows() != self.velocity_unknowns()
+            {
+                // Sized for the run's constraints; this state has others (before the run).
+                let mut sized = Newton::new(N + forms.nrows(), *newton.options())
+                    .map_err(|_| NewtonFailure::NonFinite)?;
+                return legendre::constrained_velocity(system, &mut sized, q, p, &forms, guess);
+            }
+            legendre::constrained_velocity(system, newton, q, p, &forms, guess)
+        } else {
+            legendre::velocity(system, newton, q, p, guess).map(|v| (v, DVector::zeros(0)))
+        }
+    }
+
+    /// RATTLE's momentum projection at the end of a step: `p ← p + Σ_b ν_b dg_b(q)` with `ν`
+    /// from the constrained Legendre transform at `(q, p)`, so that the velocity of the new
+    /// momentum is tangent to the holonomic constraints (and allowed by the other constraints).
+    fn project_momentum(&self, state: &mut State<N>, step: u64) -> Result<(), DiracError> {
+        let options = crate::newton::NewtonOptions {
+            line_search: true,
+            max_contraction: f64::INFINITY,
+            ..Default::default()
+        };
+        let mut newton = Newton::new(self.velocity_unknowns(), options)?;
+        let (v, nu) = self
+            .velocity_with_multipliers(&mut newton, &state.q, &state.p, &state.velocity)
+            .map_err(|failure| DiracError::Projection {
+                step,
+                why: format!(
+                    "the velocity tangent to the holonomic constraints could not be solved for \
+                     ({failure:?})"
+                ),
+            })?;
+        let system = self.discrete.system();
+        for b in 0..S::HOLONOMIC {
+            let form = constraint::holonomic(system, &state.q, b).1;
+            state.p += form * nu[S::ONE_FORMS + b];
+        }
+        state.velocity = v;
+        Ok(())
     }
 
     /// Second derivatives of the step from `state` solved by `x` with respect to `(q_k, p_k)`,
@@ -414,7 +508,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
 
     /// `L` and the energy finite at `(q, v)`, and the constraints, their velocity form and the
     /// hidden constraints of coordinates without kinetic energy satisfied.
-    fn check_start(&self, state: &State<N>) -> Result<(), DiracError> {
+    fn check_start(&self, state: &State<N>, tolerance: f64) -> Result<(), DiracError> {
         let system = self.discrete.system();
         let (q, p, v) = (&state.q, &state.p, &state.velocity);
         check_finite(system, "initial position", q)?;
@@ -441,8 +535,49 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 value: energy,
             });
         }
-        initial_state::check(system, state.t, q, v, &self.inputs)
-            .map_err(DiracError::InconsistentInitialState)
+        initial_state::check(system, state.t, q, v, &self.inputs, tolerance)
+            .map_err(DiracError::InconsistentInitialState)?;
+        let hidden = HiddenConstraints::find(system, q, v, state.t, &self.inputs);
+        if hidden.count() > 0 {
+            if !C::TRANSLATION {
+                return Err(DiracError::Unsupported(format!(
+                    "hidden constraints of coordinates without kinetic energy ({}) on a \
+                     configuration space other than Rⁿ",
+                    hidden.names(system)
+                )));
+            }
+            // c must not depend on t explicitly: its velocity form would miss ∂c/∂t.
+            let at = |t: f64| {
+                hidden
+                    .evaluate(system, q, v, t, &self.inputs)
+                    .map_err(DiracError::InconsistentInitialState)
+            };
+            let (now, scale) = {
+                let e = at(state.t)?;
+                (e.value, e.scale)
+            };
+            for t in [state.t - 1.0, state.t + 1.0] {
+                if (at(t)?.value - &now).amax() > 1e-12 * scale {
+                    return Err(DiracError::Unsupported(format!(
+                        "a hidden constraint of the coordinates without kinetic energy ({}) \
+                         that depends on time explicitly (a force on them that depends on t)",
+                        hidden.names(system)
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Finds the hidden constraints of the coordinates without kinetic energy at the start.
+    fn begin(&mut self, state: &State<N>) {
+        self.hidden = HiddenConstraints::find(
+            self.discrete.system(),
+            &state.q,
+            &state.velocity,
+            state.t,
+            &self.inputs,
+        );
     }
 
     /// The last step's solution (constant chart velocity, the same multipliers), or the path
@@ -554,6 +689,15 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         check_finite(system, "new position", &next.q)?;
         check_finite(system, "new momentum", &next.p)?;
         next.velocity = space.push_forward(&state.q, &xi, &(xi / self.discrete.h()));
+        if self.hidden.count() > 0 {
+            let t = state.t + self.discrete.h();
+            self.hidden
+                .project(system, &mut next.q, &next.velocity, t, &self.inputs)
+                .map_err(|why| DiracError::Projection { step, why })?;
+        }
+        if S::HOLONOMIC > 0 && self.holonomic_scheme == HolonomicScheme::Rattle {
+            self.project_momentum(&mut next, step)?;
+        }
         // The quadrature may never evaluate L at q_{k+1} (the midpoint rule does not): a step
         // that leaves the Lagrangian's domain is refused here, not found later as NaN energies.
         let lagrangian = system.lagrangian(&next.q, &next.velocity);
@@ -584,6 +728,15 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         self.layout.name(column, |i| self.coordinate_name(i))
     }
 
+    /// `N`, plus one multiplier per constraint on the velocity for a constrained model or one
+    /// with hidden constraints.
+    fn velocity_unknowns(&self) -> usize {
+        N + S::ONE_FORMS + S::HOLONOMIC + self.hidden.count()
+    }
+
+    /// The Legendre inversion; for a constrained model (or one with hidden constraints), the
+    /// velocity the constraints allow whose momentum differs from `p` by a constraint impulse
+    /// (see [`legendre::constrained_velocity`]): `A(q) v = 0`, `dg(q) v = 0`, `dc(q) v = 0`.
     fn velocity(
         &self,
         newton: &mut Newton,
@@ -591,7 +744,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, NewtonFailure> {
-        legendre::velocity(self.discrete.system(), newton, q, p, guess)
+        self.velocity_with_multipliers(newton, q, p, guess)
+            .map(|(v, _)| v)
     }
 
     fn energy(&self, q: &SVector<f64, N>, _p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64 {
@@ -626,6 +780,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             inputs,
             ..
         } = self.sensitivity(state, x, newton)?;
+        if S::HOLONOMIC > 0 && self.holonomic_scheme == HolonomicScheme::Rattle {
+            return Err(DiracError::Unsupported(
+                "derivatives of the step map through RATTLE's momentum projection (use \
+                 HolonomicScheme::Shake, which gives the same positions)"
+                    .into(),
+            ));
+        }
         let layout = &self.layout;
         let s = layout.points();
         let parameters = 2 * N + inputs;
@@ -633,6 +794,23 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         let mut dq = dx.rows(layout.end_point(), N).clone_owned();
         for i in 0..N {
             dq[(i, i)] += 1.0;
+        }
+        if self.hidden.count() > 0 {
+            // The end point is projected along Z onto c = 0: dq ← (I − Z (dc Z)⁺ dc) dq.
+            let end = state.q + x.fixed_rows::<N>(layout.end_point());
+            let e = self
+                .hidden
+                .evaluate(self.discrete.system(), &end, &state.velocity, state.t, &self.inputs)
+                .map_err(|why| DiracError::Projection { step: 0, why })?;
+            let free = e.free();
+            let reduced = (&e.differential * free).pseudo_inverse(1e-14).map_err(|m| {
+                DiracError::Projection {
+                    step: 0,
+                    why: m.to_string(),
+                }
+            })?;
+            let correction = free * reduced * &e.differential * &dq;
+            dq -= correction;
         }
         // p_{k+1} = ∂L_d/∂ξ_s + f_s + (1 − σ) A(q_c)ᵀμ.
         let mut dp = DMatrix::zeros(N, parameters);

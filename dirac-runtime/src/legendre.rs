@@ -1,6 +1,6 @@
 //! The Legendre transform: momentum from velocity, velocity from momentum, and the energy.
 
-use nalgebra::{DVector, SVector};
+use nalgebra::{DMatrix, DVector, SVector};
 
 use crate::derivatives::{Seed, degenerate, seeded};
 use crate::newton::{Newton, NewtonFailure};
@@ -76,4 +76,49 @@ pub(crate) fn velocity<S: DiracSystem<N>, const N: usize>(
         l.first.abs().sup(&p.abs()).amax()
     })?;
     Ok(SVector::from_column_slice(x.as_slice()))
+}
+
+/// The Legendre transform of a constrained model: solves
+///
+/// ```text
+/// ∂L/∂v (q, v) = p + Cᵀν,    C v = 0
+/// ```
+///
+/// for `(v, ν)` from `guess`, where the rows of `C` are the constraint forms at `q` (one-forms,
+/// holonomic differentials, hidden constraints' differentials). A discrete momentum carries a
+/// component along the constraint forces (`Cᵀν`) that the velocity does not: the solution is
+/// the velocity the constraints allow whose momentum differs from `p` by a constraint impulse.
+/// The velocities of coordinates without kinetic energy are fixed by `C v = 0`; where they are
+/// not (the matrix `[[∂²L/∂v², −Cᵀ], [C, 0]]` is singular), Newton fails. `newton` must be sized
+/// for `N + C.nrows()` unknowns.
+pub(crate) fn constrained_velocity<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    newton: &mut Newton,
+    q: &SVector<f64, N>,
+    p: &SVector<f64, N>,
+    forms: &DMatrix<f64>,
+    guess: &SVector<f64, N>,
+) -> Result<(SVector<f64, N>, DVector<f64>), NewtonFailure> {
+    let m = forms.nrows();
+    let mut x = DVector::zeros(N + m);
+    x.rows_mut(0, N).copy_from(guess);
+    newton.solve(&mut x, |x, r, j| {
+        let v = SVector::<f64, N>::from_column_slice(&x.as_slice()[..N]);
+        let nu = x.rows(N, m);
+        let l = seeded(system, q, &v, Seed::VELOCITY, Seed::VELOCITY);
+        let impulse = forms.transpose() * nu;
+        let mut scale = l.first.abs().sup(&p.abs()).amax();
+        for i in 0..N {
+            r[i] = l.first[i] - p[i] - impulse[i];
+            scale = scale.max(impulse[i].abs());
+        }
+        let rate = forms * v;
+        r.rows_mut(N, m).copy_from(&rate);
+        j.view_mut((0, 0), (N, N)).copy_from(&l.mixed);
+        j.view_mut((0, N), (N, m)).copy_from(&(-forms.transpose()));
+        j.view_mut((N, 0), (m, N)).copy_from(forms);
+        scale.max(forms.amax() * v.amax())
+    })?;
+    let v = SVector::from_column_slice(&x.as_slice()[..N]);
+    Ok((v, x.rows(N, m).into_owned()))
 }

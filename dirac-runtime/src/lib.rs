@@ -19,6 +19,8 @@ pub mod discrete_lagrangian;
 pub mod error;
 pub mod euler_lagrange;
 mod force;
+mod hidden_constraint;
+mod holonomic_scheme;
 mod initial_state;
 mod layout;
 pub mod legendre;
@@ -34,6 +36,7 @@ pub mod trajectory;
 
 pub use configuration_space::{ConfigurationSpace, Euclidean, Positive};
 pub use constraint::ConstraintPoint;
+pub use holonomic_scheme::HolonomicScheme;
 pub use discrete_lagrangian::DiscreteLagrangian;
 pub use error::DiracError;
 pub use lu::SingularPivot;

@@ -120,8 +120,16 @@ pub trait StepEquations<const N: usize> {
     fn coordinate_name(&self, i: usize) -> String;
 
     /// Checks that `state` is a valid initial state (finite, in the model's domain, consistent
-    /// with its constraints): the error says what is violated.
-    fn check_start(&self, state: &State<N>) -> Result<(), DiracError>;
+    /// with its constraints to the relative `tolerance`, which the stepper scales to its solver
+    /// tolerance): the error says what is violated.
+    fn check_start(&self, state: &State<N>, tolerance: f64) -> Result<(), DiracError>;
+
+    /// Called once a checked `state` becomes the start of a run, before its first step: what the
+    /// equations find out about the model there (e.g. which coordinates carry no kinetic
+    /// energy) they keep for the run.
+    fn begin(&mut self, state: &State<N>) {
+        let _ = state;
+    }
 
     /// Prepares the step from `state` and writes the predictor into `x`. `previous` holds the
     /// solution of the last accepted step, when there is one.
@@ -155,8 +163,14 @@ pub trait StepEquations<const N: usize> {
     /// multiplier).
     fn unknown_name(&self, column: usize) -> String;
 
-    /// The velocity at `(q, p)`, solved from `guess` by `newton` (sized for `N` unknowns) where
-    /// it is implicit.
+    /// Number of unknowns of the velocity solve (`N` unless the velocity comes with
+    /// multipliers).
+    fn velocity_unknowns(&self) -> usize {
+        N
+    }
+
+    /// The velocity at `(q, p)`, solved from `guess` by `newton` (sized for
+    /// [`velocity_unknowns`](Self::velocity_unknowns)) where it is implicit.
     fn velocity(
         &self,
         newton: &mut Newton,

@@ -17,6 +17,7 @@ use crate::configuration_space::{ConfigurationSpace, Euclidean};
 use crate::constraint::ConstraintPoint;
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
+use crate::holonomic_scheme::HolonomicScheme;
 use crate::euler_lagrange::{EulerLagrange, check_finite};
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
@@ -25,6 +26,10 @@ use crate::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
 use crate::trajectory::{Interrupted, Trajectory};
+
+/// The relative consistency an initial state must have with the model's constraints, at the
+/// default solver tolerance.
+const START_TOLERANCE: f64 = 1e-9;
 
 /// Which solve a Newton failure comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -188,6 +193,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         Ok((first, second))
     }
 
+    /// Chooses what a step does with the momentum of a model with holonomic constraints
+    /// (default [`HolonomicScheme::Shake`]).
+    pub fn with_holonomic_scheme(mut self, scheme: HolonomicScheme) -> Self {
+        self.equations.set_holonomic_scheme(scheme);
+        self
+    }
+
     /// Where the constraint one-forms are evaluated on a step.
     pub fn constraint_point(&self) -> ConstraintPoint {
         self.equations.constraint_point()
@@ -294,7 +306,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             max_iterations: self.newton.options().max_iterations.max(50),
             ..*self.newton.options()
         };
-        let mut newton = Newton::new(N, options)?;
+        let mut newton = Newton::new(self.equations.velocity_unknowns(), options)?;
         self.equations
             .velocity(&mut newton, q, p, guess)
             .map_err(|f| self.failure(Problem::Velocity, f))
@@ -309,7 +321,11 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                 value: state.t,
             });
         }
-        self.equations.check_start(&state)?;
+        // Consistency to a relative 1e-9, or looser where the solver is asked for less: a state
+        // this stepper (or another) produced is always accepted.
+        let tolerance = START_TOLERANCE.max(100.0 * self.newton.options().residual_tolerance);
+        self.equations.check_start(&state, tolerance)?;
+        self.equations.begin(&state);
         self.reset(state);
         Ok(())
     }
@@ -566,8 +582,10 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                     .involved
                     .iter()
                     .map(|&column| {
-                        if which == Problem::Velocity {
+                        if which == Problem::Velocity && column < N {
                             format!("{} (velocity)", self.equations.coordinate_name(column))
+                        } else if which == Problem::Velocity {
+                            format!("the multiplier of velocity constraint {}", column - N)
                         } else {
                             self.equations.unknown_name(column)
                         }

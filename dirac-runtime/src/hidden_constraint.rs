@@ -1,0 +1,315 @@
+//! Hidden constraints of the coordinates without kinetic energy, and how they are held at the
+//! step's nodes.
+//!
+//! A coordinate `q_i` without kinetic energy (`∂²L/∂v_i∂v = 0`: a capacitor's charge, a massless
+//! port) has an Euler–Lagrange row without acceleration,
+//!
+//! ```text
+//! R_i(q, v, t) + (Cᵀν)_i = 0,    R = ∂L/∂q + F − (∂²L/∂q∂v)ᵀ v,
+//! ```
+//!
+//! where the rows of `C(q)` are the constraint one-forms and the holonomic constraints'
+//! differentials, and `ν` their multipliers. Over the degenerate coordinates `D`, the
+//! multipliers are eliminated by a basis `W` of the null space of `B = C[:, D]` (the
+//! combinations of those rows no constraint force reaches): `Wᵀ R_D = 0`. The combinations of
+//! these that contain no velocity (along the velocities the constraints allow) are algebraic
+//! constraints on `q`, the hidden constraints `c(q) = 0`; the others are differential equations
+//! of first order. Parallel capacitors give `q_c1/c1 − q_c3/c3 = 0`.
+//!
+//! A variational step imposes the Euler–Lagrange rows at its quadrature nodes, not at the step's
+//! end points: the midpoint rule holds `c` at each step's midpoint, and the end points of the
+//! degenerate coordinates are then fixed only through `q_{k+1} = 2 q̄ − q_k`. A deviation at a
+//! node is reflected from step to step (a parasitic mode of root −1) and round-off accumulates
+//! in it. The stepper holds `c(q_{k+1}) = 0` at every node by moving `q_{k+1}` along the free
+//! directions `Z = ker B` (the degenerate coordinates' displacements that no constraint sees,
+//! exactly the directions the step leaves undetermined at its nodes), by Newton's method on
+//! `c(q_{k+1} + Z α) = 0` with the minimal-norm update. On a consistent trajectory the
+//! correction is round-off for hidden constraints linear in `q` and of the method's order
+//! otherwise; constraints the stepper imposes on `q_{k+1} − q_k` are unchanged where the
+//! constraint forms are constant (circuits).
+//!
+//! The velocity at a node satisfies their velocity form `dc(q) v = 0` besides the constraints
+//! (see [`legendre`](crate::legendre)). Hidden constraints that depend on time explicitly (a
+//! force on a degenerate coordinate that depends on `t`) are refused at the start.
+
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+
+use crate::constraint;
+use crate::derivatives::{Seed, degenerate, force_jacobian, seeded};
+use crate::system::DiracSystem;
+
+/// The degenerate coordinates of a model and the number of its hidden constraints, found at the
+/// start of a run.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct HiddenConstraints {
+    /// Coordinates without kinetic energy.
+    dead: Vec<usize>,
+    /// Number of algebraic combinations of their rows.
+    count: usize,
+    /// The combinations `G` and free directions `W` found at the start, kept while the
+    /// constraint forms are constant (circuits): they do not change along the motion.
+    fixed: Option<(DMatrix<f64>, DMatrix<f64>)>,
+}
+
+/// The hidden constraints at a point: `c(q)`, its differential (rows), the free directions
+/// `Z` (columns, in all coordinates), and the size of the terms summed into `c`.
+pub(crate) struct Evaluation {
+    pub value: DVector<f64>,
+    pub differential: DMatrix<f64>,
+    free: DMatrix<f64>,
+    pub scale: f64,
+}
+
+impl Evaluation {
+    /// The free directions `Z` (columns, in all coordinates).
+    pub fn free(&self) -> &DMatrix<f64> {
+        &self.free
+    }
+}
+
+impl HiddenConstraints {
+    /// The degenerate coordinates at `(q, v)` and the number of hidden constraints among their
+    /// rows (velocity dependence is tested at `v` and at a second admissible velocity).
+    pub fn find<S: DiracSystem<N>, const N: usize>(
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        t: f64,
+        inputs: &[f64],
+    ) -> Self {
+        let dead = degenerate(system, q, v);
+        if dead.is_empty() {
+            return Self::default();
+        }
+        let mut found = Self {
+            dead,
+            count: 0,
+            fixed: None,
+        };
+        let combinations = found.combinations(system, q, v, t, inputs);
+        found.count = combinations.0.ncols();
+        if constant_forms(system, q) {
+            found.fixed = Some(combinations);
+        }
+        found
+    }
+
+    /// Number of hidden (algebraic) constraints.
+    pub fn count(&self) -> usize {
+        self.count
+    }
+
+    /// The names of the degenerate coordinates.
+    pub fn names<S: DiracSystem<N>, const N: usize>(&self, system: &S) -> String {
+        let names: Vec<String> = self.dead.iter().map(|&i| system.coordinate_name(i)).collect();
+        names.join(", ")
+    }
+
+    /// The rows of the constraint forms at `q` (one-forms, then holonomic differentials).
+    fn forms<S: DiracSystem<N>, const N: usize>(system: &S, q: &SVector<f64, N>) -> DMatrix<f64> {
+        let rows: Vec<SVector<f64, N>> = (0..S::ONE_FORMS)
+            .map(|a| constraint::one_form(system, q, a).0)
+            .chain((0..S::HOLONOMIC).map(|b| constraint::holonomic(system, q, b).1))
+            .collect();
+        DMatrix::from_fn(rows.len(), N, |r, c| rows[r][c])
+    }
+
+    /// `R_D` with its Jacobian in `v` (exact) and in `q` (without the third derivatives of `L`,
+    /// which cancel in the algebraic combinations), and the size of its terms.
+    fn rows<S: DiracSystem<N>, const N: usize>(
+        &self,
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        t: f64,
+        inputs: &[f64],
+    ) -> (DVector<f64>, DMatrix<f64>, DMatrix<f64>, f64) {
+        let qq = seeded(system, q, v, Seed::POSITION, Seed::POSITION);
+        let qv = seeded(system, q, v, Seed::POSITION, Seed::VELOCITY).mixed;
+        let transport = qv.transpose() * v;
+        let (mut force, mut force_q, mut force_v) =
+            (SVector::zeros(), SMatrix::zeros(), SMatrix::zeros());
+        if S::FORCES {
+            (force, force_q) = force_jacobian(system, q, v, t, inputs, Seed::POSITION);
+            force_v = force_jacobian(system, q, v, t, inputs, Seed::VELOCITY).1;
+        }
+        let d = &self.dead;
+        let value = DVector::from_iterator(
+            d.len(),
+            d.iter().map(|&i| qq.first[i] + force[i] - transport[i]),
+        );
+        let by_v = DMatrix::from_fn(d.len(), N, |r, c| {
+            qv[(d[r], c)] - qv[(c, d[r])] + force_v[(d[r], c)]
+        });
+        let by_q = DMatrix::from_fn(d.len(), N, |r, c| qq.mixed[(d[r], c)] + force_q[(d[r], c)]);
+        let scale = d
+            .iter()
+            .map(|&i| qq.first[i].abs().max(force[i].abs()).max(transport[i].abs()))
+            .fold(0.0, f64::max);
+        (value, by_v, by_q, scale)
+    }
+
+    /// The algebraic combinations `G = W U` of the degenerate rows (columns) and the free
+    /// directions `W` (columns over `D`) at `(q, v)`.
+    fn combinations<S: DiracSystem<N>, const N: usize>(
+        &self,
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        t: f64,
+        inputs: &[f64],
+    ) -> (DMatrix<f64>, DMatrix<f64>) {
+        let forms = Self::forms(system, q);
+        let b = DMatrix::from_fn(forms.nrows(), self.dead.len(), |r, c| {
+            forms[(r, self.dead[c])]
+        });
+        let w = null_space(&b);
+        let admissible = null_space(&forms);
+        // A second admissible velocity: v moved by the sum of the admissible directions.
+        let shift = &admissible * DVector::from_element(admissible.ncols(), 1.0);
+        let other = v + SVector::<f64, N>::from_fn(|i, _| shift[i] * (1.0 + v.amax()));
+        let mut dependence = DMatrix::zeros(w.ncols(), 2 * admissible.ncols());
+        for (k, velocity) in [v, &other].into_iter().enumerate() {
+            let by_v = self.rows(system, q, velocity, t, inputs).1;
+            let j = w.transpose() * by_v * &admissible;
+            dependence
+                .columns_mut(k * admissible.ncols(), admissible.ncols())
+                .copy_from(&j);
+        }
+        let u = null_space(&dependence.transpose());
+        (&w * u, w)
+    }
+
+    /// `c(q)` at `(q, v, t)` with its differential and free directions.
+    pub fn evaluate<S: DiracSystem<N>, const N: usize>(
+        &self,
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        t: f64,
+        inputs: &[f64],
+    ) -> Result<Evaluation, String> {
+        let (g, w) = match &self.fixed {
+            Some(fixed) if constant_forms(system, q) => fixed.clone(),
+            _ => self.combinations(system, q, v, t, inputs),
+        };
+        if g.ncols() != self.count {
+            return Err(format!(
+                "the number of hidden constraints of the coordinates without kinetic energy ({}) \
+                 changed from {} to {} along the motion",
+                self.names(system),
+                self.count,
+                g.ncols()
+            ));
+        }
+        let (value, _, by_q, scale) = self.rows(system, q, v, t, inputs);
+        let mut free = DMatrix::zeros(N, w.ncols());
+        for (r, &i) in self.dead.iter().enumerate() {
+            free.row_mut(i).copy_from(&w.row(r));
+        }
+        Ok(Evaluation {
+            value: g.transpose() * value,
+            differential: g.transpose() * by_q,
+            free,
+            scale,
+        })
+    }
+
+    /// Moves `q` along the free directions until `c(q) = 0` to round-off: Newton's method with
+    /// the minimal-norm update. `v`, `t` and the inputs are those of the node.
+    pub fn project<S: DiracSystem<N>, const N: usize>(
+        &self,
+        system: &S,
+        q: &mut SVector<f64, N>,
+        v: &SVector<f64, N>,
+        t: f64,
+        inputs: &[f64],
+    ) -> Result<(), String> {
+        if self.count == 0 {
+            return Ok(());
+        }
+        let mut last = f64::INFINITY;
+        for _ in 0..MAX_ITERATIONS {
+            let e = self.evaluate(system, q, v, t, inputs)?;
+            let residual = e.value.amax();
+            if !residual.is_finite() {
+                return Err("a hidden constraint is not finite at the step's end".into());
+            }
+            if residual <= ROUND_OFF * e.scale || residual >= 0.5 * last {
+                return self.accept(residual, e.scale);
+            }
+            last = residual;
+            let reduced = &e.differential * &e.free;
+            let alpha = reduced
+                .svd(true, true)
+                .solve(&(-&e.value), 1e-14)
+                .map_err(|m| m.to_string())?;
+            let step = &e.free * alpha;
+            *q += SVector::<f64, N>::from_fn(|i, _| step[i]);
+        }
+        let e = self.evaluate(system, q, v, t, inputs)?;
+        self.accept(e.value.amax(), e.scale)
+    }
+
+    fn accept(&self, residual: f64, scale: f64) -> Result<(), String> {
+        if residual <= TOLERANCE * scale.max(f64::MIN_POSITIVE) {
+            Ok(())
+        } else {
+            Err(format!(
+                "the hidden constraints could not be held at the step's end (residual \
+                 {residual:.3e}, terms of size {scale:.3e})"
+            ))
+        }
+    }
+}
+
+/// Whether the constraint forms are constant at `q` (no holonomic constraint, one-forms with
+/// zero derivative).
+fn constant_forms<S: DiracSystem<N>, const N: usize>(system: &S, q: &SVector<f64, N>) -> bool {
+    S::HOLONOMIC == 0
+        && (0..S::ONE_FORMS).all(|a| constraint::one_form(system, q, a).1.iter().all(|x| *x == 0.0))
+}
+
+/// Iterations of the projection (a linear hidden constraint needs one).
+const MAX_ITERATIONS: usize = 8;
+/// A residual this far below its terms is round-off: the projection stops.
+const ROUND_OFF: f64 = 4.0 * f64::EPSILON;
+/// The largest residual, relative to its terms, a projection may end with.
+const TOLERANCE: f64 = 1e-10;
+
+/// An orthonormal basis (columns) of `{x : m x = 0}`, by the singular value decomposition of
+/// `m` padded with zero rows to a square matrix: singular values below `1e-10` of the largest
+/// count as zero.
+pub(crate) fn null_space(m: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = m.ncols();
+    if n == 0 || m.nrows() == 0 || m.amax() == 0.0 {
+        return DMatrix::identity(n, n);
+    }
+    let rows = m.nrows().max(n);
+    let padded = DMatrix::from_fn(rows, n, |r, c| if r < m.nrows() { m[(r, c)] } else { 0.0 });
+    let svd = padded.svd(false, true);
+    let v_t = svd.v_t.expect("requested");
+    let largest = svd.singular_values.amax();
+    let kept: Vec<usize> = (0..n)
+        .filter(|&i| svd.singular_values[i] <= 1e-10 * largest)
+        .collect();
+    DMatrix::from_fn(n, kept.len(), |r, c| v_t[(kept[c], r)])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::dmatrix;
+
+    #[test]
+    fn null_space_of_a_rank_one_matrix() {
+        let m = dmatrix![1.0, 2.0, 0.0; 2.0, 4.0, 0.0];
+        let z = null_space(&m);
+        assert_eq!(z.ncols(), 2);
+        assert!((&m * &z).amax() < 1e-14);
+        assert!((z.transpose() * &z - DMatrix::identity(2, 2)).amax() < 1e-14);
+        assert_eq!(null_space(&DMatrix::zeros(0, 3)).ncols(), 3);
+        assert_eq!(null_space(&DMatrix::identity(2, 2)).ncols(), 0);
+        assert_eq!(null_space(&DMatrix::zeros(2, 0)).ncols(), 0);
+    }
+}
