@@ -73,8 +73,9 @@ fn chain_growth(c: &mut Criterion) {
 }
 
 /// Constrained steps (midpoint, h = 0.01) beside the unconstrained double pendulum: the LC circuit
-/// (4 coordinates, 2 constant one-forms, KKT 6×6) and the knife edge (3 coordinates, one
-/// configuration-dependent one-form, KKT 4×4).
+/// (4 coordinates, 2 constant one-forms, KKT 6×6, its hidden constraint projected at each step's
+/// end), the knife edge (3 coordinates, one configuration-dependent one-form, KKT 4×4), and the
+/// Cartesian pendulum under SHAKE and RATTLE.
 fn constrained(c: &mut Criterion) {
     let mut group = c.benchmark_group("constrained_midpoint_step");
     let mut unconstrained =
@@ -94,6 +95,22 @@ fn constrained(c: &mut Criterion) {
     group.bench_function("knife_edge", |b| {
         b.iter(|| black_box(knife.step()).expect("step"))
     });
+    for scheme in [HolonomicScheme::Shake, HolonomicScheme::Rattle] {
+        let mut pendulum = Stepper::new(
+            scenes::cartesian_pendulum::SCENE,
+            Quadrature::midpoint(),
+            0.01,
+        )
+        .expect("valid scene")
+        .with_holonomic_scheme(scheme);
+        pendulum
+            .start_from_velocity(scenes::cartesian_pendulum::q0(1.0), SVector::zeros())
+            .expect("consistent start");
+        let name = format!("cartesian_pendulum_{scheme:?}").to_lowercase();
+        group.bench_function(name, |b| {
+            b.iter(|| black_box(pendulum.step()).expect("step"))
+        });
+    }
     group.finish();
 }
 

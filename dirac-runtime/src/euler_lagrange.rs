@@ -195,14 +195,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
             .collect();
         // The hidden constraints do not depend on t (refused at the start otherwise).
         let hidden = HiddenConstraints::find(system, q, guess, 0.0, &self.inputs);
-        if hidden.count() > 0 {
-            if let Ok(e) = hidden.evaluate(system, q, guess, 0.0, &self.inputs) {
-                rows.extend(
-                    e.differential
-                        .row_iter()
-                        .map(|r| SVector::<f64, N>::from_iterator(r.iter().copied())),
-                );
-            }
+        if hidden.count() > 0
+            && let Ok(e) = hidden.evaluate(system, q, guess, 0.0, &self.inputs)
+        {
+            rows.extend(
+                e.differential
+                    .row_iter()
+                    .map(|r| SVector::<f64, N>::from_iterator(r.iter().copied())),
+            );
         }
         DMatrix::from_fn(rows.len(), N, |r, c| rows[r][c])
     }
@@ -800,15 +800,21 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             let end = state.q + x.fixed_rows::<N>(layout.end_point());
             let e = self
                 .hidden
-                .evaluate(self.discrete.system(), &end, &state.velocity, state.t, &self.inputs)
+                .evaluate(
+                    self.discrete.system(),
+                    &end,
+                    &state.velocity,
+                    state.t,
+                    &self.inputs,
+                )
                 .map_err(|why| DiracError::Projection { step: 0, why })?;
             let free = e.free();
-            let reduced = (&e.differential * free).pseudo_inverse(1e-14).map_err(|m| {
-                DiracError::Projection {
+            let reduced = (&e.differential * free)
+                .pseudo_inverse(1e-14)
+                .map_err(|m| DiracError::Projection {
                     step: 0,
                     why: m.to_string(),
-                }
-            })?;
+                })?;
             let correction = free * reduced * &e.differential * &dq;
             dq -= correction;
         }

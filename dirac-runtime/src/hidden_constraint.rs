@@ -101,7 +101,11 @@ impl HiddenConstraints {
 
     /// The names of the degenerate coordinates.
     pub fn names<S: DiracSystem<N>, const N: usize>(&self, system: &S) -> String {
-        let names: Vec<String> = self.dead.iter().map(|&i| system.coordinate_name(i)).collect();
+        let names: Vec<String> = self
+            .dead
+            .iter()
+            .map(|&i| system.coordinate_name(i))
+            .collect();
         names.join(", ")
     }
 
@@ -144,7 +148,12 @@ impl HiddenConstraints {
         let by_q = DMatrix::from_fn(d.len(), N, |r, c| qq.mixed[(d[r], c)] + force_q[(d[r], c)]);
         let scale = d
             .iter()
-            .map(|&i| qq.first[i].abs().max(force[i].abs()).max(transport[i].abs()))
+            .map(|&i| {
+                qq.first[i]
+                    .abs()
+                    .max(force[i].abs())
+                    .max(transport[i].abs())
+            })
             .fold(0.0, f64::max);
         (value, by_v, by_q, scale)
     }
@@ -267,7 +276,12 @@ impl HiddenConstraints {
 /// zero derivative).
 fn constant_forms<S: DiracSystem<N>, const N: usize>(system: &S, q: &SVector<f64, N>) -> bool {
     S::HOLONOMIC == 0
-        && (0..S::ONE_FORMS).all(|a| constraint::one_form(system, q, a).1.iter().all(|x| *x == 0.0))
+        && (0..S::ONE_FORMS).all(|a| {
+            constraint::one_form(system, q, a)
+                .1
+                .iter()
+                .all(|x| *x == 0.0)
+        })
 }
 
 /// Iterations of the projection (a linear hidden constraint needs one).

@@ -72,7 +72,12 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
     let transport = qv.mixed.transpose() * v0;
     let size = dead
         .iter()
-        .map(|&i| qv.first[i].abs().max(force[i].abs()).max(transport[i].abs()))
+        .map(|&i| {
+            qv.first[i]
+                .abs()
+                .max(force[i].abs())
+                .max(transport[i].abs())
+        })
         .fold(0.0, f64::max);
     if residual > tolerance * size {
         let names: Vec<String> = dead.iter().map(|&i| name(i)).collect();

@@ -36,9 +36,9 @@ pub mod trajectory;
 
 pub use configuration_space::{ConfigurationSpace, Euclidean, Positive};
 pub use constraint::ConstraintPoint;
-pub use holonomic_scheme::HolonomicScheme;
 pub use discrete_lagrangian::DiscreteLagrangian;
 pub use error::DiracError;
+pub use holonomic_scheme::HolonomicScheme;
 pub use lu::SingularPivot;
 pub use newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 pub use quadrature::{Quadrature, Rule};
