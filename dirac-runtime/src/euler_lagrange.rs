@@ -735,8 +735,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     }
 
     /// The Legendre inversion; for a constrained model (or one with hidden constraints), the
-    /// velocity the constraints allow whose momentum differs from `p` by a constraint impulse
-    /// (see [`legendre::constrained_velocity`]): `A(q) v = 0`, `dg(q) v = 0`, `dc(q) v = 0`.
+    /// velocity the constraints allow whose momentum differs from `p` by a constraint impulse,
+    /// solving `∂L/∂v(q, v) = p + Cᵀν`, `C v = 0`: `A(q) v = 0`, `dg(q) v = 0`, `dc(q) v = 0`.
     fn velocity(
         &self,
         newton: &mut Newton,
