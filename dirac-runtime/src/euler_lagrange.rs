@@ -21,6 +21,7 @@ use crate::constraint::{self, ConstraintPoint, StepConstraints};
 use crate::derivatives::Dual;
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
+use crate::first_order;
 use crate::hidden_constraint::HiddenConstraints;
 use crate::holonomic_scheme::HolonomicScheme;
 use crate::initial_state;
@@ -60,6 +61,9 @@ pub struct EulerLagrange<S, const N: usize, C> {
     holonomic_scheme: HolonomicScheme,
     /// The hidden constraints of the run (found when it begins).
     hidden: HiddenConstraints,
+    /// Whether the run's Lagrangian is linear in every velocity (found when it begins): the
+    /// step equations are those of [`first_order`].
+    first_order: bool,
     layout: Layout,
     /// Current values of the system's inputs.
     inputs: Vec<f64>,
@@ -110,6 +114,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
             point,
             holonomic_scheme: HolonomicScheme::default(),
             hidden: HiddenConstraints::default(),
+            first_order: false,
             layout: Layout::new(N, s, S::ONE_FORMS, S::HOLONOMIC),
             inputs: vec![0.0; S::INPUTS],
             lifted_inputs: vec![Dual::from(0.0); S::INPUTS],
@@ -217,6 +222,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         guess: &SVector<f64, N>,
     ) -> Result<(SVector<f64, N>, DVector<f64>), NewtonFailure> {
         let system = self.discrete.system();
+        if first_order::is_first_order(system, q, guess) {
+            return legendre::first_order_velocity(system, newton, q, guess)
+                .map(|v| (v, DVector::zeros(0)));
+        }
         let forms = self.velocity_forms(q, guess);
         if forms.nrows() > 0 {
             if newton.options().max_iterations > 0 && N + forms.nrows() != self.velocity_unknowns()
@@ -275,10 +284,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<StepHessians<N>, DiracError> {
-        if Self::constrained() || !C::TRANSLATION {
+        if Self::constrained() || !C::TRANSLATION || self.first_order {
             return Err(DiracError::Unsupported(
-                "second derivatives of the step map of a model with constraints, or on a space \
-                 other than Rⁿ"
+                "second derivatives of the step map of a model with constraints, linear in the \
+                 velocities, or on a space other than Rⁿ"
                     .into(),
             ));
         }
@@ -368,9 +377,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<Sensitivity<N>, DiracError> {
-        if !C::TRANSLATION {
+        if !C::TRANSLATION || self.first_order {
             return Err(DiracError::Unsupported(
-                "derivatives of the step map on a configuration space other than Rⁿ".into(),
+                "derivatives of the step map on a configuration space other than Rⁿ, or of a \
+                 Lagrangian linear in the velocities"
+                    .into(),
             ));
         }
         let discrete = &self.discrete;
@@ -537,6 +548,28 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         }
         initial_state::check(system, state.t, q, v, &self.inputs, tolerance)
             .map_err(DiracError::InconsistentInitialState)?;
+        if first_order::is_first_order(system, q, v) {
+            if S::FORCES || !C::TRANSLATION {
+                return Err(DiracError::Unsupported(
+                    "a Lagrangian linear in the velocities with forces, or on a configuration \
+                     space other than Rⁿ"
+                        .into(),
+                ));
+            }
+            if let Some(why) = first_order::refusal(self.discrete.quadrature()) {
+                return Err(DiracError::InvalidQuadrature(why));
+            }
+            let theta = legendre::momentum(system, q, v);
+            if (p - theta).amax() > tolerance * theta.amax().max(p.amax()) {
+                return Err(DiracError::InconsistentInitialState(format!(
+                    "the Lagrangian is linear in the velocities, so its momentum is \
+                     ϑ(q) = ∂L/∂v = {:?}, not {:?} (start from the position alone with \
+                     Stepper::start_from_position)",
+                    theta.as_slice(),
+                    p.as_slice()
+                )));
+            }
+        }
         let hidden = HiddenConstraints::find(system, q, v, state.t, &self.inputs);
         if hidden.count() > 0 {
             if !C::TRANSLATION {
@@ -571,6 +604,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
 
     /// Finds the hidden constraints of the coordinates without kinetic energy at the start.
     fn begin(&mut self, state: &State<N>) {
+        self.first_order =
+            first_order::is_first_order(self.discrete.system(), &state.q, &state.velocity);
         self.hidden = HiddenConstraints::find(
             self.discrete.system(),
             &state.q,
@@ -624,6 +659,15 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             z.copy_from(&x.fixed_rows::<N>(self.layout.point(j + 1)));
         }
         let discrete = &self.discrete;
+        if self.first_order {
+            return first_order::collocation(
+                discrete,
+                &state.q,
+                &self.increments,
+                residual,
+                jacobian,
+            );
+        }
         let (mut covectors, mut scale) = discrete.euler_lagrange(
             &state.q,
             &self.increments,
@@ -686,6 +730,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                     "step {step} reaches a point where the retraction's tangent map is singular"
                 ))
             })?;
+        if self.first_order {
+            // The primary constraint p = ϑ(q).
+            next.p = legendre::momentum(system, &next.q, &next.velocity);
+            next.p_carry = SVector::zeros();
+        }
         check_finite(system, "new position", &next.q)?;
         check_finite(system, "new momentum", &next.p)?;
         next.velocity = space.push_forward(&state.q, &xi, &(xi / self.discrete.h()));

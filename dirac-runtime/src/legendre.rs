@@ -122,3 +122,27 @@ pub(crate) fn constrained_velocity<S: DiracSystem<N>, const N: usize>(
     let v = SVector::from_column_slice(&x.as_slice()[..N]);
     Ok((v, x.rows(N, m).into_owned()))
 }
+
+/// The velocity of a Lagrangian linear in the velocities, `L = ϑ(q)·v − H(q)`, at `q`: its
+/// momentum `ϑ(q)` does not depend on `v`, and its Euler–Lagrange equations are of first order,
+/// `R(q, v) = ∂L/∂q − (∂²L/∂q∂v)ᵀ v = (ϑ'ᵀ − ϑ') v − ∇H = 0`, which Newton solves from `guess`
+/// with the exact Jacobian `∂²L/∂q∂v − (∂²L/∂q∂v)ᵀ` (the third derivatives of a Lagrangian
+/// linear in `v` vanish there). `newton` must be sized for `N` unknowns; a singular `ϑ'ᵀ − ϑ'`
+/// (a symplectic form that degenerates) fails as a singular Jacobian.
+pub(crate) fn first_order_velocity<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    newton: &mut Newton,
+    q: &SVector<f64, N>,
+    guess: &SVector<f64, N>,
+) -> Result<SVector<f64, N>, NewtonFailure> {
+    let mut x = DVector::from_column_slice(guess.as_slice());
+    newton.solve(&mut x, |x, r, j| {
+        let v = SVector::<f64, N>::from_column_slice(x.as_slice());
+        let l = seeded(system, q, &v, Seed::POSITION, Seed::VELOCITY);
+        let transport = l.mixed.transpose() * v;
+        r.copy_from(&(l.first - transport));
+        j.copy_from(&(l.mixed - l.mixed.transpose()));
+        l.first.abs().sup(&transport.abs()).amax()
+    })?;
+    Ok(SVector::from_column_slice(x.as_slice()))
+}

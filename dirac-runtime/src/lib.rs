@@ -18,6 +18,7 @@ mod derivatives;
 pub mod discrete_lagrangian;
 pub mod error;
 pub mod euler_lagrange;
+mod first_order;
 mod force;
 mod hidden_constraint;
 mod holonomic_scheme;

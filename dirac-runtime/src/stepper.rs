@@ -147,6 +147,43 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         self.start_from_state(State::new(0.0, q0, p0, v0))
     }
 
+    /// Starts a Lagrangian linear in the velocities, `L = ϑ(q)·v − H(q)`, from its position
+    /// alone at `t = 0`: its momentum is `ϑ(q0)` and its velocity solves its first-order
+    /// equations `(ϑ'ᵀ − ϑ') v = ∇H`. Fails for a model with kinetic energy (whose state needs a
+    /// velocity or momentum too) or with constraints.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// /// A particle in the plane in a unit magnetic field, without mass: it drifts along the
+    /// /// level sets of the potential, q̇ = (−∂V/∂y, ∂V/∂x) with V = (x² + y²)/2.
+    /// struct Drift;
+    /// impl DiracSystem<2> for Drift {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+    ///         (q[0] * v[1] - q[1] * v[0]) * 0.5 - (q[0] * q[0] + q[1] * q[1]) * 0.5
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Drift, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_position(vector![1.0, 0.0])?;
+    /// assert!((stepper.v()? - vector![0.0, 1.0]).amax() < 1e-14);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn start_from_position(&mut self, q0: SVector<f64, N>) -> Result<(), DiracError> {
+        check_finite(self.system(), "initial position", &q0)?;
+        let zero = SVector::zeros();
+        if !crate::first_order::is_first_order(self.system(), &q0, &zero) {
+            return Err(DiracError::InconsistentInitialState(
+                "the position alone is the state of a Lagrangian linear in the velocities \
+                 without constraints; this model needs a velocity or a momentum too"
+                    .into(),
+            ));
+        }
+        let v0 = self.velocity_at(&q0, &legendre::momentum(self.system(), &q0, &zero), &zero)?;
+        let p0 = legendre::momentum(self.system(), &q0, &v0);
+        check_finite(self.system(), "initial momentum", &p0)?;
+        self.start_from_state(State::new(0.0, q0, p0, v0))
+    }
+
     /// Starts from position `q0` and momentum `p0` at `t = 0`. The velocity is found by a
     /// globalised Newton solve of `∂L/∂v(q0, v) = p0` from `v = 0`; when that fails (several
     /// velocities share the momentum, or `v = 0` is far from the answer), use
