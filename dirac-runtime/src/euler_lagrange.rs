@@ -192,14 +192,18 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     /// differentials and the hidden constraints' differentials (found at `(q, guess)`, so that
     /// the velocity of a state is solved the same way before a run begins; none where they
     /// cannot be evaluated: the velocity solve then reports the coordinates it cannot fix).
-    fn velocity_forms(&self, q: &SVector<f64, N>, guess: &SVector<f64, N>) -> DMatrix<f64> {
+    fn velocity_forms(
+        &self,
+        q: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+        hidden: &HiddenConstraints,
+    ) -> DMatrix<f64> {
         let system = self.discrete.system();
         let mut rows: Vec<SVector<f64, N>> = (0..S::ONE_FORMS)
             .map(|a| constraint::one_form(system, q, a).0)
             .chain((0..S::HOLONOMIC).map(|b| constraint::holonomic(system, q, b).1))
             .collect();
         // The hidden constraints do not depend on t (refused at the start otherwise).
-        let hidden = HiddenConstraints::find(system, q, guess, 0.0, &self.inputs);
         if hidden.count() > 0
             && let Ok(e) = hidden.evaluate(system, q, guess, 0.0, &self.inputs)
         {
@@ -214,22 +218,49 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
 
     /// The velocity at `(q, p)` with the constraints' multipliers `ν` (see
     /// [`legendre::constrained_velocity`]), or the plain Legendre inversion with no multipliers.
+    /// `run` holds the run's hidden constraints where they are known (inside a step); otherwise
+    /// they are found at `(q, guess)`.
     fn velocity_with_multipliers(
         &self,
         newton: &mut Newton,
         q: &SVector<f64, N>,
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
+        run: Option<&HiddenConstraints>,
     ) -> Result<(SVector<f64, N>, DVector<f64>), NewtonFailure> {
         let system = self.discrete.system();
         if first_order::is_first_order(system, q, guess) {
             return legendre::first_order_velocity(system, newton, q, guess)
                 .map(|v| (v, DVector::zeros(0)));
         }
-        let forms = self.velocity_forms(q, guess);
+        let found;
+        let hidden = match run {
+            Some(hidden) => hidden,
+            None => {
+                found = HiddenConstraints::find(system, q, guess, 0.0, &self.inputs);
+                &found
+            }
+        };
+        if hidden.dynamic() > 0 {
+            // Degenerate rows that are first-order equations (a resistor on a capacitor's
+            // branch) fix their velocities through the dynamics, not through p: the plain
+            // inversion keeps the guess there (see "Not supported yet").
+            let mut sized;
+            let newton = if self.velocity_unknowns() == N {
+                newton
+            } else {
+                sized =
+                    Newton::new(N, *newton.options()).map_err(|_| NewtonFailure::Dimension {
+                        expected: N,
+                        got: self.velocity_unknowns(),
+                    })?;
+                &mut sized
+            };
+            return legendre::velocity(system, newton, q, p, guess).map(|v| (v, DVector::zeros(0)));
+        }
+        let forms = self.velocity_forms(q, guess, hidden);
         if forms.nrows() > 0 {
-            if newton.options().max_iterations > 0 && N + forms.nrows() != self.velocity_unknowns()
-            {
+            if N + forms.nrows() != self.velocity_unknowns() {
                 // Sized for the run's constraints; this state has others (before the run).
                 let mut sized = Newton::new(N + forms.nrows(), *newton.options())
                     .map_err(|_| NewtonFailure::NonFinite)?;
@@ -252,7 +283,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         };
         let mut newton = Newton::new(self.velocity_unknowns(), options)?;
         let (v, nu) = self
-            .velocity_with_multipliers(&mut newton, &state.q, &state.p, &state.velocity)
+            .velocity_with_multipliers(
+                &mut newton,
+                &state.q,
+                &state.p,
+                &state.velocity,
+                Some(&self.hidden),
+            )
             .map_err(|failure| DiracError::Projection {
                 step,
                 why: format!(
@@ -284,10 +321,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<StepHessians<N>, DiracError> {
-        if Self::constrained() || !C::TRANSLATION || self.first_order {
+        if Self::constrained() || !C::TRANSLATION || self.first_order || self.hidden.count() > 0 {
             return Err(DiracError::Unsupported(
-                "second derivatives of the step map of a model with constraints, linear in the \
-                 velocities, or on a space other than Rⁿ"
+                "second derivatives of the step map of a model with constraints (hidden ones \
+                 included), linear in the velocities, or on a space other than Rⁿ"
                     .into(),
             ));
         }
@@ -579,23 +616,34 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                     hidden.names(system)
                 )));
             }
-            // c must not depend on t explicitly: its velocity form would miss ∂c/∂t.
-            let at = |t: f64| {
+            // c must not depend on t explicitly: its velocity form would miss ∂c/∂t. Probed at
+            // incommensurate times (a periodic force can vanish at whole offsets), at q and at a
+            // point moved along the free directions (a force f(t) q_c vanishes at q_c = 0).
+            let at = |q: &SVector<f64, N>, t: f64| {
                 hidden
                     .evaluate(system, q, v, t, &self.inputs)
                     .map_err(DiracError::InconsistentInitialState)
             };
-            let (now, scale) = {
-                let e = at(state.t)?;
-                (e.value, e.scale)
-            };
-            for t in [state.t - 1.0, state.t + 1.0] {
-                if (at(t)?.value - &now).amax() > 1e-12 * scale {
-                    return Err(DiracError::Unsupported(format!(
-                        "a hidden constraint of the coordinates without kinetic energy ({}) \
-                         that depends on time explicitly (a force on them that depends on t)",
-                        hidden.names(system)
-                    )));
+            let start = at(q, state.t)?;
+            let moved = q + start.free()
+                * DVector::from_element(start.free().ncols(), 1.0)
+                * (1e-2 * (1.0 + q.amax()));
+            let moved = SVector::<f64, N>::from_fn(|i, _| moved[i]);
+            for point in [*q, moved] {
+                let Ok(here) = at(&point, state.t) else {
+                    continue;
+                };
+                if !here.value.iter().all(|c| c.is_finite()) {
+                    continue;
+                }
+                for t in [-1.0, 0.371, 1.13, 2.9, 17.3].map(|offset| state.t + offset) {
+                    if (at(&point, t)?.value - &here.value).amax() > 1e-12 * here.scale {
+                        return Err(DiracError::Unsupported(format!(
+                            "a hidden constraint of the coordinates without kinetic energy ({}) \
+                             that depends on time explicitly (a force on them that depends on t)",
+                            hidden.names(system)
+                        )));
+                    }
                 }
             }
         }
@@ -793,7 +841,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, NewtonFailure> {
-        self.velocity_with_multipliers(newton, q, p, guess)
+        self.velocity_with_multipliers(newton, q, p, guess, None)
             .map(|(v, _)| v)
     }
 
@@ -845,25 +893,35 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             dq[(i, i)] += 1.0;
         }
         if self.hidden.count() > 0 {
-            // The end point is projected along Z onto c = 0: dq ← (I − Z (dc Z)⁺ dc) dq.
-            let end = state.q + x.fixed_rows::<N>(layout.end_point());
+            // The end point is projected along Z onto c = 0: dq ← (I − Z (dc Z)⁻¹ dc) dq, exact
+            // where dc and Z are (constant forms, degenerate rows without velocities).
+            if !self.hidden.is_fixed() {
+                return Err(DiracError::Unsupported(
+                    "derivatives of the step map through the projection onto hidden constraints \
+                     whose constraint forms vary or whose rows contain velocities"
+                        .into(),
+                ));
+            }
+            let xi = x.fixed_rows::<N>(layout.end_point()).into_owned();
+            let (h, end) = (self.discrete.h(), state.q + xi);
             let e = self
                 .hidden
                 .evaluate(
                     self.discrete.system(),
                     &end,
-                    &state.velocity,
-                    state.t,
+                    &(xi / h),
+                    state.t + h,
                     &self.inputs,
                 )
-                .map_err(|why| DiracError::Projection { step: 0, why })?;
+                .map_err(DiracError::Unsupported)?;
             let free = e.free();
-            let reduced = (&e.differential * free)
-                .pseudo_inverse(1e-14)
-                .map_err(|m| DiracError::Projection {
-                    step: 0,
-                    why: m.to_string(),
-                })?;
+            let reduced = (&e.differential * free).try_inverse().ok_or_else(|| {
+                DiracError::Unsupported(
+                    "derivatives through a projection whose free directions do not move the \
+                     hidden constraints"
+                        .into(),
+                )
+            })?;
             let correction = free * reduced * &e.differential * &dq;
             dq -= correction;
         }

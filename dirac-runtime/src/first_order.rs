@@ -36,7 +36,9 @@
 //! - The plain two-step method, with the parasitic root described above.
 //!
 //! Gauss–Lobatto rules (the trapezoid among them) have one node more than the path has free
-//! points, so collocating there is overdetermined, and they are refused before the first step.
+//! points, so collocating there is overdetermined, and Gauss rules with more nodes than the
+//! path's degree would collocate at some of their nodes only (a θ-method of order 1 for
+//! `galerkin(1, gauss_legendre(2))`): both are refused before the first step.
 
 use nalgebra::{DMatrix, DVector, SVector};
 
@@ -66,6 +68,13 @@ pub(crate) fn refusal(quadrature: &Quadrature) -> Option<String> {
              (midpoint, galerkin(s): order 2s)",
             quadrature.name(),
             quadrature.nodes().len(),
+            quadrature.degree()
+        )),
+        Rule::GaussLegendre(nodes) if nodes != quadrature.degree() => Some(format!(
+            "{} has {nodes} nodes for {} free points of the step's path: a Lagrangian linear \
+             in the velocities is collocated at the nodes of a Gauss rule with as many nodes as \
+             the path's degree (galerkin(s) with gauss_legendre(s), order 2s)",
+            quadrature.name(),
             quadrature.degree()
         )),
         _ => None,

@@ -46,8 +46,11 @@ pub(crate) struct HiddenConstraints {
     dead: Vec<usize>,
     /// Number of algebraic combinations of their rows.
     count: usize,
+    /// Number of combinations of their rows that contain velocities (first-order equations).
+    dynamic: usize,
     /// The combinations `G` and free directions `W` found at the start, kept while the
-    /// constraint forms are constant (circuits): they do not change along the motion.
+    /// constraint forms are constant and the degenerate rows contain no velocity at all
+    /// (circuits): then neither changes along the motion, and `dc` is exact.
     fixed: Option<(DMatrix<f64>, DMatrix<f64>)>,
 }
 
@@ -84,12 +87,14 @@ impl HiddenConstraints {
         let mut found = Self {
             dead,
             count: 0,
+            dynamic: 0,
             fixed: None,
         };
-        let combinations = found.combinations(system, q, v, t, inputs);
-        found.count = combinations.0.ncols();
-        if constant_forms(system, q) {
-            found.fixed = Some(combinations);
+        let (g, w, velocity_free) = found.combinations(system, q, v, t, inputs);
+        found.count = g.ncols();
+        found.dynamic = w.ncols() - g.ncols();
+        if velocity_free && constant_forms(system, q) {
+            found.fixed = Some((g, w));
         }
         found
     }
@@ -97,6 +102,17 @@ impl HiddenConstraints {
     /// Number of hidden (algebraic) constraints.
     pub fn count(&self) -> usize {
         self.count
+    }
+
+    /// Number of combinations of the degenerate rows that contain velocities.
+    pub fn dynamic(&self) -> usize {
+        self.dynamic
+    }
+
+    /// Whether `c`, its free directions and its differential are those found at the start, and
+    /// exact (constant constraint forms, degenerate rows without velocities).
+    pub fn is_fixed(&self) -> bool {
+        self.fixed.is_some()
     }
 
     /// The names of the degenerate coordinates.
@@ -158,8 +174,9 @@ impl HiddenConstraints {
         (value, by_v, by_q, scale)
     }
 
-    /// The algebraic combinations `G = W U` of the degenerate rows (columns) and the free
-    /// directions `W` (columns over `D`) at `(q, v)`.
+    /// The algebraic combinations `G = W U` of the degenerate rows (columns), the free
+    /// directions `W` (columns over `D`) at `(q, v)`, and whether the degenerate rows contain no
+    /// velocity at all there.
     fn combinations<S: DiracSystem<N>, const N: usize>(
         &self,
         system: &S,
@@ -167,7 +184,7 @@ impl HiddenConstraints {
         v: &SVector<f64, N>,
         t: f64,
         inputs: &[f64],
-    ) -> (DMatrix<f64>, DMatrix<f64>) {
+    ) -> (DMatrix<f64>, DMatrix<f64>, bool) {
         let forms = Self::forms(system, q);
         let b = DMatrix::from_fn(forms.nrows(), self.dead.len(), |r, c| {
             forms[(r, self.dead[c])]
@@ -178,15 +195,17 @@ impl HiddenConstraints {
         let shift = &admissible * DVector::from_element(admissible.ncols(), 1.0);
         let other = v + SVector::<f64, N>::from_fn(|i, _| shift[i] * (1.0 + v.amax()));
         let mut dependence = DMatrix::zeros(w.ncols(), 2 * admissible.ncols());
+        let mut velocity_free = true;
         for (k, velocity) in [v, &other].into_iter().enumerate() {
             let by_v = self.rows(system, q, velocity, t, inputs).1;
+            velocity_free &= by_v.iter().all(|x| *x == 0.0);
             let j = w.transpose() * by_v * &admissible;
             dependence
                 .columns_mut(k * admissible.ncols(), admissible.ncols())
                 .copy_from(&j);
         }
         let u = null_space(&dependence.transpose());
-        (&w * u, w)
+        (&w * u, w, velocity_free)
     }
 
     /// `c(q)` at `(q, v, t)` with its differential and free directions.
@@ -198,9 +217,13 @@ impl HiddenConstraints {
         t: f64,
         inputs: &[f64],
     ) -> Result<Evaluation, String> {
+        let computed;
         let (g, w) = match &self.fixed {
-            Some(fixed) if constant_forms(system, q) => fixed.clone(),
-            _ => self.combinations(system, q, v, t, inputs),
+            Some((g, w)) if constant_forms(system, q) => (g, w),
+            _ => {
+                computed = self.combinations(system, q, v, t, inputs);
+                (&computed.0, &computed.1)
+            }
         };
         if g.ncols() != self.count {
             return Err(format!(
@@ -249,10 +272,9 @@ impl HiddenConstraints {
             }
             last = residual;
             let reduced = &e.differential * &e.free;
-            let alpha = reduced
-                .svd(true, true)
-                .solve(&(-&e.value), 1e-14)
-                .map_err(|m| m.to_string())?;
+            let svd = reduced.svd(true, true);
+            let cutoff = 1e-12 * svd.singular_values.amax();
+            let alpha = svd.solve(&(-&e.value), cutoff).map_err(|m| m.to_string())?;
             let step = &e.free * alpha;
             *q += SVector::<f64, N>::from_fn(|i, _| step[i]);
         }
@@ -287,7 +309,7 @@ fn constant_forms<S: DiracSystem<N>, const N: usize>(system: &S, q: &SVector<f64
 /// Iterations of the projection (a linear hidden constraint needs one).
 const MAX_ITERATIONS: usize = 8;
 /// A residual this far below its terms is round-off: the projection stops.
-const ROUND_OFF: f64 = 4.0 * f64::EPSILON;
+const ROUND_OFF: f64 = 16.0 * f64::EPSILON;
 /// The largest residual, relative to its terms, a projection may end with.
 const TOLERANCE: f64 = 1e-10;
 

@@ -13,9 +13,9 @@ use crate::system::DiracSystem;
 /// Euler–Lagrange equations `d/dt ∂L/∂v_D − ∂L/∂q_D − F_D = (Aᵀμ + dgᵀλ)_D` contain no
 /// acceleration, so some multipliers must balance them at `t = 0`. Returns what is violated.
 ///
-/// Each residual is compared with `tolerance` times the size of the terms it sums (`|dg| |q|`
-/// for `g`, `|dg| |v|` for `dg v`, the largest term of a balance): the check is independent of
-/// the units, and a state a stepper produced passes it.
+/// Each residual is compared with `tolerance` times the size of the terms it sums
+/// (`Σ_i |∂g/∂q_i q_i|` for `g`, `Σ_i |A_i v_i|` for `A v`, the largest term of a balance): the
+/// check is independent of the units, and a state a stepper produced passes it.
 pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
     system: &S,
     t0: f64,
@@ -27,13 +27,13 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
     let name = |i: usize| system.coordinate_name(i);
     for b in 0..S::HOLONOMIC {
         let (g, form) = constraint::holonomic(system, q0, b);
-        if g.abs() > tolerance * form.amax() * q0.amax() {
+        if g.abs() > tolerance * size(&form, q0) {
             return Err(format!(
                 "the initial position violates holonomic constraint {b}: g = {g:.3e}"
             ));
         }
         let rate = form.dot(v0);
-        if rate.abs() > tolerance * form.amax() * v0.amax() {
+        if rate.abs() > tolerance * size(&form, v0) {
             return Err(format!(
                 "the initial velocity is not tangent to holonomic constraint {b}: dg·v = {rate:.3e}"
             ));
@@ -44,7 +44,7 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
         .collect();
     for (a, form) in forms.iter().enumerate() {
         let rate = form.dot(v0);
-        if rate.abs() > tolerance * form.amax() * v0.amax() {
+        if rate.abs() > tolerance * size(form, v0) {
             return Err(format!(
                 "the initial velocity violates constraint one-form {a}: A·v = {rate:.3e}"
             ));
@@ -66,7 +66,8 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
         rhs.amax()
     } else {
         let svd = matrix.clone().svd(true, true);
-        let multipliers = svd.solve(&rhs, 1e-12).map_err(|e| e.to_string())?;
+        let cutoff = 1e-12 * svd.singular_values.amax();
+        let multipliers = svd.solve(&rhs, cutoff).map_err(|e| e.to_string())?;
         (matrix * multipliers - &rhs).amax()
     };
     let transport = qv.mixed.transpose() * v0;
@@ -89,4 +90,9 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
         ));
     }
     Ok(())
+}
+
+/// `Σ_i |a_i x_i|`: the size of the terms of `a · x`.
+fn size<const N: usize>(a: &SVector<f64, N>, x: &SVector<f64, N>) -> f64 {
+    a.component_mul(x).abs().sum()
 }

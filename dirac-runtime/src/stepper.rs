@@ -350,7 +350,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// Starts from `state` after the equations have checked it (see
-    /// [`StepEquations::check_start`]); on error nothing changes.
+    /// [`StepEquations::check_start`]) and the first step's equations have been found
+    /// nonsingular there (a singular Jacobian is `SingularJacobian`, naming the unknowns the
+    /// rule does not determine); on error nothing changes.
     pub fn start_from_state(&mut self, state: State<N>) -> Result<(), DiracError> {
         if !state.t.is_finite() {
             return Err(DiracError::NonFinite {
@@ -363,6 +365,22 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let tolerance = START_TOLERANCE.max(100.0 * self.newton.options().residual_tolerance);
         self.equations.check_start(&state, tolerance)?;
         self.equations.begin(&state);
+        // A rule that does not determine the model's motion (the first step's Jacobian is
+        // singular) is refused here, before the first step, naming the undetermined unknowns.
+        let equations = &mut self.equations;
+        equations.predict(&state, None, &mut self.unknowns);
+        let trial = self.newton.solve(&mut self.unknowns, |x, r, j| {
+            equations.assemble(&state, x, r, j)
+        });
+        if let Err(failure @ NewtonFailure::Singular(_)) = trial {
+            let steps = std::mem::replace(&mut self.steps, 0);
+            let error = self.failure(Problem::Step, failure);
+            self.steps = steps;
+            if let Some(current) = self.state {
+                self.equations.begin(&current);
+            }
+            return Err(error);
+        }
         self.reset(state);
         Ok(())
     }
