@@ -8,25 +8,12 @@ mod support;
 
 use dirac::prelude::*;
 use dirac::step_equations::State;
-use scenes::{cartesian_pendulum, circuit, knife_edge, port};
+use scenes::circuit::{self, LcCircuit};
+use scenes::{cartesian_pendulum, knife_edge, port};
 use support::slope;
 
 /// L in series with C2 and (C1 ∥ C3) with unequal capacitances.
-#[dirac_system(
-    coordinates(q_l, q_c1, q_c2, q_c3),
-    lagrangian = 0.5 * l * dot(q_l).powi(2)
-        - q_c1.powi(2) / (2.0 * c1) - q_c2.powi(2) / (2.0 * c2) - q_c3.powi(2) / (2.0 * c3),
-    constraints(-dq_l + dq_c2, -dq_c1 + dq_c2 - dq_c3),
-)]
-#[derive(Debug, Clone, Copy)]
-struct Unequal {
-    l: f64,
-    c1: f64,
-    c2: f64,
-    c3: f64,
-}
-
-const UNEQUAL: Unequal = Unequal {
+const UNEQUAL: LcCircuit = LcCircuit {
     l: 1.0,
     c1: 1.0,
     c2: 1.0,
@@ -44,7 +31,7 @@ fn unequal_start() -> (SVector<f64, 4>, SVector<f64, 4>) {
 /// The closed form: with x = q_c2 and S = q_c1 + q_c3 = x + K (KCL), the parallel pair holds
 /// q_c1 = c1 S / C, q_c3 = c3 S / C (C = c1 + c3) and `l ẍ = −x/c2 − (x + K)/C`.
 fn unequal_exact(t: f64) -> SVector<f64, 4> {
-    let Unequal { l, c1, c2, c3 } = UNEQUAL;
+    let LcCircuit { l, c1, c2, c3 } = UNEQUAL;
     let (q0, v0) = unequal_start();
     let big_c = c1 + c3;
     let k = q0[1] + q0[3] - q0[2];

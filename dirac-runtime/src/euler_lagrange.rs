@@ -199,21 +199,24 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         hidden: &HiddenConstraints,
     ) -> DMatrix<f64> {
         let system = self.discrete.system();
-        let mut rows: Vec<SVector<f64, N>> = (0..S::ONE_FORMS)
-            .map(|a| constraint::one_form(system, q, a).0)
-            .chain((0..S::HOLONOMIC).map(|b| constraint::holonomic(system, q, b).1))
-            .collect();
-        // The hidden constraints do not depend on t (refused at the start otherwise).
-        if hidden.count() > 0
-            && let Ok(e) = hidden.evaluate(system, q, guess, 0.0, &self.inputs)
-        {
-            rows.extend(
-                e.differential
-                    .row_iter()
-                    .map(|r| SVector::<f64, N>::from_iterator(r.iter().copied())),
-            );
+        let forms = HiddenConstraints::forms(system, q);
+        if hidden.count() == 0 {
+            return forms;
         }
-        DMatrix::from_fn(rows.len(), N, |r, c| rows[r][c])
+        // The hidden constraints do not depend on t (refused at the start otherwise).
+        match hidden.evaluate(system, q, guess, 0.0, &self.inputs) {
+            Ok(e) => {
+                let (m, k) = (forms.nrows(), e.differential.nrows());
+                DMatrix::from_fn(m + k, N, |r, c| {
+                    if r < m {
+                        forms[(r, c)]
+                    } else {
+                        e.differential[(r - m, c)]
+                    }
+                })
+            }
+            _ => forms,
+        }
     }
 
     /// The velocity at `(q, p)` with the constraints' multipliers `ν` (see
@@ -241,31 +244,17 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
                 &found
             }
         };
+        let mut spare = None;
         if hidden.dynamic() > 0 {
             // Degenerate rows that are first-order equations (a resistor on a capacitor's
             // branch) fix their velocities through the dynamics, not through p: the plain
             // inversion keeps the guess there (see "Not supported yet").
-            let mut sized;
-            let newton = if self.velocity_unknowns() == N {
-                newton
-            } else {
-                sized =
-                    Newton::new(N, *newton.options()).map_err(|_| NewtonFailure::Dimension {
-                        expected: N,
-                        got: self.velocity_unknowns(),
-                    })?;
-                &mut sized
-            };
+            let newton = sized(newton, N, &mut spare)?;
             return legendre::velocity(system, newton, q, p, guess).map(|v| (v, DVector::zeros(0)));
         }
         let forms = self.velocity_forms(q, guess, hidden);
+        let newton = sized(newton, N + forms.nrows(), &mut spare)?;
         if forms.nrows() > 0 {
-            if N + forms.nrows() != self.velocity_unknowns() {
-                // Sized for the run's constraints; this state has others (before the run).
-                let mut sized = Newton::new(N + forms.nrows(), *newton.options())
-                    .map_err(|_| NewtonFailure::NonFinite)?;
-                return legendre::constrained_velocity(system, &mut sized, q, p, &forms, guess);
-            }
             legendre::constrained_velocity(system, newton, q, p, &forms, guess)
         } else {
             legendre::velocity(system, newton, q, p, guess).map(|v| (v, DVector::zeros(0)))
@@ -1006,4 +995,22 @@ pub(crate) fn check_finite<S: DiracSystem<N>, const N: usize>(
             value: x[i],
         }),
     }
+}
+
+/// `newton` if it is sized for `n` unknowns, else a solver with its options sized for `n`, kept
+/// in `spare` (the stepper sizes the velocity solver for the run's constraints; a state before
+/// the run, or a model whose rows are first-order equations, has others).
+fn sized<'a>(
+    newton: &'a mut Newton,
+    n: usize,
+    spare: &'a mut Option<Newton>,
+) -> Result<&'a mut Newton, NewtonFailure> {
+    if newton.unknowns() == n {
+        return Ok(newton);
+    }
+    let fresh = Newton::new(n, *newton.options()).map_err(|_| NewtonFailure::Dimension {
+        expected: n,
+        got: newton.unknowns(),
+    })?;
+    Ok(spare.insert(fresh))
 }

@@ -126,7 +126,10 @@ impl HiddenConstraints {
     }
 
     /// The rows of the constraint forms at `q` (one-forms, then holonomic differentials).
-    fn forms<S: DiracSystem<N>, const N: usize>(system: &S, q: &SVector<f64, N>) -> DMatrix<f64> {
+    pub fn forms<S: DiracSystem<N>, const N: usize>(
+        system: &S,
+        q: &SVector<f64, N>,
+    ) -> DMatrix<f64> {
         let rows: Vec<SVector<f64, N>> = (0..S::ONE_FORMS)
             .map(|a| constraint::one_form(system, q, a).0)
             .chain((0..S::HOLONOMIC).map(|b| constraint::holonomic(system, q, b).1))

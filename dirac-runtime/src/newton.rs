@@ -218,6 +218,11 @@ impl Newton {
         pivots.max() / pivots.min()
     }
 
+    /// The number of unknowns the solver is sized for.
+    pub(crate) fn unknowns(&self) -> usize {
+        self.residual.len()
+    }
+
     /// The options in force.
     pub fn options(&self) -> &NewtonOptions {
         &self.options
