@@ -262,12 +262,29 @@ fn driven_rlc_reaches_the_phasor_amplitude() {
     assert_eq!(stepper.inputs(), &[0.5]);
 }
 
-/// Constraints are imposed on a step's end points: a quadrature with internal points is refused
-/// for a constrained system rather than integrated wrongly.
+/// Constraint one-forms are imposed on a step's end points: a quadrature with internal points is
+/// refused for them rather than integrated wrongly. Holonomic constraints are held at every
+/// point of the path: degree 2 is accepted (order 4, `tests/constrained.rs`), degree 3 refused
+/// (it measured order 4 too, not 6).
 #[test]
-fn constrained_systems_need_a_degree_one_quadrature() {
+fn constrained_systems_refuse_quadratures_they_cannot_hold() {
     let err = Stepper::new(circuit::LC, Quadrature::gauss(2).unwrap(), 0.01).unwrap_err();
     assert!(matches!(err, DiracError::InvalidQuadrature(_)), "{err}");
+    let err = Stepper::new(
+        cartesian_pendulum::SCENE,
+        Quadrature::gauss(3).unwrap(),
+        0.01,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("order 4"), "{err}");
+    assert!(
+        Stepper::new(
+            cartesian_pendulum::SCENE,
+            Quadrature::gauss(2).unwrap(),
+            0.01
+        )
+        .is_ok()
+    );
 }
 
 /// Unconstrained models carry no constraint or force machinery; constrained ones report their

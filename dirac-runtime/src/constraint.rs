@@ -154,7 +154,49 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraint
                 jacobian[(col, step_col + j)] = form[j];
             }
         }
+        if layout.points() > 1 {
+            let (more, size) = self.add_internal(x, residual, jacobian);
+            impulse += more;
+            scale = scale.max(size);
+        }
         (StepCovectors { impulse, end }, scale)
+    }
+
+    /// The holonomic constraints at the internal points `Q_j = q_k + ξ_j` (`j = 1..s−1`, on a
+    /// translation chart): `g_b(Q_j) = 0`, with the impulse `dg_b(Q_j)ᵀλ_{j,b}` on the row of
+    /// `Q_j`. Returns the impulses' sum and the size of the constraint rows' terms.
+    fn add_internal(
+        &self,
+        x: &DVector<f64>,
+        residual: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> (SVector<f64, N>, f64) {
+        let (system, layout, base) = (self.system, self.layout, self.base);
+        let mut impulse = SVector::<f64, N>::zeros();
+        let mut scale = 0.0_f64;
+        for j in 1..layout.points() {
+            // The unknown ξ_j and the Euler–Lagrange row of Q_j (row blocks are j = 0..s−1).
+            let (column, row) = (layout.point(j), j * N);
+            let point = base + x.fixed_rows::<N>(column);
+            for b in 0..S::HOLONOMIC {
+                let col = layout.holonomic_at(j, b);
+                let lambda = x[col];
+                let (g, form) = holonomic(system, &point, b);
+                let curvature = crate::derivatives::holonomic_hessian(system, &point, b);
+                impulse += form * lambda;
+                for i in 0..N {
+                    residual[row + i] += lambda * form[i];
+                    jacobian[(row + i, col)] += form[i];
+                    for m in 0..N {
+                        jacobian[(row + i, column + m)] += lambda * curvature[(i, m)];
+                    }
+                    jacobian[(col, column + i)] = form[i];
+                }
+                residual[col] = g;
+                scale = scale.max(form.abs().dot(&point.abs()).max(g.abs()));
+            }
+        }
+        (impulse, scale)
     }
 }
 

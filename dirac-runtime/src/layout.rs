@@ -1,8 +1,10 @@
 //! The unknowns of a Lagrangian step and the rows of its equations, in one order.
 
 /// Where each unknown of a step sits in `x = [ξ_1, …, ξ_s, μ, λ]`: `s` blocks of `N` chart
-/// coordinates (the internal points, then the end point), one multiplier per one-form, one per
-/// holonomic constraint. The Euler–Lagrange rows use the same blocks.
+/// coordinates (the internal points, then the end point), one multiplier per one-form, and one
+/// per holonomic constraint and point of the path `j = 1..s` (the constraint holds at every
+/// point: `λ_{j,b}` pairs with `g_b(Q_j) = 0`; the end point's `λ_{s,b}` is SHAKE's, applied at
+/// `q_k`). The Euler–Lagrange rows use the same blocks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Layout {
     coordinates: usize,
@@ -28,7 +30,7 @@ impl Layout {
 
     /// Number of unknowns.
     pub(crate) fn len(&self) -> usize {
-        self.coordinates * self.points + self.one_forms + self.holonomic
+        self.coordinates * self.points + self.one_forms + self.holonomic * self.points
     }
 
     /// Number of points solved for, `s` (the internal points and the end point).
@@ -56,9 +58,14 @@ impl Layout {
         self.multipliers() + a
     }
 
-    /// Column of the multiplier of holonomic constraint `b`.
+    /// Column of the multiplier of holonomic constraint `b` at the end point (SHAKE's).
     pub(crate) fn holonomic(&self, b: usize) -> usize {
-        self.multipliers() + self.one_forms + b
+        self.holonomic_at(self.points, b)
+    }
+
+    /// Column of the multiplier of holonomic constraint `b` at point `j` (`1..=s`).
+    pub(crate) fn holonomic_at(&self, j: usize, b: usize) -> usize {
+        self.multipliers() + self.one_forms + (j - 1) * self.holonomic + b
     }
 
     /// What unknown `column` is, with `coordinate` naming coordinates.
@@ -68,10 +75,13 @@ impl Layout {
             return if c < self.one_forms {
                 format!("the multiplier of one-form {c}")
             } else {
-                format!(
-                    "the multiplier of holonomic constraint {}",
-                    c - self.one_forms
-                )
+                let c = c - self.one_forms;
+                let (j, b) = (c / self.holonomic + 1, c % self.holonomic);
+                if j == self.points {
+                    format!("the multiplier of holonomic constraint {b}")
+                } else {
+                    format!("the multiplier of holonomic constraint {b} at internal point {j}")
+                }
             };
         }
         let slot = match column / self.coordinates + 1 {
