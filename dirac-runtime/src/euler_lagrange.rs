@@ -59,8 +59,8 @@ pub struct EulerLagrange<S, const N: usize, C> {
     discrete: DiscreteLagrangian<S, N, C>,
     point: ConstraintPoint,
     holonomic_scheme: HolonomicScheme,
-    /// The hidden constraints of the run (found when it begins).
-    hidden: HiddenConstraints,
+    /// The hidden constraints of the run (found when it begins; `None` before a run).
+    hidden: Option<HiddenConstraints>,
     /// Whether the run's Lagrangian is linear in every velocity (found when it begins): the
     /// step equations are those of [`first_order`].
     first_order: bool,
@@ -132,7 +132,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         Ok(Self {
             point,
             holonomic_scheme: HolonomicScheme::default(),
-            hidden: HiddenConstraints::default(),
+            hidden: None,
             first_order: false,
             layout: Layout::new(N, s, S::ONE_FORMS, S::HOLONOMIC),
             inputs: vec![0.0; S::INPUTS],
@@ -207,6 +207,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         S::ONE_FORMS + S::HOLONOMIC > 0
     }
 
+    /// The run's hidden constraints (none before a run).
+    fn hidden(&self) -> &HiddenConstraints {
+        static NONE: HiddenConstraints = HiddenConstraints::none();
+        self.hidden.as_ref().unwrap_or(&NONE)
+    }
+
     /// The rows of the constraints on the velocity at `q`: the one-forms, the holonomic
     /// differentials and the hidden constraints' differentials (found at `(q, guess)`, so that
     /// the velocity of a state is solved the same way before a run begins; none where they
@@ -240,8 +246,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
 
     /// The velocity at `(q, p)` with the constraints' multipliers `ν` (see
     /// [`legendre::constrained_velocity`]), or the plain Legendre inversion with no multipliers.
-    /// `run` holds the run's hidden constraints where they are known (inside a step); otherwise
-    /// they are found at `(q, guess)`.
+    /// `run` holds the run's hidden constraints once a run has begun; before it they are found
+    /// at `(q, guess)`.
     fn velocity_with_multipliers(
         &self,
         newton: &mut Newton,
@@ -296,7 +302,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
                 &state.q,
                 &state.p,
                 &state.velocity,
-                Some(&self.hidden),
+                self.hidden.as_ref(),
             )
             .map_err(|failure| DiracError::Projection {
                 step,
@@ -329,7 +335,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<StepHessians<N>, DiracError> {
-        if Self::constrained() || !C::TRANSLATION || self.first_order || self.hidden.count() > 0 {
+        if Self::constrained() || !C::TRANSLATION || self.first_order || self.hidden().count() > 0 {
             return Err(DiracError::Unsupported(
                 "second derivatives of the step map of a model with constraints (hidden ones \
                  included), linear in the velocities, or on a space other than Rⁿ"
@@ -668,13 +674,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     fn begin(&mut self, state: &State<N>) {
         self.first_order =
             first_order::is_first_order(self.discrete.system(), &state.q, &state.velocity);
-        self.hidden = HiddenConstraints::find(
+        self.hidden = Some(HiddenConstraints::find(
             self.discrete.system(),
             &state.q,
             &state.velocity,
             state.t,
             &self.inputs,
-        );
+        ));
     }
 
     /// The last step's solution (constant chart velocity, the same multipliers), or the path
@@ -800,9 +806,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         check_finite(system, "new position", &next.q)?;
         check_finite(system, "new momentum", &next.p)?;
         next.velocity = space.push_forward(&state.q, &xi, &(xi / self.discrete.h()));
-        if self.hidden.count() > 0 {
+        if self.hidden().count() > 0 {
             let t = state.t + self.discrete.h();
-            self.hidden
+            self.hidden()
                 .project(system, &mut next.q, &next.velocity, t, &self.inputs)
                 .map_err(|why| DiracError::Projection { step, why })?;
         }
@@ -842,7 +848,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     /// `N`, plus one multiplier per constraint on the velocity for a constrained model or one
     /// with hidden constraints.
     fn velocity_unknowns(&self) -> usize {
-        N + S::ONE_FORMS + S::HOLONOMIC + self.hidden.count()
+        N + S::ONE_FORMS + S::HOLONOMIC + self.hidden().count()
     }
 
     /// The Legendre inversion; for a constrained model (or one with hidden constraints), the
@@ -855,7 +861,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, NewtonFailure> {
-        self.velocity_with_multipliers(newton, q, p, guess, None)
+        self.velocity_with_multipliers(newton, q, p, guess, self.hidden.as_ref())
             .map(|(v, _)| v)
     }
 
@@ -906,10 +912,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         for i in 0..N {
             dq[(i, i)] += 1.0;
         }
-        if self.hidden.count() > 0 {
+        if self.hidden().count() > 0 {
             // The end point is projected along Z onto c = 0: dq ← (I − Z (dc Z)⁻¹ dc) dq, exact
             // where dc and Z are (constant forms, degenerate rows without velocities).
-            if !self.hidden.is_fixed() {
+            if !self.hidden().is_fixed() {
                 return Err(DiracError::Unsupported(
                     "derivatives of the step map through the projection onto hidden constraints \
                      whose constraint forms vary or whose rows contain velocities"
@@ -919,7 +925,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             let xi = x.fixed_rows::<N>(layout.end_point()).into_owned();
             let (h, end) = (self.discrete.h(), state.q + xi);
             let e = self
-                .hidden
+                .hidden()
                 .evaluate(
                     self.discrete.system(),
                     &end,

@@ -71,6 +71,16 @@ impl Evaluation {
 }
 
 impl HiddenConstraints {
+    /// No degenerate coordinates.
+    pub const fn none() -> Self {
+        Self {
+            dead: Vec::new(),
+            count: 0,
+            dynamic: 0,
+            fixed: None,
+        }
+    }
+
     /// The degenerate coordinates at `(q, v)` and the number of hidden constraints among their
     /// rows (velocity dependence is tested at `v` and at a second admissible velocity).
     pub fn find<S: DiracSystem<N>, const N: usize>(
