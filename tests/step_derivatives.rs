@@ -256,6 +256,8 @@ fn constrained_case<S: DiracSystem<N> + Clone, const N: usize>(
         if S::INPUTS > 0 {
             equations.set_inputs(&[u]).unwrap();
         }
+        // As a run does: the hidden constraints found at the start are projected at each end.
+        equations.begin(&State::new(T0, q, p, v));
         equations
     };
     let u0 = u.unwrap_or(0.0);
@@ -323,6 +325,19 @@ fn constrained_derivatives_match_central_differences() {
     lc.start_from_velocity(circuit::q0(), SVector::zeros())
         .unwrap();
     constrained_case("LC circuit", circuit::LC, lc, None);
+    // Unequal parallel capacitors with a current: the step's end is projected onto
+    // q_c1/c1 = q_c3/c3, and A includes the projection.
+    let unequal = circuit::LcCircuit {
+        c3: 2.0,
+        ..circuit::LC
+    };
+    let mut lc = Stepper::new(unequal, Quadrature::midpoint(), 0.05).unwrap();
+    lc.start_from_velocity(
+        vector![0.0, 0.2, 1.0, 0.4],
+        vector![0.5, 0.5 / 3.0, 0.5, 1.0 / 3.0],
+    )
+    .unwrap();
+    constrained_case("unequal LC circuit", unequal, lc, None);
     let mut rlc = Stepper::new(circuit::RLC, Quadrature::midpoint(), 0.05).unwrap();
     rlc.start_from_velocity(circuit::q0(), SVector::zeros())
         .unwrap();
