@@ -262,14 +262,16 @@ fn driven_rlc_reaches_the_phasor_amplitude() {
     assert_eq!(stepper.inputs(), &[0.5]);
 }
 
-/// Constraint one-forms are imposed on a step's end points: a quadrature with internal points is
-/// refused for them rather than integrated wrongly. Holonomic constraints are held at every
-/// point of the path: degree 2 is accepted (order 4, `tests/constrained.rs`), degree 3 refused
-/// (it measured order 4 too, not 6).
+/// Constraint one-forms of a Galerkin step are held at the nodes of its Gauss rule: a Lobatto
+/// rule (a node more than the path's free points) is refused for them rather than integrated
+/// wrongly. Holonomic constraints are held at every point of the path: degree 2 is accepted
+/// (order 4, `tests/constrained.rs`), degree 3 refused (it measured order 4 too, not 6).
 #[test]
 fn constrained_systems_refuse_quadratures_they_cannot_hold() {
-    let err = Stepper::new(circuit::LC, Quadrature::gauss(2).unwrap(), 0.01).unwrap_err();
+    let lobatto = Quadrature::galerkin(2, Rule::GaussLobatto(3)).unwrap();
+    let err = Stepper::new(circuit::LC, lobatto, 0.01).unwrap_err();
     assert!(matches!(err, DiracError::InvalidQuadrature(_)), "{err}");
+    assert!(Stepper::new(circuit::LC, Quadrature::gauss(2).unwrap(), 0.01).is_ok());
     let err = Stepper::new(
         cartesian_pendulum::SCENE,
         Quadrature::gauss(3).unwrap(),

@@ -217,10 +217,10 @@ fn a_lagrangian_stepper_continues_from_another_steppers_state() {
 #[test]
 fn the_lagrangian_equations_validate_what_the_stepper_would() {
     use dirac::euler_lagrange::EulerLagrange;
-    // A constrained model with internal points, and a negative step, are refused by the
+    // One-forms with a Lobatto rule of degree 2, and a negative step, are refused by the
     // equations themselves, so Stepper::with_equations cannot bypass the checks.
-    let discrete =
-        DiscreteLagrangian::new(scenes::circuit::LC, Quadrature::gauss(2).unwrap(), 0.01);
+    let lobatto = Quadrature::galerkin(2, Rule::GaussLobatto(3)).unwrap();
+    let discrete = DiscreteLagrangian::new(scenes::circuit::LC, lobatto, 0.01);
     assert!(matches!(
         EulerLagrange::new(discrete),
         Err(DiracError::InvalidQuadrature(_))

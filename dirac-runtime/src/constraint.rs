@@ -25,6 +25,7 @@ use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
 pub use crate::constraint_point::ConstraintPoint;
 use crate::derivatives::{gradient, lift};
 use crate::layout::Layout;
+use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
 
 /// One-form `a` read in the chart centred at `base`, at `xi`: the row `Ã_a(ξ)` and its
@@ -85,6 +86,9 @@ pub(crate) struct StepConstraints<'a, S, C, const N: usize> {
     pub base: &'a SVector<f64, N>,
     pub layout: &'a Layout,
     pub holonomic_forms: &'a [SVector<f64, N>],
+    /// The step's quadrature and size (one-forms of a Galerkin step hold at its nodes).
+    pub quadrature: &'a Quadrature,
+    pub h: f64,
 }
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraints<'_, S, C, N> {
@@ -104,6 +108,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraint
             base,
             layout,
             holonomic_forms,
+            ..
         } = *self;
         let step_col = layout.end_point();
         let step = x.fixed_rows::<N>(step_col).into_owned();
@@ -111,7 +116,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraint
         let mut impulse = SVector::<f64, N>::zeros();
         let mut scale = 0.0_f64;
         let xi_c = step * theta;
-        for a in 0..S::ONE_FORMS {
+        let one_forms = if layout.points() == 1 {
+            S::ONE_FORMS
+        } else {
+            0
+        };
+        for a in 0..one_forms {
             let (row, derivative) = one_form_in_chart(system, space, base, &xi_c, a);
             let col = layout.one_form(a);
             let mu = x[col];
@@ -131,7 +141,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraint
                 jacobian[(col, step_col + j)] = row[j] + through_point[j];
             }
         }
-        let end = impulse * (1.0 - share);
+        let mut end = impulse * (1.0 - share);
+        if layout.points() > 1 && S::ONE_FORMS > 0 {
+            let (forces, size) = self.add_at_nodes(x, residual, jacobian);
+            impulse += forces.impulse;
+            end += forces.end;
+            scale = scale.max(size);
+        }
         for (b, force_form) in holonomic_forms.iter().enumerate() {
             let col = layout.holonomic(b);
             let lambda = x[col];
@@ -158,6 +174,67 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraint
             let (more, size) = self.add_internal(x, residual, jacobian);
             impulse += more;
             scale = scale.max(size);
+        }
+        (StepCovectors { impulse, end }, scale)
+    }
+
+    /// The one-forms of a Galerkin step (Gauss rule, `s` nodes, on a translation chart): the
+    /// velocity constraints `A_a(Q_i) Q̇_i = 0` at the nodes `Q_i = Q(c_i)`, with the constraint
+    /// force `Σ_a μ_{i,a} A_a(Q_i)` at node `i` entering the rows as a force does (Lagrange–
+    /// d'Alembert by the quadrature): row `j` gets `h Σ_i b_i ℓ_j(c_i) Σ_a μ_{i,a} A_a(Q_i)`.
+    /// For one node this is the midpoint constraint point. Returns the impulses (total, on the
+    /// end point) and the size of the constraint rows' terms.
+    fn add_at_nodes(
+        &self,
+        x: &DVector<f64>,
+        residual: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> (StepCovectors<N>, f64) {
+        let (system, layout, base, quad, h) =
+            (self.system, self.layout, self.base, self.quadrature, self.h);
+        let s = layout.points();
+        let mut impulse = SVector::<f64, N>::zeros();
+        let mut end = SVector::<f64, N>::zeros();
+        let mut scale = 0.0_f64;
+        for (i, &b) in quad.weights().iter().enumerate() {
+            let (mut xi, mut xi_dot) = (SVector::<f64, N>::zeros(), SVector::<f64, N>::zeros());
+            for k in 1..=s {
+                let z = x.fixed_rows::<N>(layout.point(k));
+                xi += z * quad.ell(i, k);
+                xi_dot += z * (quad.ell_prime(i, k) / h);
+            }
+            let node = base + xi;
+            for a in 0..S::ONE_FORMS {
+                let (row, derivative) = one_form(system, &node, a);
+                let col = layout.one_form_at(i, a);
+                let mu = x[col];
+                let w = h * b;
+                impulse += row * (w * mu);
+                end += row * (w * mu * quad.ell(i, s));
+                for j in 0..s {
+                    let lj = w * quad.ell(i, j);
+                    for r in 0..N {
+                        residual[j * N + r] += lj * mu * row[r];
+                        jacobian[(j * N + r, col)] += lj * row[r];
+                        for k in 1..=s {
+                            for m in 0..N {
+                                jacobian[(j * N + r, layout.point(k) + m)] +=
+                                    lj * mu * derivative[(r, m)] * quad.ell(i, k);
+                            }
+                        }
+                    }
+                }
+                // A_a(Q_i) · Q̇_i, scaled by h to read as a displacement.
+                residual[col] = h * row.dot(&xi_dot);
+                scale = scale.max(h * row.abs().dot(&xi_dot.abs()));
+                let turning = derivative.transpose() * xi_dot;
+                for k in 1..=s {
+                    for m in 0..N {
+                        jacobian[(col, layout.point(k) + m)] =
+                            h * turning[m] * quad.ell(i, k) + row[m] * quad.ell_prime(i, k);
+                    }
+                }
+            }
         }
         (StepCovectors { impulse, end }, scale)
     }
@@ -230,4 +307,30 @@ pub(crate) fn violation<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: us
     });
     let holonomic = (0..S::HOLONOMIC).map(|b| system.holonomic(q1, b).abs());
     forms.chain(holonomic).fold(0.0, f64::max)
+}
+
+/// The largest violation of the one-forms at the nodes of a Galerkin step from `base` with points
+/// `increments` (`|A_a(Q_i) Q̇_i| h`, a displacement like the degree-1 step's `|A(q_c) ξ|`),
+/// with that of the holonomic constraints at its end.
+pub(crate) fn node_violation<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    quadrature: &Quadrature,
+    h: f64,
+    base: &SVector<f64, N>,
+    increments: &[SVector<f64, N>],
+) -> f64 {
+    let mut worst = 0.0_f64;
+    for i in 0..quadrature.nodes().len() {
+        let (mut xi, mut xi_dot) = (SVector::<f64, N>::zeros(), SVector::<f64, N>::zeros());
+        for (k, z) in increments.iter().enumerate() {
+            xi += z * quadrature.ell(i, k + 1);
+            xi_dot += z * (quadrature.ell_prime(i, k + 1) / h);
+        }
+        let node = base + xi;
+        for a in 0..S::ONE_FORMS {
+            worst = worst.max((system.one_form(&node, a).dot(&xi_dot) * h).abs());
+        }
+    }
+    let end = base + increments[increments.len() - 1];
+    (0..S::HOLONOMIC).fold(worst, |w, b| w.max(system.holonomic(&end, b).abs()))
 }

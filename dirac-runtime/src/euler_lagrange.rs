@@ -104,11 +104,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
             });
         }
         let quadrature = discrete.quadrature();
-        if S::ONE_FORMS > 0 && quadrature.degree() > 1 {
+        if S::ONE_FORMS > 0
+            && quadrature.degree() > 1
+            && (quadrature.nodes().len() != quadrature.degree() || !C::TRANSLATION)
+        {
             return Err(DiracError::InvalidQuadrature(format!(
-                "{} has internal points, but constraint one-forms are imposed on a step's end \
-                 points only; use a degree-1 quadrature (midpoint or trapezoid) for a \
-                 nonholonomic system",
+                "{}: constraint one-forms of a Galerkin step are held at the nodes of a Gauss \
+                 rule with as many nodes as the path's degree (galerkin(s) with \
+                 gauss_legendre(s)), on Rⁿ",
                 quadrature.name()
             )));
         }
@@ -428,11 +431,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<Sensitivity<N>, DiracError> {
-        if !C::TRANSLATION || self.first_order || (S::HOLONOMIC > 0 && self.layout.points() > 1) {
+        if !C::TRANSLATION || self.first_order || (Self::constrained() && self.layout.points() > 1)
+        {
             return Err(DiracError::Unsupported(
                 "derivatives of the step map on a configuration space other than Rⁿ, of a \
-                 Lagrangian linear in the velocities, or with holonomic constraints at internal \
-                 points"
+                 Lagrangian linear in the velocities, or with constraints at internal points or \
+                 nodes"
                     .into(),
             ));
         }
@@ -555,12 +559,17 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     }
 
     fn multipliers(&self) -> usize {
-        S::ONE_FORMS + S::HOLONOMIC * self.layout.points()
+        (S::ONE_FORMS + S::HOLONOMIC) * self.layout.points()
     }
 
     fn multiplier_names(&self) -> Vec<String> {
-        (0..S::ONE_FORMS)
+        let s = self.layout.points();
+        (0..if s == 1 { S::ONE_FORMS } else { 0 })
             .map(|a| format!("mu_{a}"))
+            .chain(
+                (0..if s > 1 { s } else { 0 })
+                    .flat_map(|i| (0..S::ONE_FORMS).map(move |a| format!("mu_{a}_node_{}", i + 1))),
+            )
             .chain(
                 (1..self.layout.points()).flat_map(|j| {
                     (0..S::HOLONOMIC).map(move |b| format!("lambda_{b}_internal_{j}"))
@@ -764,6 +773,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 base: &state.q,
                 layout: &self.layout,
                 holonomic_forms: &self.holonomic_forms,
+                quadrature: discrete.quadrature(),
+                h: discrete.h(),
             };
             let (impulses, size) = constraints.add(x, residual, jacobian);
             covectors.impulse += impulses.impulse;
@@ -827,7 +838,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 value: lagrangian,
             });
         }
-        let violation = if Self::constrained() {
+        let violation = if S::ONE_FORMS > 0 && self.layout.points() > 1 {
+            let increments: Vec<SVector<f64, N>> = (1..=self.layout.points())
+                .map(|j| x.fixed_rows::<N>(self.layout.point(j)).into_owned())
+                .collect();
+            let h = self.discrete.h();
+            constraint::node_violation(system, self.discrete.quadrature(), h, &state.q, &increments)
+        } else if Self::constrained() {
             // Measured on the stored points, as a user reading the trajectory would.
             let stored = space.local(&state.q, &next.q).unwrap_or(xi);
             constraint::violation(system, space, self.point, &state.q, &stored, &next.q)

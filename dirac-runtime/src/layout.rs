@@ -1,10 +1,11 @@
 //! The unknowns of a Lagrangian step and the rows of its equations, in one order.
 
 /// Where each unknown of a step sits in `x = [ξ_1, …, ξ_s, μ, λ]`: `s` blocks of `N` chart
-/// coordinates (the internal points, then the end point), one multiplier per one-form, and one
-/// per holonomic constraint and point of the path `j = 1..s` (the constraint holds at every
-/// point: `λ_{j,b}` pairs with `g_b(Q_j) = 0`; the end point's `λ_{s,b}` is SHAKE's, applied at
-/// `q_k`). The Euler–Lagrange rows use the same blocks.
+/// coordinates (the internal points, then the end point), one multiplier per one-form and
+/// quadrature node of a Galerkin step (`μ_{i,a}` pairs with `A_a(Q(c_i)) Q̇(c_i) = 0`; a single
+/// one for a degree-1 step), and one per holonomic constraint and point of the path `j = 1..s`
+/// (the constraint holds at every point: `λ_{j,b}` pairs with `g_b(Q_j) = 0`; the end point's
+/// `λ_{s,b}` is SHAKE's, applied at `q_k`). The Euler–Lagrange rows use the same blocks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Layout {
     coordinates: usize,
@@ -30,7 +31,7 @@ impl Layout {
 
     /// Number of unknowns.
     pub(crate) fn len(&self) -> usize {
-        self.coordinates * self.points + self.one_forms + self.holonomic * self.points
+        self.coordinates * self.points + (self.one_forms + self.holonomic) * self.points
     }
 
     /// Number of points solved for, `s` (the internal points and the end point).
@@ -53,9 +54,14 @@ impl Layout {
         self.coordinates * self.points
     }
 
-    /// Column of the multiplier of one-form `a`.
+    /// Column of the multiplier of one-form `a` (of a degree-1 step).
     pub(crate) fn one_form(&self, a: usize) -> usize {
-        self.multipliers() + a
+        self.one_form_at(0, a)
+    }
+
+    /// Column of the multiplier of one-form `a` at quadrature node `i` (`0..s`).
+    pub(crate) fn one_form_at(&self, i: usize, a: usize) -> usize {
+        self.multipliers() + i * self.one_forms + a
     }
 
     /// Column of the multiplier of holonomic constraint `b` at the end point (SHAKE's).
@@ -65,17 +71,24 @@ impl Layout {
 
     /// Column of the multiplier of holonomic constraint `b` at point `j` (`1..=s`).
     pub(crate) fn holonomic_at(&self, j: usize, b: usize) -> usize {
-        self.multipliers() + self.one_forms + (j - 1) * self.holonomic + b
+        self.multipliers() + self.one_forms * self.points + (j - 1) * self.holonomic + b
     }
 
     /// What unknown `column` is, with `coordinate` naming coordinates.
     pub(crate) fn name(&self, column: usize, coordinate: impl Fn(usize) -> String) -> String {
         if column >= self.multipliers() {
             let c = column - self.multipliers();
-            return if c < self.one_forms {
+            let forms = self.one_forms * self.points;
+            return if c < forms && self.points == 1 {
                 format!("the multiplier of one-form {c}")
+            } else if c < forms {
+                let (i, a) = (c / self.one_forms, c % self.one_forms);
+                format!(
+                    "the multiplier of one-form {a} at quadrature node {}",
+                    i + 1
+                )
             } else {
-                let c = c - self.one_forms;
+                let c = c - forms;
                 let (j, b) = (c / self.holonomic + 1, c % self.holonomic);
                 if j == self.points {
                     format!("the multiplier of holonomic constraint {b}")
