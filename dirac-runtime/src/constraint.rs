@@ -1,5 +1,6 @@
-//! Constraints on a step: one-forms `A(q) v = 0` evaluated at a chosen point of the step, and
-//! holonomic constraints `g(q) = 0` imposed exactly at `q_{k+1}`.
+//! Constraints on a step: one-forms `A(q) v = 0` evaluated at a chosen point of a degree-1
+//! step (at the Gauss nodes of a Galerkin step), and holonomic constraints `g(q) = 0` imposed
+//! exactly at `q_{k+1}` (and at the internal points of a Galerkin step).
 //!
 //! In the chart centred at `q_k` (on `Rⁿ`: `ξ = q − q_k`) the one-forms read
 //! `Ã(ξ) = (T_ξ R_{q_k})ᵀ A(R_{q_k}(ξ))`. With the constraint point `ξ_c = θ ξ_s` (on `Rⁿ`,

@@ -9,7 +9,9 @@
 //!       Ã(ξ_c) ξ_s = 0,   g(R(ξ_s)) = 0          (one-forms, holonomic constraints)
 //! ```
 //!
-//! solved for `x = [ξ_1, …, ξ_s, μ, λ]` (the `layout` module); then `q_{k+1} = R_{q_k}(ξ_s)` and the
+//! solved for `x = [ξ_1, …, ξ_s, μ, λ]` (the `layout` module; a Galerkin step also holds the
+//! one-forms at its Gauss nodes and the holonomic constraints at its internal points, see
+//! [`EulerLagrange::new`]); then `q_{k+1} = R_{q_k}(ξ_s)` and the
 //! momentum advances by the configuration space from the step's covectors (on `Rⁿ`,
 //! `p_{k+1} = p_k + Σ_j (∂L_d/∂ξ_j + f_j) + Ãᵀμ + dg̃ᵀλ`, which equals
 //! `D_2 L_d + f_s + (1 − σ) Ãᵀμ` at the solution without its cancellation).
@@ -83,10 +85,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     /// The equations of `discrete`, with the constraint one-forms evaluated at the system's
     /// [`constraint_point`](DiracSystem::constraint_point) and every input at 0. Fails on a
     /// non-positive or non-finite step, a non-finite parameter, constraint one-forms with a
-    /// quadrature of degree above 1 (they are imposed on the step's end points only), or
-    /// holonomic constraints with a quadrature of degree above 2: they are held at every point of
-    /// the step's path (`g(Q_j) = 0` with an impulse `dg(Q_j)ᵀλ_j` on the row of each internal
-    /// point), which gives order 4 at degree 2 and still 4 above it.
+    /// Galerkin quadrature other than a Gauss rule with as many nodes as its degree (they are
+    /// held at its nodes: `A(Q(c_i)) Q̇(c_i) = 0`, the force `A(Q(c_i))ᵀμ_i` entering the rows
+    /// as a force does, so that `mu_a_node_i` are forces where a degree-1 step's `mu_a` are
+    /// impulses), or holonomic constraints with a quadrature of degree above 2: they are held at
+    /// every point of the step's path (`g(Q_j) = 0` with an impulse `dg(Q_j)ᵀλ_j` on the row of
+    /// each internal point), which gives order 4 at degree 2 and still 4 above it.
     pub fn new(discrete: DiscreteLagrangian<S, N, C>) -> Result<Self, DiracError> {
         let h = discrete.h();
         if !(h > 0.0 && h.is_finite()) {
@@ -587,6 +591,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     /// hidden constraints of coordinates without kinetic energy satisfied.
     fn check_start(&self, state: &State<N>, tolerance: f64) -> Result<(), DiracError> {
         let system = self.discrete.system();
+        if S::ONE_FORMS > 0 && self.layout.points() > 1 && self.point != ConstraintPoint::Midpoint {
+            return Err(DiracError::InvalidQuadrature(format!(
+                "{} holds the one-forms at its Gauss nodes, so it has no constraint point; \
+                 {:?} applies to degree-1 quadratures only (leave the default, Midpoint)",
+                self.discrete.quadrature().name(),
+                self.point
+            )));
+        }
         let (q, p, v) = (&state.q, &state.p, &state.velocity);
         check_finite(system, "initial position", q)?;
         let space = self.discrete.space();
@@ -839,8 +851,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             });
         }
         let violation = if S::ONE_FORMS > 0 && self.layout.points() > 1 {
-            let increments: Vec<SVector<f64, N>> = (1..=self.layout.points())
-                .map(|j| x.fixed_rows::<N>(self.layout.point(j)).into_owned())
+            // Measured with the stored end point (after any projection).
+            let s = self.layout.points();
+            let increments: Vec<SVector<f64, N>> = (1..=s)
+                .map(|j| match j {
+                    j if j == s => space.local(&state.q, &next.q).unwrap_or(xi),
+                    j => x.fixed_rows::<N>(self.layout.point(j)).into_owned(),
+                })
                 .collect();
             let h = self.discrete.h();
             constraint::node_violation(system, self.discrete.quadrature(), h, &state.q, &increments)
@@ -878,7 +895,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, NewtonFailure> {
-        self.velocity_with_multipliers(newton, q, p, guess, self.hidden.as_ref())
+        let system = self.discrete.system();
+        let run = self
+            .hidden
+            .as_ref()
+            .filter(|hidden| hidden.matches(system, q, guess));
+        self.velocity_with_multipliers(newton, q, p, guess, run)
             .map(|(v, _)| v)
     }
 

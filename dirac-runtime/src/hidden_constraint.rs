@@ -109,6 +109,17 @@ impl HiddenConstraints {
         found
     }
 
+    /// Whether these are the degenerate coordinates at `(q, v)` (a run's hidden constraints
+    /// serve another state of the same model only where they are).
+    pub fn matches<S: DiracSystem<N>, const N: usize>(
+        &self,
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> bool {
+        degenerate(system, q, v) == self.dead
+    }
+
     /// Number of hidden (algebraic) constraints.
     pub fn count(&self) -> usize {
         self.count
