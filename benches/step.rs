@@ -114,6 +114,38 @@ fn constrained(c: &mut Criterion) {
     group.finish();
 }
 
+/// Lotka–Volterra, H = q1 + q2 − ln q1 − 2 ln q2, in the gauge ϑ = (ln q2 / q1, 0): a
+/// Lagrangian linear in the velocities.
+#[dirac_system(
+    coordinates(q1, q2),
+    lagrangian = ln(q2) / q1 * dot(q1) - (q1 + q2 - ln(q1) - 2.0 * ln(q2)),
+)]
+struct LotkaVolterra;
+
+/// Steps of the newer model classes (h = 0.05): a Lagrangian linear in the velocities
+/// (collocated at the Gauss nodes, p = ϑ(q)), and the knife edge with its one-form held at the
+/// Gauss nodes of a Galerkin step.
+fn newer_classes(c: &mut Criterion) {
+    let mut group = c.benchmark_group("model_class_step");
+    for quadrature in [Quadrature::midpoint(), Quadrature::gauss(2).expect("rule")] {
+        let name = quadrature.name();
+        let mut lv = Stepper::new(LotkaVolterra, quadrature.clone(), 0.05).expect("valid");
+        lv.start_from_position(vector![2.0, 1.0]).expect("start");
+        group.bench_function(format!("lotka_volterra/{name}"), |b| {
+            b.iter(|| black_box(lv.step()).expect("step"))
+        });
+        let mut knife =
+            Stepper::new(scenes::knife_edge::SCENE, quadrature.clone(), 0.05).expect("valid");
+        knife
+            .start_from_velocity(SVector::zeros(), vector![0.0, 0.0, 1.0])
+            .expect("start");
+        group.bench_function(format!("knife_edge/{name}"), |b| {
+            b.iter(|| black_box(knife.step()).expect("step"))
+        });
+    }
+    group.finish();
+}
+
 /// trep's double pendulum (m = l = 1, g = 9.81, both links horizontal at rest, midpoint,
 /// h = 0.01): a step, a step with the first derivatives of the step map (`A` by the implicit
 /// function theorem), and with the first and second, beside
@@ -157,6 +189,7 @@ criterion_group!(
     quadratures,
     chain_growth,
     constrained,
-    step_derivatives
+    step_derivatives,
+    newer_classes
 );
 criterion_main!(benches);
