@@ -114,14 +114,6 @@ fn constrained(c: &mut Criterion) {
     group.finish();
 }
 
-/// Lotka–Volterra, H = q1 + q2 − ln q1 − 2 ln q2, in the gauge ϑ = (ln q2 / q1, 0): a
-/// Lagrangian linear in the velocities.
-#[dirac_system(
-    coordinates(q1, q2),
-    lagrangian = ln(q2) / q1 * dot(q1) - (q1 + q2 - ln(q1) - 2.0 * ln(q2)),
-)]
-struct LotkaVolterra;
-
 /// Steps of the newer model classes (h = 0.05): a Lagrangian linear in the velocities
 /// (collocated at the Gauss nodes, p = ϑ(q)), and the knife edge with its one-form held at the
 /// Gauss nodes of a Galerkin step.
@@ -129,7 +121,8 @@ fn newer_classes(c: &mut Criterion) {
     let mut group = c.benchmark_group("model_class_step");
     for quadrature in [Quadrature::midpoint(), Quadrature::gauss(2).expect("rule")] {
         let name = quadrature.name();
-        let mut lv = Stepper::new(LotkaVolterra, quadrature.clone(), 0.05).expect("valid");
+        let mut lv =
+            Stepper::new(scenes::lotka_volterra::SCENE, quadrature.clone(), 0.05).expect("valid");
         lv.start_from_position(vector![2.0, 1.0]).expect("start");
         group.bench_function(format!("lotka_volterra/{name}"), |b| {
             b.iter(|| black_box(lv.step()).expect("step"))

@@ -1,7 +1,8 @@
 //! Runs every scene, prints one table (scene, quadrature, h, steps, max energy error, wall time,
 //! check against the known answer) and writes it to `output/tour.csv`, beside one CSV trajectory
 //! per run. Unconstrained scenes run with every tour quadrature; constrained ones with the
-//! midpoint rule (the knife edge with each discrete constraint point), and the trapezoid rule's
+//! midpoint rule (the knife edge with each discrete constraint point); Lotka–Volterra (linear
+//! in the velocities) and the rolling disk with the Gauss rules; and the trapezoid rule's
 //! refusal of the ill-posed LC circuit is shown. Pictures: `output/convergence.png`,
 //! `output/energy_error.png`, `output/knife_edge.png`, `output/lc_circuit.png`.
 //!
@@ -38,6 +39,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         reports.push(scene(Quadrature::midpoint())?);
     }
     reports.push(circuit::driven_report()?);
+    // The newer model classes with the Gauss rules (the trapezoid is refused for a Lagrangian
+    // linear in the velocities).
+    type Newer = fn(Quadrature) -> Result<Report, DiracError>;
+    let newer: [Newer; 2] = [scenes::lotka_volterra::report, scenes::rolling_disk::report];
+    for scene in newer {
+        for quadrature in scenes::quadratures()
+            .into_iter()
+            .filter(|q| *q != Quadrature::trapezoid())
+        {
+            reports.push(scene(quadrature)?);
+        }
+    }
     for point in [
         ConstraintPoint::Start,
         ConstraintPoint::Midpoint,

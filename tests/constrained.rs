@@ -9,7 +9,7 @@ mod support;
 use dirac::prelude::*;
 use dirac::step_equations::State;
 use scenes::circuit::{self, LcCircuit};
-use scenes::{cartesian_pendulum, knife_edge, port};
+use scenes::{cartesian_pendulum, knife_edge, port, rolling_disk};
 use support::slope;
 
 /// L in series with C2 and (C1 ∥ C3) with unequal capacitances.
@@ -513,60 +513,6 @@ fn holonomic_galerkin_of_degree_two_is_fourth_order() {
     }
 }
 
-/// A vertical disk rolling without slipping: q = (x, y, θ, φ), rolling angle θ, heading φ;
-/// ẋ = r cos φ θ̇, ẏ = r sin φ θ̇. θ̇ = Ω and φ̇ = ω stay constant, so the contact point runs on a
-/// circle: x = x0 + (rΩ/ω)(sin(ωt + φ0) − sin φ0), y = y0 − (rΩ/ω)(cos(ωt + φ0) − cos φ0).
-#[dirac_system(
-    coordinates(x, y, theta, phi),
-    lagrangian = 0.5 * mass * (dot(x).powi(2) + dot(y).powi(2))
-        + 0.5 * rolling * dot(theta).powi(2)
-        + 0.5 * turning * dot(phi).powi(2),
-    constraints(dx - radius * cos(phi) * dtheta, dy - radius * sin(phi) * dtheta),
-)]
-#[derive(Debug, Clone, Copy)]
-struct RollingDisk {
-    mass: f64,
-    rolling: f64,
-    turning: f64,
-    radius: f64,
-}
-
-const DISK: RollingDisk = RollingDisk {
-    mass: 1.0,
-    rolling: 0.5,
-    turning: 0.25,
-    radius: 1.0,
-};
-const DISK_SPIN: f64 = 1.0;
-const DISK_TURN: f64 = 0.7;
-const DISK_HEADING: f64 = 0.3;
-
-fn disk_exact(t: f64) -> SVector<f64, 4> {
-    let (r, spin, turn, phi0) = (DISK.radius, DISK_SPIN, DISK_TURN, DISK_HEADING);
-    let phi = phi0 + turn * t;
-    vector![
-        r * spin / turn * (phi.sin() - phi0.sin()),
-        -r * spin / turn * (phi.cos() - phi0.cos()),
-        spin * t,
-        phi
-    ]
-}
-
-fn disk_stepper(quadrature: Quadrature, h: f64) -> Stepper<RollingDisk, 4> {
-    let mut stepper = Stepper::new(DISK, quadrature, h).unwrap();
-    let phi0 = DISK_HEADING;
-    let v0 = vector![
-        DISK.radius * phi0.cos() * DISK_SPIN,
-        DISK.radius * phi0.sin() * DISK_SPIN,
-        DISK_SPIN,
-        DISK_TURN
-    ];
-    stepper
-        .start_from_velocity(vector![0.0, 0.0, 0.0, phi0], v0)
-        .unwrap();
-    stepper
-}
-
 /// Constraint one-forms held at the Gauss nodes of a Galerkin step (the constraint force enters
 /// the rows as a force does): orders 2, 4, 6 for midpoint, `galerkin(2)`, `galerkin(3)` on the
 /// knife edge (measured 2.00, 4.00, 6.00), the rolling disk and the LC circuit (2.01, 3.99,
@@ -599,12 +545,12 @@ fn one_forms_at_the_nodes_of_galerkin_steps_keep_the_orders() {
         let disk: Vec<f64> = hs
             .iter()
             .map(|&h| {
-                let mut stepper = disk_stepper(quadrature.clone(), h);
+                let mut stepper = rolling_disk::stepper(quadrature.clone(), h).unwrap();
                 for _ in 0..(2.0 / h).round() as usize {
                     stepper.step().unwrap();
                     assert!(stepper.constraint_violation() < 1e-14, "{name}");
                 }
-                (stepper.q() - disk_exact(2.0)).amax()
+                (stepper.q() - rolling_disk::exact(2.0)).amax()
             })
             .collect();
         let lc: Vec<f64> = hs

@@ -3,23 +3,13 @@
 //! computed here by an independent method (classical Runge–Kutta on the vector field derived by
 //! hand).
 
+#[path = "../examples/scenes/mod.rs"]
+mod scenes;
 mod support;
 
 use dirac::prelude::*;
+use scenes::lotka_volterra::{self, LotkaVolterra};
 use support::slope;
-
-/// Lotka–Volterra, H = a1 q1 + a2 q2 + b1 ln q1 + b2 ln q2, in the gauge ϑ = (ln q2 / q1, 0).
-#[dirac_system(
-    coordinates(q1, q2),
-    lagrangian = ln(q2) / q1 * dot(q1) - (a1 * q1 + a2 * q2 + b1 * ln(q1) + b2 * ln(q2)),
-)]
-#[derive(Debug, Clone, Copy)]
-struct LotkaVolterra {
-    a1: f64,
-    a2: f64,
-    b1: f64,
-    b2: f64,
-}
 
 /// The same system in the gauge ϑ = (q2 + ln q2 / q1, q1) (ϑ changed by the gradient of q1 q2).
 #[dirac_system(
@@ -35,16 +25,11 @@ struct LotkaVolterraGauge {
     b2: f64,
 }
 
-const A1: f64 = 1.0;
-const A2: f64 = 1.0;
-const B1: f64 = -1.0;
-const B2: f64 = -2.0;
-const LV: LotkaVolterra = LotkaVolterra {
-    a1: A1,
-    a2: A2,
-    b1: B1,
-    b2: B2,
-};
+const LV: LotkaVolterra = lotka_volterra::SCENE;
+const A1: f64 = LV.a1;
+const A2: f64 = LV.a2;
+const B1: f64 = LV.b1;
+const B2: f64 = LV.b2;
 const LV_GAUGE: LotkaVolterraGauge = LotkaVolterraGauge {
     a1: A1,
     a2: A2,
@@ -52,34 +37,7 @@ const LV_GAUGE: LotkaVolterraGauge = LotkaVolterraGauge {
     b2: B2,
 };
 
-fn q0() -> SVector<f64, 2> {
-    vector![2.0, 1.0]
-}
-
-fn hamiltonian(q: &SVector<f64, 2>) -> f64 {
-    A1 * q[0] + A2 * q[1] + B1 * q[0].ln() + B2 * q[1].ln()
-}
-
-/// The vector field by hand: (ϑ'ᵀ − ϑ') q̇ = ∇H with ϑ'ᵀ − ϑ' = [[0, −1/(q1 q2)], [1/(q1 q2), 0]]
-/// gives q̇1 = q1 (a2 q2 + b2), q̇2 = −q2 (a1 q1 + b1).
-fn field(q: &SVector<f64, 2>) -> SVector<f64, 2> {
-    vector![q[0] * (A2 * q[1] + B2), -q[1] * (A1 * q[0] + B1)]
-}
-
-/// Classical Runge–Kutta at h = 1e-4: error far below the errors measured here.
-fn reference(t: f64) -> SVector<f64, 2> {
-    let steps = (t / 1e-4).round() as usize;
-    let h = t / steps as f64;
-    let mut q = q0();
-    for _ in 0..steps {
-        let k1 = field(&q);
-        let k2 = field(&(q + k1 * (h / 2.0)));
-        let k3 = field(&(q + k2 * (h / 2.0)));
-        let k4 = field(&(q + k3 * h));
-        q += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0);
-    }
-    q
-}
+use lotka_volterra::{field, hamiltonian, q0, reference};
 
 fn error_at<S: DiracSystem<2>>(
     system: S,

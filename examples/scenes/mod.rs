@@ -11,10 +11,12 @@ pub mod figures;
 pub mod hand_written;
 pub mod kepler;
 pub mod knife_edge;
+pub mod lotka_volterra;
 pub mod oscillator;
 pub mod pendulum;
 pub mod plot;
 pub mod port;
+pub mod rolling_disk;
 
 use std::time::{Duration, Instant};
 
