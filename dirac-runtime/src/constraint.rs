@@ -197,13 +197,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraint
         let mut impulse = SVector::<f64, N>::zeros();
         let mut end = SVector::<f64, N>::zeros();
         let mut scale = 0.0_f64;
+        let increments: Vec<SVector<f64, N>> = (1..=s)
+            .map(|k| x.fixed_rows::<N>(layout.point(k)).into_owned())
+            .collect();
         for (i, &b) in quad.weights().iter().enumerate() {
-            let (mut xi, mut xi_dot) = (SVector::<f64, N>::zeros(), SVector::<f64, N>::zeros());
-            for k in 1..=s {
-                let z = x.fixed_rows::<N>(layout.point(k));
-                xi += z * quad.ell(i, k);
-                xi_dot += z * (quad.ell_prime(i, k) / h);
-            }
+            let (xi, xi_dot) = quad.path_at(i, &increments, h);
             let node = base + xi;
             for a in 0..S::ONE_FORMS {
                 let (row, derivative) = one_form(system, &node, a);
@@ -322,11 +320,7 @@ pub(crate) fn node_violation<S: DiracSystem<N>, const N: usize>(
 ) -> f64 {
     let mut worst = 0.0_f64;
     for i in 0..quadrature.nodes().len() {
-        let (mut xi, mut xi_dot) = (SVector::<f64, N>::zeros(), SVector::<f64, N>::zeros());
-        for (k, z) in increments.iter().enumerate() {
-            xi += z * quadrature.ell(i, k + 1);
-            xi_dot += z * (quadrature.ell_prime(i, k + 1) / h);
-        }
+        let (xi, xi_dot) = quadrature.path_at(i, increments, h);
         let node = base + xi;
         for a in 0..S::ONE_FORMS {
             worst = worst.max((system.one_form(&node, a).dot(&xi_dot) * h).abs());

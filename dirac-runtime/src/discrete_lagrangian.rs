@@ -102,13 +102,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         i: usize,
         increments: &[SVector<f64, N>],
     ) -> (SVector<f64, N>, SVector<f64, N>) {
-        let mut xi = SVector::zeros();
-        let mut v = SVector::zeros();
-        for (j, z) in increments.iter().enumerate() {
-            xi += z * self.quadrature.ell(i, j + 1);
-            v += z * (self.quadrature.ell_prime(i, j + 1) / self.h);
-        }
-        (xi, v)
+        self.quadrature.path_at(i, increments, self.h)
     }
 
     /// How node `i`'s position and velocity move when the step's points `0..=s` move by

@@ -12,6 +12,8 @@
 //! with the 2-point Gauss–Lobatto rule. Measured orders are in the README and asserted in
 //! `tests/convergence.rs`.
 
+use nalgebra::SVector;
+
 use crate::error::DiracError;
 
 /// The quadrature rule on `[0, 1]` used to integrate the Lagrangian along one step.
@@ -199,6 +201,24 @@ impl Quadrature {
     /// `ℓ'_j(c_i)` for indices the caller keeps in range.
     pub(crate) fn ell_prime(&self, node: usize, point: usize) -> f64 {
         self.basis_derivative[node * (self.degree + 1) + point]
+    }
+
+    /// The path through `0, increments[0], …, increments[s−1]` at node `i`: its value
+    /// `Σ_j ℓ_j(c_i) ξ_j` and its rate `Σ_j ℓ'_j(c_i) ξ_j / h` (for indices the caller keeps in
+    /// range).
+    pub(crate) fn path_at<const N: usize>(
+        &self,
+        node: usize,
+        increments: &[SVector<f64, N>],
+        h: f64,
+    ) -> (SVector<f64, N>, SVector<f64, N>) {
+        let mut xi = SVector::zeros();
+        let mut rate = SVector::zeros();
+        for (j, z) in increments.iter().enumerate() {
+            xi += z * self.ell(node, j + 1);
+            rate += z * (self.ell_prime(node, j + 1) / h);
+        }
+        (xi, rate)
     }
 
     /// A short name in the attribute's syntax: `midpoint`, `trapezoid` or `galerkin(s, rule(r))`.
