@@ -120,6 +120,38 @@ impl HiddenConstraints {
         degenerate(system, q, v) == self.dead
     }
 
+    /// The degenerate coordinates at `(q, v)`, their combinations not examined (`count` 0):
+    /// enough for [`balance`](Self::balance).
+    pub fn rows_of<S: DiracSystem<N>, const N: usize>(
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Self {
+        Self {
+            dead: degenerate(system, q, v),
+            ..Self::none()
+        }
+    }
+
+    /// The degenerate coordinates.
+    pub fn coordinates(&self) -> &[usize] {
+        &self.dead
+    }
+
+    /// Their Euler–Lagrange rows without the multipliers, `R_D(q, v, t)`, and the size of the
+    /// terms summed into them.
+    pub fn balance<S: DiracSystem<N>, const N: usize>(
+        &self,
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        t: f64,
+        inputs: &[f64],
+    ) -> (DVector<f64>, f64) {
+        let (value, _, _, scale) = self.rows(system, q, v, t, inputs);
+        (value, scale)
+    }
+
     /// Number of hidden (algebraic) constraints.
     pub fn count(&self) -> usize {
         self.count

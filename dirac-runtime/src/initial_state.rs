@@ -2,10 +2,10 @@
 //! and the hidden constraints of degenerate coordinates (those without kinetic energy, whose
 //! Euler–Lagrange equations are algebraic).
 
-use nalgebra::{DMatrix, DVector, SVector};
+use nalgebra::{DMatrix, SVector};
 
 use crate::constraint;
-use crate::derivatives::{Seed, degenerate, seeded};
+use crate::hidden_constraint::HiddenConstraints;
 use crate::system::DiracSystem;
 
 /// Checks `(q0, v0)` against the holonomic constraints `g(q0) = 0`, `dg(q0) v0 = 0`, the one-forms
@@ -50,36 +50,23 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
             ));
         }
     }
-    let dead = degenerate(system, q0, v0);
-    if dead.is_empty() {
+    let rows = HiddenConstraints::rows_of(system, q0, v0);
+    if rows.coordinates().is_empty() {
         return Ok(());
     }
     // Rows D of  ∂L/∂q + F − d/dt ∂L/∂v + Aᵀμ + dgᵀλ = 0, with d/dt ∂L/∂v_D = Σ_j ∂²L/∂q_j∂v_D v_j.
-    let qv = seeded(system, q0, v0, Seed::POSITION, Seed::VELOCITY);
-    let force = system.force(q0, v0, t0, inputs);
-    let unbalanced: SVector<f64, N> = qv.first + force - qv.mixed.transpose() * v0;
-    let mut columns: Vec<SVector<f64, N>> = forms;
-    columns.extend((0..S::HOLONOMIC).map(|b| constraint::holonomic(system, q0, b).1));
-    let matrix = DMatrix::from_fn(dead.len(), columns.len(), |r, c| columns[c][dead[r]]);
-    let rhs = DVector::from_iterator(dead.len(), dead.iter().map(|&i| -unbalanced[i]));
-    let residual = if columns.is_empty() {
-        rhs.amax()
+    let (unbalanced, size) = rows.balance(system, q0, v0, t0, inputs);
+    let (dead, forms) = (rows.coordinates(), HiddenConstraints::forms(system, q0));
+    let matrix = DMatrix::from_fn(dead.len(), forms.nrows(), |r, c| forms[(c, dead[r])]);
+    let residual = if forms.nrows() == 0 {
+        unbalanced.amax()
     } else {
         let svd = matrix.clone().svd(true, true);
         let cutoff = 1e-12 * svd.singular_values.amax();
+        let rhs = -&unbalanced;
         let multipliers = svd.solve(&rhs, cutoff).map_err(|e| e.to_string())?;
         (matrix * multipliers - &rhs).amax()
     };
-    let transport = qv.mixed.transpose() * v0;
-    let size = dead
-        .iter()
-        .map(|&i| {
-            qv.first[i]
-                .abs()
-                .max(force[i].abs())
-                .max(transport[i].abs())
-        })
-        .fold(0.0, f64::max);
     if residual > tolerance * size {
         let names: Vec<String> = dead.iter().map(|&i| name(i)).collect();
         return Err(format!(
