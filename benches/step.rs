@@ -127,6 +127,15 @@ fn newer_classes(c: &mut Criterion) {
         group.bench_function(format!("lotka_volterra/{name}"), |b| {
             b.iter(|| black_box(lv.step()).expect("step"))
         });
+        let mut projected = Stepper::new(scenes::lotka_volterra::SCENE, quadrature.clone(), 0.05)
+            .expect("valid")
+            .with_first_order_scheme(FirstOrderScheme::SymmetricProjection);
+        projected
+            .start_from_position(vector![2.0, 1.0])
+            .expect("start");
+        group.bench_function(format!("lotka_volterra_projected/{name}"), |b| {
+            b.iter(|| black_box(projected.step()).expect("step"))
+        });
         let mut knife =
             Stepper::new(scenes::knife_edge::SCENE, quadrature.clone(), 0.05).expect("valid");
         knife

@@ -24,6 +24,7 @@ use crate::derivatives::Dual;
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
 use crate::first_order;
+use crate::first_order_scheme::FirstOrderScheme;
 use crate::hidden_constraint::HiddenConstraints;
 use crate::holonomic_scheme::HolonomicScheme;
 use crate::initial_state;
@@ -66,6 +67,7 @@ pub struct EulerLagrange<S, const N: usize, C> {
     /// Whether the run's Lagrangian is linear in every velocity (found when it begins): the
     /// step equations are those of [`first_order`].
     first_order: bool,
+    first_order_scheme: FirstOrderScheme,
     layout: Layout,
     /// Current values of the system's inputs.
     inputs: Vec<f64>,
@@ -141,6 +143,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
             holonomic_scheme: HolonomicScheme::default(),
             hidden: None,
             first_order: false,
+            first_order_scheme: FirstOrderScheme::default(),
             layout: Layout::new(N, s, S::ONE_FORMS, S::HOLONOMIC),
             inputs: vec![0.0; S::INPUTS],
             lifted_inputs: vec![Dual::from(0.0); S::INPUTS],
@@ -178,6 +181,23 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     /// Sets what a step does with the momentum of a model with holonomic constraints.
     pub fn set_holonomic_scheme(&mut self, scheme: HolonomicScheme) {
         self.holonomic_scheme = scheme;
+    }
+
+    /// Which step a Lagrangian linear in the velocities is advanced by.
+    pub fn first_order_scheme(&self) -> FirstOrderScheme {
+        self.first_order_scheme
+    }
+
+    /// Sets which step a Lagrangian linear in the velocities is advanced by (taken up when a
+    /// run begins).
+    pub fn set_first_order_scheme(&mut self, scheme: FirstOrderScheme) {
+        self.first_order_scheme = scheme;
+    }
+
+    /// Whether the run's steps are projected onto `p = ϑ(q)` by the multipliers at the end of
+    /// the unknowns.
+    fn projected(&self) -> bool {
+        self.first_order && self.first_order_scheme == FirstOrderScheme::SymmetricProjection
     }
 
     /// Current input values.
@@ -695,6 +715,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     fn begin(&mut self, state: &State<N>) {
         self.first_order =
             first_order::is_first_order(self.discrete.system(), &state.q, &state.velocity);
+        let projection = if self.projected() { N } else { 0 };
+        self.layout = self.layout.with_projection(projection);
         self.hidden = Some(HiddenConstraints::find(
             self.discrete.system(),
             &state.q,
@@ -748,6 +770,18 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             z.copy_from(&x.fixed_rows::<N>(self.layout.point(j + 1)));
         }
         let discrete = &self.discrete;
+        if self.projected() {
+            let shift = x.fixed_rows::<N>(self.layout.projection()).into_owned();
+            return first_order::symmetric_projection(
+                discrete,
+                &state.q,
+                &state.p,
+                &self.increments,
+                &shift,
+                residual,
+                jacobian,
+            );
+        }
         if self.first_order {
             return first_order::collocation(
                 discrete,
@@ -805,7 +839,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     ) -> Result<(State<N>, f64), DiracError> {
         let space = self.discrete.space();
         let system = self.discrete.system();
-        let xi = x.fixed_rows::<N>(self.layout.end_point()).into_owned();
+        let mut xi = x.fixed_rows::<N>(self.layout.end_point()).into_owned();
+        if self.projected() {
+            let shift = x.fixed_rows::<N>(self.layout.projection()).into_owned();
+            xi = first_order::projected_increment(self.discrete.quadrature(), &xi, &shift);
+        }
         let mut next = *state;
         space.advance(&mut next.q, &mut next.q_carry, &xi);
         space

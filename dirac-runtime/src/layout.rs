@@ -5,13 +5,17 @@
 /// quadrature node of a Galerkin step (`μ_{i,a}` pairs with `A_a(Q(c_i)) Q̇(c_i) = 0`; a single
 /// one for a degree-1 step), and one per holonomic constraint and point of the path `j = 1..s`
 /// (the constraint holds at every point: `λ_{j,b}` pairs with `g_b(Q_j) = 0`; the end point's
-/// `λ_{s,b}` is SHAKE's, applied at `q_k`). The Euler–Lagrange rows use the same blocks.
+/// `λ_{s,b}` is SHAKE's, applied at `q_k`). The Euler–Lagrange rows use the same blocks. A
+/// step projected onto `p = ϑ(q)` (a Lagrangian linear in the velocities under
+/// [`FirstOrderScheme::SymmetricProjection`](crate::FirstOrderScheme)) ends with one projection
+/// multiplier per coordinate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Layout {
     coordinates: usize,
     points: usize,
     one_forms: usize,
     holonomic: usize,
+    projection: usize,
 }
 
 impl Layout {
@@ -26,11 +30,22 @@ impl Layout {
             points,
             one_forms,
             holonomic,
+            projection: 0,
         }
+    }
+
+    /// The same layout with `projection` projection multipliers at its end (0 for none).
+    pub(crate) fn with_projection(self, projection: usize) -> Self {
+        Self { projection, ..self }
     }
 
     /// Number of unknowns.
     pub(crate) fn len(&self) -> usize {
+        self.projection() + self.projection
+    }
+
+    /// First column of the projection multipliers (one per coordinate, when there are any).
+    pub(crate) fn projection(&self) -> usize {
         self.coordinates * self.points + (self.one_forms + self.holonomic) * self.points
     }
 
@@ -76,6 +91,10 @@ impl Layout {
 
     /// What unknown `column` is, with `coordinate` naming coordinates.
     pub(crate) fn name(&self, column: usize, coordinate: impl Fn(usize) -> String) -> String {
+        if column >= self.projection() {
+            let coordinate = coordinate(column - self.projection());
+            return format!("the multiplier projecting {coordinate} onto p = ϑ(q)");
+        }
         if column >= self.multipliers() {
             let c = column - self.multipliers();
             let forms = self.one_forms * self.points;

@@ -107,7 +107,8 @@ pub trait StepEquations<const N: usize> {
     /// The step size.
     fn h(&self) -> f64;
 
-    /// Number of unknowns of a step.
+    /// Number of unknowns of a step (read again after [`begin`](Self::begin): it may depend on
+    /// what the equations find at the start of a run).
     fn unknowns(&self) -> usize;
 
     /// Number of multipliers among the unknowns (constraint impulses).

@@ -18,6 +18,7 @@ use crate::constraint::ConstraintPoint;
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
 use crate::euler_lagrange::{EulerLagrange, check_finite};
+use crate::first_order_scheme::FirstOrderScheme;
 use crate::holonomic_scheme::HolonomicScheme;
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
@@ -237,6 +238,33 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         self
     }
 
+    /// Chooses which step a Lagrangian linear in the velocities is advanced by (default
+    /// [`FirstOrderScheme::Collocation`]); taken up by the next start.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, FirstOrderScheme, Quadrature, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// /// Lotka–Volterra, L = ϑ(q)·v − H(q) with ϑ = (ln q2 / q1, 0).
+    /// struct LotkaVolterra;
+    /// impl DiracSystem<2> for LotkaVolterra {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+    ///         q[1].ln() / q[0] * v[0] - (q[0] + q[1] - q[0].ln() - q[1].ln() * 2.0)
+    ///     }
+    /// }
+    /// let h = |q: &SVector<f64, 2>| q[0] + q[1] - q[0].ln() - 2.0 * q[1].ln();
+    /// let mut stepper = Stepper::new(LotkaVolterra, Quadrature::gauss(2)?, 0.05)?
+    ///     .with_first_order_scheme(FirstOrderScheme::SymmetricProjection);
+    /// let q0 = vector![2.0, 1.0];
+    /// stepper.start_from_position(q0)?;
+    /// stepper.run(200)?;
+    /// assert!((h(&stepper.q()) - h(&q0)).abs() < 1e-5);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn with_first_order_scheme(mut self, scheme: FirstOrderScheme) -> Self {
+        self.equations.set_first_order_scheme(scheme);
+        self
+    }
+
     /// Where the constraint one-forms are evaluated on a step.
     pub fn constraint_point(&self) -> ConstraintPoint {
         self.equations.constraint_point()
@@ -364,7 +392,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         // this stepper (or another) produced is always accepted.
         let tolerance = START_TOLERANCE.max(100.0 * self.newton.options().residual_tolerance);
         self.equations.check_start(&state, tolerance)?;
-        self.equations.begin(&state);
+        self.begin(&state)?;
         // A rule that does not determine the model's motion (the first step's Jacobian is
         // singular) is refused here, before the first step, naming the undetermined unknowns.
         let equations = &mut self.equations;
@@ -377,11 +405,23 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             let error = self.failure(Problem::Step, failure);
             self.steps = steps;
             if let Some(current) = self.state {
-                self.equations.begin(&current);
+                self.begin(&current)?;
             }
             return Err(error);
         }
         self.reset(state);
+        Ok(())
+    }
+
+    /// Lets the equations examine the start of a run, and sizes the solver for the unknowns
+    /// they then have.
+    fn begin(&mut self, state: &State<N>) -> Result<(), DiracError> {
+        self.equations.begin(state);
+        let unknowns = self.equations.unknowns();
+        if unknowns != self.unknowns.len() {
+            self.newton = Newton::new(unknowns, *self.newton.options())?;
+            self.unknowns = DVector::zeros(unknowns);
+        }
         Ok(())
     }
 
