@@ -228,6 +228,22 @@ fn every_constrained_scene_restarts_from_its_own_state() {
         stepper
     };
     check_restart("massless port", ports, 0.02, port_at, 100, 150);
+
+    let rc = |h| {
+        let mut stepper = Stepper::new(ParallelRc, Quadrature::midpoint(), h).unwrap();
+        stepper
+            .start_from_velocity(vector![0.0, 1.0, 0.0], vector![0.0, -2.0, 2.0])
+            .unwrap();
+        stepper
+    };
+    check_restart(
+        "resistor beside a capacitor",
+        rc,
+        0.02,
+        parallel_rc_at,
+        50,
+        100,
+    );
 }
 
 /// The pendulum angle at `t` from rest at 1 rad, by `galerkin(3)` at h = 1e-3 (error < 1e-12).
@@ -392,6 +408,14 @@ fn time_dependence_is_found_where_it_vanishes_at_the_start() {
 #[derive(Debug, Clone, Copy)]
 struct ParallelRc;
 
+/// The closed form from q_c = 1 with no current: with x = q_c and i = q̇_l, ẋ = i − 2x and
+/// i̇ = −x (double eigenvalue −1), so x = (1 − t) e^{−t}, i = −t e^{−t}, q_l = (1 + t) e^{−t} − 1
+/// and q_r = ∫ 2x = 2 t e^{−t}.
+fn parallel_rc_at(t: f64) -> SVector<f64, 3> {
+    let decay = (-t).exp();
+    vector![(1.0 + t) * decay - 1.0, (1.0 - t) * decay, 2.0 * t * decay]
+}
+
 #[test]
 fn a_resistor_parallel_to_a_capacitor_runs() {
     let mut stepper = Stepper::new(ParallelRc, Quadrature::midpoint(), 0.01).unwrap();
@@ -409,6 +433,22 @@ fn a_resistor_parallel_to_a_capacitor_runs() {
         energy.windows(2).all(|w| w[1] <= w[0] + 1e-12),
         "{energy:?}"
     );
+    // The velocity keeps Kirchhoff's current law and the resistor's law R q̇_r = q_c / C at the
+    // node, and is the closed form's to the method's order.
+    let v = stepper.v().unwrap();
+    let q = stepper.q();
+    assert!((-v[0] + v[1] + v[2]).abs() < 1e-14, "KCL: {v:?}");
+    assert!(
+        (0.5 * v[2] - q[1]).abs() < 1e-14,
+        "resistor: {v:?} at {q:?}"
+    );
+    let t = stepper.t();
+    let exact = vector![
+        -t * (-t).exp(),
+        (t - 2.0) * (-t).exp(),
+        2.0 * (1.0 - t) * (-t).exp()
+    ];
+    assert!((v - exact).amax() < 1e-3, "{v:?} vs {exact:?}");
 }
 
 /// The holonomic check is relative to the terms of g: g = x y − 1 at (1e-5, 6e5) is 5, far from

@@ -115,6 +115,7 @@ impl StepEquations<1> for ImplicitMidpoint {
     fn velocity(
         &self,
         _newton: &mut Newton,
+        _t: f64,
         _q: &SVector<f64, 1>,
         p: &SVector<f64, 1>,
         _guess: &SVector<f64, 1>,

@@ -278,6 +278,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     fn velocity_with_multipliers(
         &self,
         newton: &mut Newton,
+        t: f64,
         q: &SVector<f64, N>,
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
@@ -292,15 +293,32 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         let hidden = match run {
             Some(hidden) => hidden,
             None => {
-                found = HiddenConstraints::find(system, q, guess, 0.0, &self.inputs);
+                found = HiddenConstraints::find(system, q, guess, t, &self.inputs);
                 &found
             }
         };
         let mut spare = None;
-        if hidden.dynamic() > 0 {
+        if hidden.dynamic() > 0 && hidden.count() == 0 {
             // Degenerate rows that are first-order equations (a resistor on a capacitor's
-            // branch) fix their velocities through the dynamics, not through p: the plain
-            // inversion keeps the guess there (see "Not supported yet").
+            // branch) fix their velocities through the dynamics, not through p.
+            let forms = HiddenConstraints::forms(system, q);
+            let (reached, unreached) = hidden.reach(system, q);
+            if reached.ncols() + unreached.ncols() == hidden.coordinates().len() {
+                let newton = sized(newton, N + forms.nrows(), &mut spare)?;
+                let dynamic = legendre::DynamicRows {
+                    coordinates: hidden.coordinates(),
+                    reached: &reached,
+                    unreached: &unreached,
+                    rows: |v: &SVector<f64, N>| {
+                        hidden.rows_in_velocity(system, q, v, t, &self.inputs)
+                    },
+                };
+                return legendre::dynamic_velocity(system, newton, q, p, &forms, guess, &dynamic);
+            }
+        }
+        if hidden.dynamic() > 0 {
+            // With hidden constraints among the same rows, the plain inversion keeps the
+            // guess on the degenerate velocities (see "Not supported yet").
             let newton = sized(newton, N, &mut spare)?;
             return legendre::velocity(system, newton, q, p, guess).map(|v| (v, DVector::zeros(0)));
         }
@@ -326,6 +344,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         let (v, nu) = self
             .velocity_with_multipliers(
                 &mut newton,
+                state.t,
                 &state.q,
                 &state.p,
                 &state.velocity,
@@ -926,9 +945,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     /// The Legendre inversion; for a constrained model (or one with hidden constraints), the
     /// velocity the constraints allow whose momentum differs from `p` by a constraint impulse,
     /// solving `∂L/∂v(q, v) = p + Cᵀν`, `C v = 0`: `A(q) v = 0`, `dg(q) v = 0`, `dc(q) v = 0`.
+    /// Degenerate rows that are first-order equations (a resistor beside a capacitor) fix their
+    /// coordinates' velocities at `(q, t)` instead (see `legendre::dynamic_velocity`).
     fn velocity(
         &self,
         newton: &mut Newton,
+        t: f64,
         q: &SVector<f64, N>,
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
@@ -938,7 +960,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             .hidden
             .as_ref()
             .filter(|hidden| hidden.matches(system, q, guess));
-        self.velocity_with_multipliers(newton, q, p, guess, run)
+        self.velocity_with_multipliers(newton, t, q, p, guess, run)
             .map(|(v, _)| v)
     }
 

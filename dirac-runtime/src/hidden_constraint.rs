@@ -29,7 +29,10 @@
 //! constraint forms are constant (circuits).
 //!
 //! The velocity at a node satisfies their velocity form `dc(q) v = 0` besides the constraints
-//! (see [`legendre`](crate::legendre)). Hidden constraints that depend on time explicitly (a
+//! (see [`legendre`](crate::legendre)). Where the combinations contain velocities (a resistor
+//! beside a capacitor), the velocity solves them at the node instead, `Wᵀ R_D(q, v, t) = 0`,
+//! with the constraints (models with both kinds among their rows keep the velocity's guess on
+//! the degenerate coordinates). Hidden constraints that depend on time explicitly (a
 //! force on a degenerate coordinate that depends on `t`) are refused at the start.
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
@@ -152,6 +155,45 @@ impl HiddenConstraints {
         (value, scale)
     }
 
+    /// For the velocity solve of degenerate rows that contain velocities: an orthonormal basis
+    /// `P` (columns over `D`) of the combinations of those rows the constraint forces reach,
+    /// and a basis `W` of those they do not (`W ⟂ P`, together all of `R^D`).
+    pub fn reach<S: DiracSystem<N>, const N: usize>(
+        &self,
+        system: &S,
+        q: &SVector<f64, N>,
+    ) -> (DMatrix<f64>, DMatrix<f64>) {
+        let w = self.unreached(system, q);
+        (null_space(&w.transpose()), w)
+    }
+
+    /// `R_D(q, v, t)` with its Jacobian in `v`, and the size of its terms.
+    pub fn rows_in_velocity<S: DiracSystem<N>, const N: usize>(
+        &self,
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        t: f64,
+        inputs: &[f64],
+    ) -> (DVector<f64>, DMatrix<f64>, f64) {
+        let (value, by_v, _, scale) = self.rows(system, q, v, t, inputs);
+        (value, by_v, scale)
+    }
+
+    /// A basis `W` (columns over `D`) of the null space of `B = C[:, D]`: the combinations of
+    /// the degenerate rows no constraint force reaches.
+    fn unreached<S: DiracSystem<N>, const N: usize>(
+        &self,
+        system: &S,
+        q: &SVector<f64, N>,
+    ) -> DMatrix<f64> {
+        let forms = Self::forms(system, q);
+        let b = DMatrix::from_fn(forms.nrows(), self.dead.len(), |r, c| {
+            forms[(r, self.dead[c])]
+        });
+        null_space(&b)
+    }
+
     /// Number of hidden (algebraic) constraints.
     pub fn count(&self) -> usize {
         self.count
@@ -242,10 +284,7 @@ impl HiddenConstraints {
         inputs: &[f64],
     ) -> (DMatrix<f64>, DMatrix<f64>, bool) {
         let forms = Self::forms(system, q);
-        let b = DMatrix::from_fn(forms.nrows(), self.dead.len(), |r, c| {
-            forms[(r, self.dead[c])]
-        });
-        let w = null_space(&b);
+        let w = self.unreached(system, q);
         let admissible = null_space(&forms);
         // A second admissible velocity: v moved by the sum of the admissible directions.
         let shift = &admissible * DVector::from_element(admissible.ncols(), 1.0);

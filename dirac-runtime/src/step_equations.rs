@@ -170,11 +170,12 @@ pub trait StepEquations<const N: usize> {
         N
     }
 
-    /// The velocity at `(q, p)`, solved from `guess` by `newton` (sized for
+    /// The velocity at `(q, p)` at time `t`, solved from `guess` by `newton` (sized for
     /// [`velocity_unknowns`](Self::velocity_unknowns)) where it is implicit.
     fn velocity(
         &self,
         newton: &mut Newton,
+        t: f64,
         q: &SVector<f64, N>,
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,

@@ -179,7 +179,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
                     .into(),
             ));
         }
-        let v0 = self.velocity_at(&q0, &legendre::momentum(self.system(), &q0, &zero), &zero)?;
+        let theta = legendre::momentum(self.system(), &q0, &zero);
+        let v0 = self.velocity_at(0.0, &q0, &theta, &zero)?;
         let p0 = legendre::momentum(self.system(), &q0, &v0);
         check_finite(self.system(), "initial momentum", &p0)?;
         self.start_from_state(State::new(0.0, q0, p0, v0))
@@ -208,7 +209,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         check_finite(self.system(), "initial position", &q0)?;
         check_finite(self.system(), "initial momentum", &p0)?;
         check_finite(self.system(), "velocity guess", &v_guess)?;
-        let v0 = self.velocity_at(&q0, &p0, &v_guess)?;
+        let v0 = self.velocity_at(0.0, &q0, &p0, &v_guess)?;
         self.start_from_state(State::new(0.0, q0, p0, v0))
     }
 
@@ -361,6 +362,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// The velocity at `(q, p)` by the globalised Legendre inversion from `guess`.
     fn velocity_at(
         &self,
+        t: f64,
         q: &SVector<f64, N>,
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
@@ -373,7 +375,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         };
         let mut newton = Newton::new(self.equations.velocity_unknowns(), options)?;
         self.equations
-            .velocity(&mut newton, q, p, guess)
+            .velocity(&mut newton, t, q, p, guess)
             .map_err(|f| self.failure(Problem::Velocity, f))
     }
 
@@ -608,7 +610,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// Hessian, seeded with the last step's velocity).
     pub fn v(&self) -> Result<SVector<f64, N>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
-        self.velocity_at(&state.q, &state.p, &state.velocity)
+        self.velocity_at(state.t, &state.q, &state.p, &state.velocity)
     }
 
     /// Energy `⟨p, v⟩ − L(q, v)` of the current state, with `v` from [`v`](Self::v); an error,
@@ -620,7 +622,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
 
     /// The energy of `state`, reached after `steps` steps (for the error message).
     fn energy_of(&self, state: &State<N>, steps: u64) -> Result<f64, DiracError> {
-        let v = self.velocity_at(&state.q, &state.p, &state.velocity)?;
+        let v = self.velocity_at(state.t, &state.q, &state.p, &state.velocity)?;
         let energy = self.equations.energy(&state.q, &state.p, &v);
         if !energy.is_finite() {
             return Err(DiracError::NonFinite {
