@@ -523,3 +523,150 @@ fn a_particle_drifting_in_a_magnetic_field() {
         );
     }
 }
+
+/// Lotka–Volterra coupled to an oscillator with kinetic energy: L = ϑ(q)·q̇ + ẋ²/2 − H with
+/// H = H_LV(q) + x²/2 + ε x q1. The rows of q1, q2 (linear in their velocities) are
+/// collocated, the row of x stays variational. Its equations: q̇1 = q1 q2 ∂H/∂q2,
+/// q̇2 = −q1 q2 ∂H/∂q1, ẍ = −x − ε q1.
+#[dirac_system(
+    coordinates(q1, q2, x),
+    lagrangian = ln(q2) / q1 * dot(q1) + 0.5 * dot(x).powi(2)
+        - (a1 * q1 + a2 * q2 + b1 * ln(q1) + b2 * ln(q2) + 0.5 * x.powi(2) + eps * x * q1),
+)]
+#[derive(Debug, Clone, Copy)]
+struct CoupledToAnOscillator {
+    a1: f64,
+    a2: f64,
+    b1: f64,
+    b2: f64,
+    eps: f64,
+}
+
+const COUPLED: CoupledToAnOscillator = CoupledToAnOscillator {
+    a1: A1,
+    a2: A2,
+    b1: B1,
+    b2: B2,
+    eps: 0.3,
+};
+
+/// The coupled model's vector field on (q1, q2, x, ẋ).
+fn coupled_field(y: &SVector<f64, 4>) -> SVector<f64, 4> {
+    let (q1, q2, x, v) = (y[0], y[1], y[2], y[3]);
+    let dh_dq1 = A1 + B1 / q1 + COUPLED.eps * x;
+    let dh_dq2 = A2 + B2 / q2;
+    vector![
+        q1 * q2 * dh_dq2,
+        -q1 * q2 * dh_dq1,
+        v,
+        -x - COUPLED.eps * q1
+    ]
+}
+
+const COUPLED_START: [f64; 4] = [2.0, 1.0, 0.5, 0.0];
+
+/// Classical Runge–Kutta at h = 1e-4 on the vector field.
+fn coupled_reference(t: f64) -> SVector<f64, 4> {
+    let steps = (t / 1e-4).round() as usize;
+    let h = t / steps as f64;
+    let mut y = SVector::<f64, 4>::from(COUPLED_START);
+    for _ in 0..steps {
+        let k1 = coupled_field(&y);
+        let k2 = coupled_field(&(y + k1 * (h / 2.0)));
+        let k3 = coupled_field(&(y + k2 * (h / 2.0)));
+        let k4 = coupled_field(&(y + k3 * h));
+        y += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0);
+    }
+    y
+}
+
+fn coupled_stepper(
+    quadrature: Quadrature,
+    h: f64,
+) -> Result<Stepper<CoupledToAnOscillator, 3>, DiracError> {
+    let start = SVector::<f64, 4>::from(COUPLED_START);
+    let field = coupled_field(&start);
+    let mut stepper = Stepper::new(COUPLED, quadrature, h)?;
+    stepper.start_from_velocity(
+        vector![start[0], start[1], start[2]],
+        vector![field[0], field[1], start[3]],
+    )?;
+    Ok(stepper)
+}
+
+/// A Lagrangian linear in some velocities and quadratic in others keeps the orders 2, 4, 6 (the
+/// plain variational step measured 2 for `galerkin(2)`), refuses the trapezoid before the first
+/// step, reports the velocity of its vector field, and restarts from its own state.
+#[test]
+fn a_lagrangian_linear_in_some_velocities() {
+    let t = 2.0;
+    let exact = coupled_reference(t);
+    for (quadrature, hs, order) in [
+        (Quadrature::midpoint(), [0.1, 0.05, 0.025, 0.0125], 2.0),
+        (Quadrature::gauss(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
+        (Quadrature::gauss(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
+    ] {
+        let errors: Vec<f64> = hs
+            .iter()
+            .map(|&h| {
+                let mut stepper = coupled_stepper(quadrature.clone(), h).unwrap();
+                for _ in 0..(t / h).round() as usize {
+                    stepper.step().unwrap();
+                }
+                let q = stepper.q();
+                (q - vector![exact[0], exact[1], exact[2]]).amax()
+            })
+            .collect();
+        let measured = slope(&hs, &errors);
+        println!("coupled, {}: {measured:.2} {errors:?}", quadrature.name());
+        assert!(
+            (measured - order).abs() < 0.3,
+            "{}: order {measured}, {errors:?}",
+            quadrature.name()
+        );
+    }
+    let err = coupled_stepper(Quadrature::trapezoid(), 0.1).unwrap_err();
+    assert!(matches!(err, DiracError::InvalidQuadrature(_)), "{err}");
+    // The velocity: the vector field on q1, q2 at the current state.
+    let mut stepper = coupled_stepper(Quadrature::gauss(2).unwrap(), 0.05).unwrap();
+    for _ in 0..20 {
+        stepper.step().unwrap();
+    }
+    let (q, v) = (stepper.q(), stepper.v().unwrap());
+    let field = coupled_field(&vector![q[0], q[1], q[2], v[2]]);
+    assert!(
+        (v[0] - field[0]).abs() < 1e-12 && (v[1] - field[1]).abs() < 1e-12,
+        "{v:?} vs {field:?}"
+    );
+    // A restart from (q, p) continues the run.
+    let mut again = Stepper::new(COUPLED, Quadrature::gauss(2).unwrap(), 0.05).unwrap();
+    again.start_from_momentum(q, stepper.p()).unwrap();
+    for _ in 0..20 {
+        stepper.step().unwrap();
+        again.step().unwrap();
+    }
+    assert!((again.q() - stepper.q()).amax() < 1e-12);
+}
+
+/// The same coupled model with a constraint: its rows linear in the velocities would be stepped
+/// variationally, which loses order when their momenta depend on q; refused before the first
+/// step.
+#[dirac_system(
+    coordinates(q1, q2, x),
+    lagrangian = ln(q2) / q1 * dot(q1) + 0.5 * dot(x).powi(2)
+        - (q1 + q2 - ln(q1) - 2.0 * ln(q2) + 0.5 * x.powi(2)),
+    constraints(dx - dq2),
+)]
+#[derive(Debug, Clone, Copy)]
+struct ConstrainedFirstOrder;
+
+#[test]
+fn constraints_on_rows_linear_in_their_velocities_are_refused() {
+    let mut stepper = Stepper::new(ConstrainedFirstOrder, Quadrature::midpoint(), 0.05).unwrap();
+    let err = stepper
+        .start_from_velocity(vector![2.0, 1.0, 0.0], vector![-2.0, -1.0, -1.0])
+        .unwrap_err();
+    assert!(matches!(err, DiracError::Unsupported(_)), "{err}");
+    assert!(err.to_string().contains("depends on the position"), "{err}");
+    assert!(stepper.state().is_none());
+}

@@ -20,7 +20,7 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::configuration_space::{ConfigurationSpace, StepCovectors};
 use crate::constraint::{self, ConstraintPoint, StepConstraints};
-use crate::derivatives::Dual;
+use crate::derivatives::{Dual, Seed, seeded};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
 use crate::first_order;
@@ -64,9 +64,11 @@ pub struct EulerLagrange<S, const N: usize, C> {
     holonomic_scheme: HolonomicScheme,
     /// The hidden constraints of the run (found when it begins; `None` before a run).
     hidden: Option<HiddenConstraints>,
-    /// Whether the run's Lagrangian is linear in every velocity (found when it begins): the
-    /// step equations are those of [`first_order`].
-    first_order: bool,
+    /// The coordinates whose Euler–Lagrange rows are collocated at the Gauss nodes (found when
+    /// a run begins, see [`first_order`]): every coordinate of a Lagrangian linear in every
+    /// velocity, the coordinates without kinetic energy of an unconstrained Lagrangian linear
+    /// in some velocities and quadratic in others, none otherwise.
+    collocated: Vec<usize>,
     first_order_scheme: FirstOrderScheme,
     layout: Layout,
     /// Current values of the system's inputs.
@@ -142,7 +144,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
             point,
             holonomic_scheme: HolonomicScheme::default(),
             hidden: None,
-            first_order: false,
+            collocated: Vec::new(),
             first_order_scheme: FirstOrderScheme::default(),
             layout: Layout::new(N, s, S::ONE_FORMS, S::HOLONOMIC),
             inputs: vec![0.0; S::INPUTS],
@@ -197,7 +199,29 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     /// Whether the run's steps are projected onto `p = ϑ(q)` by the multipliers at the end of
     /// the unknowns.
     fn projected(&self) -> bool {
-        self.first_order && self.first_order_scheme == FirstOrderScheme::SymmetricProjection
+        self.first_order() && self.first_order_scheme == FirstOrderScheme::SymmetricProjection
+    }
+
+    /// Whether the run's Lagrangian is linear in every velocity.
+    fn first_order(&self) -> bool {
+        N > 0 && self.collocated.len() == N
+    }
+
+    /// The coordinates whose rows a run from `(q, v)` collocates (see `collocated`), given the
+    /// degenerate coordinates `hidden` found there.
+    fn collocated_rows(
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        hidden: &HiddenConstraints,
+    ) -> Vec<usize> {
+        if first_order::is_first_order(system, q, v) {
+            (0..N).collect()
+        } else if !Self::constrained() && hidden.count() == 0 {
+            hidden.coordinates().to_vec()
+        } else {
+            Vec::new()
+        }
     }
 
     /// Current input values.
@@ -381,7 +405,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<StepHessians<N>, DiracError> {
-        if Self::constrained() || !C::TRANSLATION || self.first_order || self.hidden().count() > 0 {
+        if Self::constrained()
+            || !C::TRANSLATION
+            || !self.collocated.is_empty()
+            || self.hidden().count() > 0
+        {
             return Err(DiracError::Unsupported(
                 "second derivatives of the step map of a model with constraints (hidden ones \
                  included), linear in the velocities, or on a space other than Rⁿ"
@@ -474,7 +502,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<Sensitivity<N>, DiracError> {
-        if !C::TRANSLATION || self.first_order || (Self::constrained() && self.layout.points() > 1)
+        if !C::TRANSLATION
+            || !self.collocated.is_empty()
+            || (Self::constrained() && self.layout.points() > 1)
         {
             return Err(DiracError::Unsupported(
                 "derivatives of the step map on a configuration space other than Rⁿ, of a \
@@ -665,11 +695,31 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         }
         initial_state::check(system, state.t, q, v, &self.inputs, tolerance)
             .map_err(DiracError::InconsistentInitialState)?;
-        if first_order::is_first_order(system, q, v) {
+        let hidden = HiddenConstraints::find(system, q, v, state.t, &self.inputs);
+        let collocated = Self::collocated_rows(system, q, v, &hidden);
+        if Self::constrained() && hidden.dynamic() > 0 {
+            // First-order rows with constraints are stepped variationally; that keeps the
+            // orders where their momenta ϑ_d do not depend on q (a resistor beside a
+            // capacitor), and loses them otherwise (as it does without constraints).
+            let turning = seeded(system, q, v, Seed::POSITION, Seed::VELOCITY).mixed;
+            if let Some(&d) = hidden
+                .coordinates()
+                .iter()
+                .find(|&&d| turning.column(d).iter().any(|x| *x != 0.0))
+            {
+                return Err(DiracError::Unsupported(format!(
+                    "constraints on a Lagrangian linear in the velocity of {} with a momentum \
+                     ∂L/∂v that depends on the position (its rows would be stepped \
+                     variationally, which loses order)",
+                    system.coordinate_name(d)
+                )));
+            }
+        }
+        if !collocated.is_empty() {
             if S::FORCES || !C::TRANSLATION {
                 return Err(DiracError::Unsupported(
-                    "a Lagrangian linear in the velocities with forces, or on a configuration \
-                     space other than Rⁿ"
+                    "a Lagrangian linear in some or all velocities (without constraints) with \
+                     forces, or on a configuration space other than Rⁿ"
                         .into(),
                 ));
             }
@@ -677,17 +727,25 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 return Err(DiracError::InvalidQuadrature(why));
             }
             let theta = legendre::momentum(system, q, v);
-            if (p - theta).amax() > tolerance * theta.amax().max(p.amax()) {
+            let size = theta.amax().max(p.amax());
+            if collocated
+                .iter()
+                .any(|&d| (p[d] - theta[d]).abs() > tolerance * size)
+            {
+                let names: Vec<String> = collocated
+                    .iter()
+                    .map(|&d| system.coordinate_name(d))
+                    .collect();
                 return Err(DiracError::InconsistentInitialState(format!(
-                    "the Lagrangian is linear in the velocities, so its momentum is \
-                     ϑ(q) = ∂L/∂v = {:?}, not {:?} (start from the position alone with \
-                     Stepper::start_from_position)",
-                    theta.as_slice(),
-                    p.as_slice()
+                    "the Lagrangian is linear in the velocities of {}, so their momenta are \
+                     ϑ(q) = ∂L/∂v = {:?}, not {:?} (start a Lagrangian linear in every velocity \
+                     from its position alone with Stepper::start_from_position)",
+                    names.join(", "),
+                    collocated.iter().map(|&d| theta[d]).collect::<Vec<_>>(),
+                    collocated.iter().map(|&d| p[d]).collect::<Vec<_>>(),
                 )));
             }
         }
-        let hidden = HiddenConstraints::find(system, q, v, state.t, &self.inputs);
         if hidden.count() > 0 {
             if !C::TRANSLATION {
                 return Err(DiracError::Unsupported(format!(
@@ -732,17 +790,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
 
     /// Finds the hidden constraints of the coordinates without kinetic energy at the start.
     fn begin(&mut self, state: &State<N>) {
-        self.first_order =
-            first_order::is_first_order(self.discrete.system(), &state.q, &state.velocity);
+        let system = self.discrete.system();
+        let hidden =
+            HiddenConstraints::find(system, &state.q, &state.velocity, state.t, &self.inputs);
+        self.collocated = Self::collocated_rows(system, &state.q, &state.velocity, &hidden);
+        self.hidden = Some(hidden);
         let projection = if self.projected() { N } else { 0 };
         self.layout = self.layout.with_projection(projection);
-        self.hidden = Some(HiddenConstraints::find(
-            self.discrete.system(),
-            &state.q,
-            &state.velocity,
-            state.t,
-            &self.inputs,
-        ));
     }
 
     /// The last step's solution (constant chart velocity, the same multipliers), or the path
@@ -801,11 +855,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 jacobian,
             );
         }
-        if self.first_order {
+        if self.first_order() {
             return first_order::collocation(
                 discrete,
                 &state.q,
                 &self.increments,
+                &self.collocated,
                 residual,
                 jacobian,
             );
@@ -817,6 +872,19 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             residual,
             jacobian,
         );
+        if !self.collocated.is_empty() {
+            // A mixed Lagrangian: the rows of the coordinates linear in their velocities are
+            // collocated, the others stay variational.
+            let size = first_order::collocation(
+                discrete,
+                &state.q,
+                &self.increments,
+                &self.collocated,
+                residual,
+                jacobian,
+            );
+            scale = scale.max(size);
+        }
         if S::FORCES {
             let (forces, size) = discrete.add_forces(
                 &state.q,
@@ -878,10 +946,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                     "step {step} reaches a point where the retraction's tangent map is singular"
                 ))
             })?;
-        if self.first_order {
-            // The primary constraint p = ϑ(q).
-            next.p = legendre::momentum(system, &next.q, &next.velocity);
-            next.p_carry = SVector::zeros();
+        if !self.collocated.is_empty() {
+            // The primary constraint p = ϑ(q) on the collocated coordinates.
+            let theta = legendre::momentum(system, &next.q, &next.velocity);
+            for &d in &self.collocated {
+                next.p[d] = theta[d];
+                next.p_carry[d] = 0.0;
+            }
         }
         check_finite(system, "new position", &next.q)?;
         check_finite(system, "new momentum", &next.p)?;

@@ -58,6 +58,14 @@
 //!   it at the two Gauss nodes.
 //! - The plain two-step method, with the parasitic root described above.
 //!
+//! A Lagrangian linear in some velocities and quadratic in others (`ϑ(q)·ẏ + T(q, ẋ) − H(q)`,
+//! guiding-centre motion with a parallel velocity), without constraints, mixes the two kinds of
+//! rows. The rows of the coordinates without kinetic energy (`∂²L/∂v∂v_d = 0`, so `∂L/∂v_d` is
+//! a function of `q` alone) are collocated as above and their momenta kept on `ϑ_d(q)`; the
+//! other rows stay those of the variational Galerkin step. With every row a Gauss method's, the
+//! orders are `2s` (measured 2.00, 4.00, 5.89 on Lotka–Volterra coupled to an oscillator; the
+//! plain variational step measured 2 for `galerkin(2)`, and the trapezoid did not converge).
+//!
 //! Gauss–Lobatto rules (the trapezoid among them) have one node more than the path has free
 //! points, so collocating there is overdetermined, and Gauss rules with more nodes than the
 //! path's degree would collocate at some of their nodes only (a θ-method of order 1 for
@@ -104,17 +112,20 @@ pub(crate) fn refusal(quadrature: &Quadrature) -> Option<String> {
     }
 }
 
-/// Writes `ρ(Q(c_i), Q̇(c_i))` for the Gauss nodes `i = 1..s` into the row
-/// blocks and its exact Jacobian in `ξ_1..ξ_s` into `jacobian` (zeroed by the caller); returns
-/// the size of the terms of `ρ`.
+/// Writes `ρ_r(Q(c_i), Q̇(c_i))` for the Gauss nodes `i = 1..s` and the coordinates `r` in
+/// `rows` into row `r` of block `i` (all of them for a Lagrangian linear in every velocity; the
+/// coordinates without kinetic energy of a mixed one, whose other rows are the variational
+/// step's), and overwrites those rows of `jacobian` with their exact derivatives in `ξ_1..ξ_s`;
+/// returns the size of the terms of `ρ`.
 ///
-/// `∂ρ/∂q̇ = ∂²L/∂q∂v − (∂²L/∂q∂v)ᵀ`; `∂ρ_i/∂q_m = ∂²L/∂q_i∂q_m − Σ_j ∂³L/∂q_m∂q_j∂v_i q̇_j`,
-/// whose last term is `(∇²ϑ_i q̇)_m` with `∇²ϑ_i = ∂²L/∂q²(q, e_i) − ∂²L/∂q²(q, 0)` (`L` is
-/// linear in `v`).
+/// `∂ρ/∂q̇ = ∂²L/∂q∂v − (∂²L/∂q∂v)ᵀ`; `∂ρ_r/∂q_m = ∂²L/∂q_r∂q_m − Σ_j ∂³L/∂q_m∂q_j∂v_r q̇_j`,
+/// whose last term is `(∇²ϑ_r q̇)_m` with `∇²ϑ_r = ∂²L/∂q²(q, e_r) − ∂²L/∂q²(q, 0)` (`L` is
+/// linear in `v_r`, and `∂²L/∂v∂v_r = 0`).
 pub(crate) fn collocation<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
     discrete: &DiscreteLagrangian<S, N, C>,
     base: &SVector<f64, N>,
     increments: &[SVector<f64, N>],
+    rows: &[usize],
     residual: &mut DVector<f64>,
     jacobian: &mut DMatrix<f64>,
 ) -> f64 {
@@ -127,10 +138,6 @@ pub(crate) fn collocation<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: 
         let qv = seeded(system, &q, &v, Seed::POSITION, Seed::VELOCITY);
         let qq = seeded(system, &q, &v, Seed::POSITION, Seed::POSITION).mixed;
         let transport = qv.mixed.transpose() * v;
-        residual
-            .rows_mut(i * N, N)
-            .copy_from(&(qv.first - transport));
-        scale = scale.max(qv.first.amax()).max(transport.amax());
         let flat = seeded(
             system,
             &q,
@@ -139,21 +146,19 @@ pub(crate) fn collocation<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: 
             Seed::POSITION,
         )
         .mixed;
-        let mut by_q = qq;
-        for r in 0..N {
+        let by_v = qv.mixed - qv.mixed.transpose();
+        for &r in rows {
+            residual[i * N + r] = qv.first[r] - transport[r];
+            scale = scale.max(qv.first[r].abs()).max(transport[r].abs());
             let unit = SVector::<f64, N>::from_fn(|k, _| if k == r { 1.0 } else { 0.0 });
             let hessian = seeded(system, &q, &unit, Seed::POSITION, Seed::POSITION).mixed - flat;
-            let row = hessian * v;
-            for m in 0..N {
-                by_q[(r, m)] -= row[m];
+            let by_q = qq.row(r) - (hessian * v).transpose();
+            for k in 1..=s {
+                let entries = by_q * quad.ell(i, k) + by_v.row(r) * (quad.ell_prime(i, k) / h);
+                jacobian
+                    .view_mut((i * N + r, (k - 1) * N), (1, N))
+                    .copy_from(&entries);
             }
-        }
-        let by_v = qv.mixed - qv.mixed.transpose();
-        for k in 1..=s {
-            let block = by_q * quad.ell(i, k) + by_v * (quad.ell_prime(i, k) / h);
-            jacobian
-                .fixed_view_mut::<N, N>(i * N, (k - 1) * N)
-                .copy_from(&block);
         }
     }
     scale
