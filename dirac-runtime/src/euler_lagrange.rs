@@ -715,6 +715,21 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 )));
             }
         }
+        if collocated.is_empty()
+            && hidden.dynamic() > 0
+            && first_order::refusal(self.discrete.quadrature()).is_some()
+        {
+            let quadrature = self.discrete.quadrature();
+            return Err(DiracError::InvalidQuadrature(format!(
+                "{}: the rows of {} are first-order equations (coordinates without kinetic \
+                 energy whose rows contain velocities), and a rule whose nodes are not the \
+                 path's Gauss points follows a parasitic mode of them (a resistor beside a \
+                 capacitor: under the trapezoid the error grows as e^(2t); with two Gauss nodes \
+                 on a straight path, order 1); use a Gauss rule (midpoint, galerkin(s))",
+                quadrature.name(),
+                hidden.names(system)
+            )));
+        }
         if !collocated.is_empty() {
             if S::FORCES || !C::TRANSLATION {
                 return Err(DiracError::Unsupported(
