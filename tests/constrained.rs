@@ -496,6 +496,78 @@ fn a_resistor_parallel_to_a_capacitor_keeps_its_orders() {
     }
 }
 
+/// A Maxwell element without constraints: a mass on a spring whose other end y has no mass and
+/// is held by a damper, L = ẋ²/2 − k (x − y)²/2 with F_y = −c ẏ. The row of y is a first-order
+/// equation with a constant momentum (0); the variational step keeps the orders, and the
+/// trapezoid is refused.
+#[dirac_system(
+    coordinates(x, y),
+    lagrangian = 0.5 * dot(x).powi(2) - 0.5 * k * (x - y).powi(2),
+    forces(-c * dot(y) * dy),
+)]
+#[derive(Debug, Clone, Copy)]
+struct Maxwell {
+    k: f64,
+    c: f64,
+}
+
+const MAXWELL: Maxwell = Maxwell { k: 4.0, c: 2.0 };
+
+/// (x, ẋ, y) by classical Runge–Kutta at h = 1e-4: ẍ = −k (x − y), ẏ = k (x − y) / c.
+fn maxwell_at(t: f64) -> SVector<f64, 3> {
+    let field = |s: &SVector<f64, 3>| {
+        let stretch = MAXWELL.k * (s[0] - s[2]);
+        vector![s[1], -stretch, stretch / MAXWELL.c]
+    };
+    let steps = (t / 1e-4).round() as usize;
+    let h = t / steps as f64;
+    let mut s = vector![1.0, 0.0, 0.0];
+    for _ in 0..steps {
+        let k1 = field(&s);
+        let k2 = field(&(s + k1 * (h / 2.0)));
+        let k3 = field(&(s + k2 * (h / 2.0)));
+        let k4 = field(&(s + k3 * h));
+        s += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0);
+    }
+    s
+}
+
+#[test]
+fn a_maxwell_element_keeps_its_orders() {
+    // y's velocity at the start: k (x − y) / c = 2.
+    let start = |quadrature: Quadrature, h: f64| {
+        let mut stepper = Stepper::new(MAXWELL, quadrature, h)?;
+        stepper.start_from_velocity(vector![1.0, 0.0], vector![0.0, 2.0])?;
+        Ok::<_, DiracError>(stepper)
+    };
+    let err = start(Quadrature::trapezoid(), 0.05).unwrap_err();
+    assert!(matches!(err, DiracError::InvalidQuadrature(_)), "{err}");
+    let t = 2.0;
+    let exact = maxwell_at(t);
+    for (quadrature, hs, order) in [
+        (Quadrature::midpoint(), [0.1, 0.05, 0.025], 2.0),
+        (Quadrature::gauss(2).unwrap(), [0.2, 0.1, 0.05], 4.0),
+    ] {
+        let errors: Vec<f64> = hs
+            .iter()
+            .map(|&h| {
+                let mut stepper = start(quadrature.clone(), h).unwrap();
+                for _ in 0..(t / h).round() as usize {
+                    stepper.step().unwrap();
+                }
+                (stepper.q() - vector![exact[0], exact[2]]).amax()
+            })
+            .collect();
+        let measured = slope(&hs, &errors);
+        println!("Maxwell, {}: {measured:.2} {errors:?}", quadrature.name());
+        assert!(
+            (measured - order).abs() < 0.3,
+            "{}: {measured} {errors:?}",
+            quadrature.name()
+        );
+    }
+}
+
 /// The holonomic check is relative to the terms of g: g = x y − 1 at (1e-5, 6e5) is 5, far from
 /// 0 relative to its terms (12), though small next to |dg| |q| (3.6e11).
 #[dirac_system(

@@ -199,7 +199,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     /// Whether the run's steps are projected onto `p = ϑ(q)` by the multipliers at the end of
     /// the unknowns.
     fn projected(&self) -> bool {
-        self.first_order() && self.first_order_scheme == FirstOrderScheme::SymmetricProjection
+        self.layout.len() > self.layout.projection()
     }
 
     /// Whether the run's Lagrangian is linear in every velocity.
@@ -217,11 +217,41 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     ) -> Vec<usize> {
         if first_order::is_first_order(system, q, v) {
             (0..N).collect()
-        } else if !Self::constrained() && hidden.count() == 0 {
+        } else if !Self::constrained()
+            && hidden.count() == 0
+            && hidden.dynamic() > 0
+            && Self::turning(system, q, v, hidden.coordinates()).is_some()
+        {
             hidden.coordinates().to_vec()
         } else {
+            // Where every degenerate momentum ϑ_d is constant, the variational step's rows of
+            // those coordinates already are a Gauss method's (their ℓ' terms telescope).
             Vec::new()
         }
+    }
+
+    /// A coordinate among `coordinates` (without kinetic energy) whose momentum `ϑ_d = ∂L/∂v_d`
+    /// depends on the position, probed at `(q, v)` and at a point moved off `q` by uneven
+    /// amounts (a dependence can vanish at one point).
+    fn turning(
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        coordinates: &[usize],
+    ) -> Option<usize> {
+        let moved = SVector::<f64, N>::from_fn(|i, _| {
+            q[i] + 0.0137 * (1.0 + 0.1 * i as f64) * (1.0 + q[i].abs())
+        });
+        [*q, moved].iter().find_map(|point| {
+            let turning = seeded(system, point, v, Seed::POSITION, Seed::VELOCITY).mixed;
+            if !turning.iter().all(|x| x.is_finite()) {
+                return None;
+            }
+            coordinates
+                .iter()
+                .copied()
+                .find(|&d| turning.column(d).iter().any(|x| *x != 0.0))
+        })
     }
 
     /// Current input values.
@@ -358,7 +388,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     /// RATTLE's momentum projection at the end of a step: `p ← p + Σ_b ν_b dg_b(q)` with `ν`
     /// from the constrained Legendre transform at `(q, p)`, so that the velocity of the new
     /// momentum is tangent to the holonomic constraints (and allowed by the other constraints).
-    fn project_momentum(&self, state: &mut State<N>, step: u64) -> Result<(), DiracError> {
+    fn project_momentum(&self, state: &mut State<N>, t: f64, step: u64) -> Result<(), DiracError> {
         let options = crate::newton::NewtonOptions {
             line_search: true,
             max_contraction: f64::INFINITY,
@@ -368,7 +398,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         let (v, nu) = self
             .velocity_with_multipliers(
                 &mut newton,
-                state.t,
+                t,
                 &state.q,
                 &state.p,
                 &state.velocity,
@@ -384,7 +414,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         let system = self.discrete.system();
         for b in 0..S::HOLONOMIC {
             let form = constraint::holonomic(system, &state.q, b).1;
-            state.p += form * nu[S::ONE_FORMS + b];
+            let nu = nu
+                .get(S::ONE_FORMS + b)
+                .ok_or_else(|| DiracError::Projection {
+                    step,
+                    why: "the velocity solve gave no multipliers of the holonomic constraints"
+                        .into(),
+                })?;
+            state.p += form * *nu;
         }
         state.velocity = v;
         Ok(())
@@ -697,21 +734,27 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             .map_err(DiracError::InconsistentInitialState)?;
         let hidden = HiddenConstraints::find(system, q, v, state.t, &self.inputs);
         let collocated = Self::collocated_rows(system, q, v, &hidden);
-        if Self::constrained() && hidden.dynamic() > 0 {
-            // First-order rows with constraints are stepped variationally; that keeps the
-            // orders where their momenta ϑ_d do not depend on q (a resistor beside a
-            // capacitor), and loses them otherwise (as it does without constraints).
-            let turning = seeded(system, q, v, Seed::POSITION, Seed::VELOCITY).mixed;
-            if let Some(&d) = hidden
-                .coordinates()
-                .iter()
-                .find(|&&d| turning.column(d).iter().any(|x| *x != 0.0))
+        if collocated.is_empty() && hidden.dynamic() > 0 {
+            // First-order rows that are not collocated (with constraints or hidden constraints)
+            // are stepped variationally; that keeps the orders where their momenta ϑ_d do not
+            // depend on q (a resistor beside a capacitor), and loses them otherwise.
+            if let Some(d) = Self::turning(system, q, v, hidden.coordinates()) {
+                return Err(DiracError::Unsupported(format!(
+                    "constraints or hidden constraints on a Lagrangian linear in the velocity \
+                     of {} with a momentum ∂L/∂v that depends on the position (its rows would \
+                     be stepped variationally, which loses order)",
+                    system.coordinate_name(d)
+                )));
+            }
+            if hidden.count() > 0
+                && S::HOLONOMIC > 0
+                && self.holonomic_scheme == HolonomicScheme::Rattle
             {
                 return Err(DiracError::Unsupported(format!(
-                    "constraints on a Lagrangian linear in the velocity of {} with a momentum \
-                     ∂L/∂v that depends on the position (its rows would be stepped \
-                     variationally, which loses order)",
-                    system.coordinate_name(d)
+                    "RATTLE's momentum projection on a model whose coordinates without kinetic \
+                     energy ({}) have both hidden constraints and first-order rows (their \
+                     velocity is not solved for; use SHAKE)",
+                    hidden.names(system)
                 )));
             }
         }
@@ -810,8 +853,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             HiddenConstraints::find(system, &state.q, &state.velocity, state.t, &self.inputs);
         self.collocated = Self::collocated_rows(system, &state.q, &state.velocity, &hidden);
         self.hidden = Some(hidden);
-        let projection = if self.projected() { N } else { 0 };
-        self.layout = self.layout.with_projection(projection);
+        // The scheme is taken up here, at the start of a run: the unknowns follow it.
+        let projected =
+            self.first_order() && self.first_order_scheme == FirstOrderScheme::SymmetricProjection;
+        self.layout = self.layout.with_projection(if projected { N } else { 0 });
     }
 
     /// The last step's solution (constant chart velocity, the same multipliers), or the path
@@ -819,8 +864,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>) {
         let space = self.discrete.space();
         match previous {
-            Some(previous) => x.copy_from(previous),
-            None => {
+            Some(previous) if previous.len() == x.len() => x.copy_from(previous),
+            _ => {
                 x.fill(0.0);
                 let (s, h) = (self.layout.points(), self.discrete.h());
                 let xi_dot = space
@@ -979,7 +1024,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 .map_err(|why| DiracError::Projection { step, why })?;
         }
         if S::HOLONOMIC > 0 && self.holonomic_scheme == HolonomicScheme::Rattle {
-            self.project_momentum(&mut next, step)?;
+            self.project_momentum(&mut next, state.t + self.discrete.h(), step)?;
         }
         // The quadrature may never evaluate L at q_{k+1} (the midpoint rule does not): a step
         // that leaves the Lagrangian's domain is refused here, not found later as NaN energies.

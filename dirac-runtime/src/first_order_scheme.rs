@@ -1,6 +1,7 @@
 //! Which step a Lagrangian linear in the velocities, `L = ϑ(q)·v − H(q)`, is advanced by.
 
-/// Which step a Lagrangian linear in the velocities, `L = ϑ(q)·v − H(q)`, is advanced by. Both
+/// Which step a Lagrangian linear in every velocity, `L = ϑ(q)·v − H(q)`, is advanced by (one
+/// linear in some velocities only is always collocated on the rows of those). Both
 /// keep the momentum on the primary constraint `p = ϑ(q)` at every step and reach order `2s`
 /// with `galerkin(s)` (Gauss rules only); they differ in what they do over long times and in
 /// how they depend on the gauge of `ϑ` (the mathematics and the figures are in the

@@ -84,6 +84,8 @@ pub struct Stepper<S, const N: usize, E = EulerLagrange<S, N, Euclidean>> {
     state: Option<State<N>>,
     /// Time of the initial state.
     start: f64,
+    /// The initial state, which the equations examined when the run began.
+    origin: Option<State<N>>,
     steps: u64,
     /// Newton unknowns (the iterate), laid out by the equations.
     unknowns: DVector<f64>,
@@ -338,6 +340,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             newton,
             state: None,
             start: 0.0,
+            origin: None,
             steps: 0,
             unknowns: DVector::zeros(unknowns),
             previous: None,
@@ -406,8 +409,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             let steps = std::mem::replace(&mut self.steps, 0);
             let error = self.failure(Problem::Step, failure);
             self.steps = steps;
-            if let Some(current) = self.state {
-                self.begin(&current)?;
+            // The equations examine the running start again: they find what they found then.
+            if let Some(origin) = self.origin {
+                self.begin(&origin)?;
             }
             return Err(error);
         }
@@ -431,6 +435,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         self.violation = 0.0;
         self.multipliers.fill(0.0);
         self.start = state.t;
+        self.origin = Some(state);
         self.state = Some(state);
         self.steps = 0;
         self.previous = None;
