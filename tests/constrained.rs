@@ -244,6 +244,19 @@ fn every_constrained_scene_restarts_from_its_own_state() {
         50,
         100,
     );
+
+    let disk = |h| rolling_disk::stepper(Quadrature::midpoint(), h).unwrap();
+    check_restart("rolling disk", disk, 0.05, rolling_disk::exact, 50, 100);
+    // A constrained Galerkin step (one-forms at the Gauss nodes) restarts the same way.
+    let disk_galerkin = |h| rolling_disk::stepper(Quadrature::gauss(2).unwrap(), h).unwrap();
+    check_restart(
+        "rolling disk, galerkin(2)",
+        disk_galerkin,
+        0.1,
+        rolling_disk::exact,
+        20,
+        40,
+    );
 }
 
 /// The pendulum angle at `t` from rest at 1 rad, by `galerkin(3)` at h = 1e-3 (error < 1e-12).

@@ -192,15 +192,35 @@ pub(crate) fn gradient<const N: usize>(x: &Dual<N>) -> SVector<f64, N> {
     x.eps.unwrap_generic(Const::<N>, U1)
 }
 
-/// Coordinates with no kinetic term at `(q, v)`: rows of `∂²L/∂v²` that vanish.
+/// Coordinates with no kinetic term: rows of `∂²L/∂v²` that vanish at `(q, v)` and at a second
+/// state near it (none where neither can be evaluated).
 pub(crate) fn degenerate<S: DiracSystem<N>, const N: usize>(
     system: &S,
     q: &SVector<f64, N>,
     v: &SVector<f64, N>,
 ) -> Vec<usize> {
-    let vv = seeded(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed;
+    // Probed at (q, v) and at a point moved by uneven amounts: a kinetic term can vanish at one
+    // state (ẏ⁴ at ẏ = 0). A probe outside the Lagrangian's domain (not finite) is skipped.
+    let moved = |x: &SVector<f64, N>, shift: f64| {
+        SVector::<f64, N>::from_fn(|i, _| {
+            x[i] + shift * (1.0 + 0.1 * i as f64) * (1.0 + x[i].abs())
+        })
+    };
+    let probes = [(*q, *v), (moved(q, 0.0137), moved(v, 0.291))];
+    let hessians: Vec<_> = probes
+        .iter()
+        .map(|(q, v)| seeded(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed)
+        .filter(|vv| vv.iter().all(|x| x.is_finite()))
+        .collect();
+    if hessians.is_empty() {
+        return Vec::new();
+    }
     (0..N)
-        .filter(|&i| vv.row(i).iter().all(|x| *x == 0.0))
+        .filter(|&i| {
+            hessians
+                .iter()
+                .all(|vv| vv.row(i).iter().all(|x| *x == 0.0))
+        })
         .collect()
 }
 
@@ -220,4 +240,32 @@ pub(crate) fn force_jacobian<S: DiracSystem<N>, const N: usize>(
         f.map(|x| x.re),
         SMatrix::from_fn(|r, c| f[r].eps.unwrap_generic(Const::<N>, U1)[c]),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scalar::Scalar;
+
+    /// `L = ẋ²/2 + ẏ⁴/4 − z²/2`: y has kinetic energy though `∂²L/∂ẏ² = 3ẏ²` vanishes at ẏ = 0;
+    /// z has none anywhere.
+    struct Quartic;
+    impl DiracSystem<3> for Quartic {
+        fn lagrangian<D: Scalar>(&self, q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+            v[0] * v[0] * 0.5 + v[1].powi(4) * 0.25 - q[2] * q[2] * 0.5
+        }
+    }
+
+    #[test]
+    fn a_kinetic_term_that_vanishes_at_the_start_is_not_degenerate() {
+        let q = SVector::<f64, 3>::from([0.0, 1.0, 0.5]);
+        assert_eq!(
+            degenerate(&Quartic, &q, &SVector::<f64, 3>::from([1.0, 0.0, 0.0])),
+            vec![2]
+        );
+        assert_eq!(
+            degenerate(&Quartic, &q, &SVector::<f64, 3>::from([1.0, 2.0, 0.0])),
+            vec![2]
+        );
+    }
 }
