@@ -185,8 +185,29 @@ fn step_derivatives(c: &mut Criterion) {
     group.finish();
 }
 
+/// Recording a run against bare steps: 100 midpoint steps of the double pendulum (h = 0.01) by
+/// `step()` in a loop, and by `run(100)`, which also solves every sample's velocity for its
+/// energy and stores the sample.
+fn recording(c: &mut Criterion) {
+    let mut group = c.benchmark_group("double_pendulum_100_steps");
+    let mut bare = double_pendulum::stepper(Quadrature::midpoint(), 0.01).expect("valid scene");
+    group.bench_function("step_loop", |b| {
+        b.iter(|| {
+            for _ in 0..100 {
+                black_box(bare.step()).expect("step");
+            }
+        })
+    });
+    let mut recorded = double_pendulum::stepper(Quadrature::midpoint(), 0.01).expect("valid scene");
+    group.bench_function("run", |b| {
+        b.iter(|| black_box(recorded.run(100)).expect("run"))
+    });
+    group.finish();
+}
+
 criterion_group!(
     benches,
+    recording,
     generated_vs_hand,
     quadratures,
     chain_growth,

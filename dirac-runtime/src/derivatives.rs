@@ -192,6 +192,19 @@ pub(crate) fn gradient<const N: usize>(x: &Dual<N>) -> SVector<f64, N> {
     x.eps.unwrap_generic(Const::<N>, U1)
 }
 
+/// Coordinates whose rows of `∂²L/∂v²` vanish at `(q, v)` (one probe: enough to check that a
+/// known classification holds at a state; [`degenerate`] classifies).
+pub(crate) fn degenerate_at<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+) -> Vec<usize> {
+    let vv = seeded(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed;
+    (0..N)
+        .filter(|&i| vv.row(i).iter().all(|x| *x == 0.0))
+        .collect()
+}
+
 /// Coordinates with no kinetic term: rows of `∂²L/∂v²` that vanish at `(q, v)` and at a second
 /// state near it (none where neither can be evaluated).
 pub(crate) fn degenerate<S: DiracSystem<N>, const N: usize>(

@@ -339,10 +339,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         run: Option<&HiddenConstraints>,
     ) -> Result<(SVector<f64, N>, DVector<f64>), NewtonFailure> {
         let system = self.discrete.system();
-        if first_order::is_first_order(system, q, guess) {
-            return legendre::first_order_velocity(system, newton, q, guess)
-                .map(|v| (v, DVector::zeros(0)));
-        }
         let found;
         let hidden = match run {
             Some(hidden) => hidden,
@@ -351,6 +347,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
                 &found
             }
         };
+        if N > 0 && !Self::constrained() && hidden.coordinates().len() == N {
+            // Linear in every velocity: the first-order equations fix the velocity.
+            return legendre::first_order_velocity(system, newton, q, guess)
+                .map(|v| (v, DVector::zeros(0)));
+        }
+        let dead = hidden.coordinates();
         let mut spare = None;
         if hidden.dynamic() > 0 && hidden.count() == 0 {
             // Degenerate rows that are first-order equations (a resistor on a capacitor's
@@ -374,14 +376,15 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
             // With hidden constraints among the same rows, the plain inversion keeps the
             // guess on the degenerate velocities (see "Not supported yet").
             let newton = sized(newton, N, &mut spare)?;
-            return legendre::velocity(system, newton, q, p, guess).map(|v| (v, DVector::zeros(0)));
+            return legendre::velocity(system, newton, q, p, guess, dead)
+                .map(|v| (v, DVector::zeros(0)));
         }
         let forms = self.velocity_forms(q, guess, hidden);
         let newton = sized(newton, N + forms.nrows(), &mut spare)?;
         if forms.nrows() > 0 {
             legendre::constrained_velocity(system, newton, q, p, &forms, guess)
         } else {
-            legendre::velocity(system, newton, q, p, guess).map(|v| (v, DVector::zeros(0)))
+            legendre::velocity(system, newton, q, p, guess, dead).map(|v| (v, DVector::zeros(0)))
         }
     }
 

@@ -38,7 +38,7 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::constraint;
-use crate::derivatives::{Seed, degenerate, force_jacobian, seeded};
+use crate::derivatives::{Seed, degenerate, degenerate_at, force_jacobian, seeded};
 use crate::system::DiracSystem;
 
 /// The degenerate coordinates of a model and the number of its hidden constraints, found at the
@@ -120,7 +120,7 @@ impl HiddenConstraints {
         q: &SVector<f64, N>,
         v: &SVector<f64, N>,
     ) -> bool {
-        degenerate(system, q, v) == self.dead
+        degenerate_at(system, q, v) == self.dead
     }
 
     /// The degenerate coordinates at `(q, v)`, their combinations not examined (`count` 0):

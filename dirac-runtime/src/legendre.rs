@@ -2,7 +2,7 @@
 
 use nalgebra::{DMatrix, DVector, SVector};
 
-use crate::derivatives::{Seed, degenerate, seeded};
+use crate::derivatives::{Seed, seeded};
 use crate::newton::{Newton, NewtonFailure};
 use crate::system::DiracSystem;
 
@@ -52,23 +52,23 @@ pub fn energy<S: DiracSystem<N>, const N: usize>(
 /// Inverts the Legendre transform: solves `∂L/∂v (q, v) = p` for `v` by Newton's method from
 /// `guess`, with the exact Hessian `∂²L/∂v²`. `newton` must be sized for `N` unknowns.
 ///
-/// Velocities without kinetic energy (rows of `∂²L/∂v²` that vanish at the guess) are not
-/// determined by `p`; they keep their guess, and the energy does not depend on them.
+/// Velocities without kinetic energy (`dead`, the coordinates whose rows of `∂²L/∂v²` vanish)
+/// are not determined by `p`; they keep their guess, and the energy does not depend on them.
 pub(crate) fn velocity<S: DiracSystem<N>, const N: usize>(
     system: &S,
     newton: &mut Newton,
     q: &SVector<f64, N>,
     p: &SVector<f64, N>,
     guess: &SVector<f64, N>,
+    dead: &[usize],
 ) -> Result<SVector<f64, N>, NewtonFailure> {
-    let dead = degenerate(system, q, guess);
     let mut x = DVector::from_column_slice(guess.as_slice());
     newton.solve(&mut x, |x, r, j| {
         let v = SVector::<f64, N>::from_column_slice(x.as_slice());
         let l = seeded(system, q, &v, Seed::VELOCITY, Seed::VELOCITY);
         r.copy_from(&(l.first - p));
         j.copy_from(&l.mixed);
-        for &i in &dead {
+        for &i in dead {
             r[i] = x[i] - guess[i];
             j.row_mut(i).fill(0.0);
             j[(i, i)] = 1.0;

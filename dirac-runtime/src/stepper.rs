@@ -81,6 +81,9 @@ struct Proposal<const N: usize> {
 pub struct Stepper<S, const N: usize, E = EulerLagrange<S, N, Euclidean>> {
     equations: E,
     newton: Newton,
+    /// The workspace of the velocity solves of recorded samples (reused: no allocation per
+    /// sample).
+    velocity_newton: Newton,
     state: Option<State<N>>,
     /// Time of the initial state.
     start: f64,
@@ -334,7 +337,12 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             )));
         }
         let newton = Newton::new(unknowns, NewtonOptions::default())?;
+        let velocity_newton = Newton::new(
+            equations.velocity_unknowns(),
+            velocity_options(newton.options()),
+        )?;
         Ok(Self {
+            velocity_newton,
             multipliers: vec![0.0; equations.multipliers()],
             equations,
             newton,
@@ -354,6 +362,10 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// options out of range.
     pub fn with_newton_options(mut self, options: NewtonOptions) -> Result<Self, DiracError> {
         self.newton = Newton::new(self.unknowns.len(), options)?;
+        self.velocity_newton = Newton::new(
+            self.equations.velocity_unknowns(),
+            velocity_options(self.newton.options()),
+        )?;
         Ok(self)
     }
 
@@ -370,16 +382,31 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, DiracError> {
-        let options = NewtonOptions {
-            line_search: true,
-            max_contraction: f64::INFINITY,
-            max_iterations: self.newton.options().max_iterations.max(50),
-            ..*self.newton.options()
-        };
+        let options = velocity_options(self.newton.options());
         let mut newton = Newton::new(self.equations.velocity_unknowns(), options)?;
         self.equations
             .velocity(&mut newton, t, q, p, guess)
             .map_err(|f| self.failure(Problem::Velocity, f))
+    }
+
+    /// The energy of a recorded `state`, reached after `steps` steps, with its velocity solved
+    /// from `guess` in the stepper's own workspace.
+    fn sample_energy(
+        &mut self,
+        state: &State<N>,
+        guess: &SVector<f64, N>,
+        steps: u64,
+    ) -> Result<f64, DiracError> {
+        let unknowns = self.equations.velocity_unknowns();
+        if self.velocity_newton.unknowns() != unknowns {
+            self.velocity_newton = Newton::new(unknowns, velocity_options(self.newton.options()))?;
+        }
+        let (t, q, p) = (state.t, &state.q, &state.p);
+        let solved = self
+            .equations
+            .velocity(&mut self.velocity_newton, t, q, p, guess);
+        let v = solved.map_err(|f| self.failure(Problem::Velocity, f))?;
+        self.energy_at(state, &v, steps)
     }
 
     /// Starts from `state` after the equations have checked it (see
@@ -530,12 +557,17 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             )));
         }
         let every = every.max(1);
-        let energy = self.energy_of(&state, self.steps)?;
+        let energy = self.sample_energy(&state, &state.velocity, self.steps)?;
         self.push_sample(trajectory, &state, energy)?;
         for k in 1..=steps {
+            let before = self.state.ok_or(DiracError::NotStarted)?;
             let proposal = self.solve_step()?;
             if k % every == 0 {
-                let energy = self.energy_of(&proposal.next, self.steps + 1)?;
+                // The step's velocity hint is its mean velocity, half a step behind its end:
+                // extrapolated by half the change since the last one, it is O(h²) off.
+                let hint = proposal.next.velocity;
+                let guess = hint + (hint - before.velocity) * 0.5;
+                let energy = self.sample_energy(&proposal.next, &guess, self.steps + 1)?;
                 let next = proposal.next;
                 self.accept(proposal);
                 self.push_sample(trajectory, &next, energy)?;
@@ -628,7 +660,18 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// The energy of `state`, reached after `steps` steps (for the error message).
     fn energy_of(&self, state: &State<N>, steps: u64) -> Result<f64, DiracError> {
         let v = self.velocity_at(state.t, &state.q, &state.p, &state.velocity)?;
-        let energy = self.equations.energy(&state.q, &state.p, &v);
+        self.energy_at(state, &v, steps)
+    }
+
+    /// The energy of `state` with velocity `v`, reached after `steps` steps; an error where it
+    /// is not finite.
+    fn energy_at(
+        &self,
+        state: &State<N>,
+        v: &SVector<f64, N>,
+        steps: u64,
+    ) -> Result<f64, DiracError> {
+        let energy = self.equations.energy(&state.q, &state.p, v);
         if !energy.is_finite() {
             return Err(DiracError::NonFinite {
                 what: format!("the energy after {steps} steps"),
@@ -725,5 +768,16 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                 "{problem}: {got} unknowns where the solver has {expected}"
             )),
         }
+    }
+}
+
+/// The Newton options of a velocity solve: the stepper's, globalised (line search, no contraction
+/// test, at least 50 iterations).
+fn velocity_options(options: &NewtonOptions) -> NewtonOptions {
+    NewtonOptions {
+        line_search: true,
+        max_contraction: f64::INFINITY,
+        max_iterations: options.max_iterations.max(50),
+        ..*options
     }
 }
