@@ -1098,6 +1098,20 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             .map(|(v, _)| v)
     }
 
+    /// As [`velocity`](StepEquations::velocity), with the run's degenerate coordinates and hidden
+    /// constraints as found when it began (not checked again at the state).
+    fn velocity_in_run(
+        &self,
+        newton: &mut Newton,
+        t: f64,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, NewtonFailure> {
+        self.velocity_with_multipliers(newton, t, q, p, guess, self.hidden.as_ref())
+            .map(|(v, _)| v)
+    }
+
     fn energy(&self, q: &SVector<f64, N>, _p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64 {
         legendre::energy(self.discrete.system(), q, v)
     }

@@ -170,6 +170,20 @@ pub trait StepEquations<const N: usize> {
         N
     }
 
+    /// The velocity of a state of the running run (after [`begin`](Self::begin)): the
+    /// equations may rely on what they found when it began. By default,
+    /// [`velocity`](Self::velocity).
+    fn velocity_in_run(
+        &self,
+        newton: &mut Newton,
+        t: f64,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, NewtonFailure> {
+        self.velocity(newton, t, q, p, guess)
+    }
+
     /// The velocity at `(q, p)` at time `t`, solved from `guess` by `newton` (sized for
     /// [`velocity_unknowns`](Self::velocity_unknowns)) where it is implicit.
     fn velocity(

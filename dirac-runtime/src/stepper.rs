@@ -185,7 +185,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
             ));
         }
         let theta = legendre::momentum(self.system(), &q0, &zero);
-        let v0 = self.velocity_at(0.0, &q0, &theta, &zero)?;
+        let v0 = self.velocity_at(0.0, &q0, &theta, &zero, false)?;
         let p0 = legendre::momentum(self.system(), &q0, &v0);
         check_finite(self.system(), "initial momentum", &p0)?;
         self.start_from_state(State::new(0.0, q0, p0, v0))
@@ -214,7 +214,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         check_finite(self.system(), "initial position", &q0)?;
         check_finite(self.system(), "initial momentum", &p0)?;
         check_finite(self.system(), "velocity guess", &v_guess)?;
-        let v0 = self.velocity_at(0.0, &q0, &p0, &v_guess)?;
+        let v0 = self.velocity_at(0.0, &q0, &p0, &v_guess, false)?;
         self.start_from_state(State::new(0.0, q0, p0, v0))
     }
 
@@ -374,19 +374,24 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         &self.equations
     }
 
-    /// The velocity at `(q, p)` by the globalised Legendre inversion from `guess`.
+    /// The velocity at `(q, p)` by the globalised Legendre inversion from `guess`; `in_run`
+    /// when the state is the running one (see [`StepEquations::velocity_in_run`]).
     fn velocity_at(
         &self,
         t: f64,
         q: &SVector<f64, N>,
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
+        in_run: bool,
     ) -> Result<SVector<f64, N>, DiracError> {
         let options = velocity_options(self.newton.options());
         let mut newton = Newton::new(self.equations.velocity_unknowns(), options)?;
-        self.equations
-            .velocity(&mut newton, t, q, p, guess)
-            .map_err(|f| self.failure(Problem::Velocity, f))
+        let solved = if in_run {
+            self.equations.velocity_in_run(&mut newton, t, q, p, guess)
+        } else {
+            self.equations.velocity(&mut newton, t, q, p, guess)
+        };
+        solved.map_err(|f| self.failure(Problem::Velocity, f))
     }
 
     /// The energy of a recorded `state`, reached after `steps` steps, with its velocity solved
@@ -404,7 +409,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let (t, q, p) = (state.t, &state.q, &state.p);
         let solved = self
             .equations
-            .velocity(&mut self.velocity_newton, t, q, p, guess);
+            .velocity_in_run(&mut self.velocity_newton, t, q, p, guess);
         let v = solved.map_err(|f| self.failure(Problem::Velocity, f))?;
         self.energy_at(state, &v, steps)
     }
@@ -647,7 +652,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// Hessian, seeded with the last step's velocity).
     pub fn v(&self) -> Result<SVector<f64, N>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
-        self.velocity_at(state.t, &state.q, &state.p, &state.velocity)
+        self.velocity_at(state.t, &state.q, &state.p, &state.velocity, true)
     }
 
     /// Energy `⟨p, v⟩ − L(q, v)` of the current state, with `v` from [`v`](Self::v); an error,
@@ -659,7 +664,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
 
     /// The energy of `state`, reached after `steps` steps (for the error message).
     fn energy_of(&self, state: &State<N>, steps: u64) -> Result<f64, DiracError> {
-        let v = self.velocity_at(state.t, &state.q, &state.p, &state.velocity)?;
+        let v = self.velocity_at(state.t, &state.q, &state.p, &state.velocity, true)?;
         self.energy_at(state, &v, steps)
     }
 
