@@ -361,15 +361,23 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
             let (reached, unreached) = hidden.reach(system, q);
             if reached.ncols() + unreached.ncols() == hidden.coordinates().len() {
                 let newton = sized(newton, N + forms.nrows(), &mut spare)?;
+                let rows =
+                    |v: &SVector<f64, N>| hidden.rows_in_velocity(system, q, v, t, &self.inputs);
                 let dynamic = legendre::DynamicRows {
                     coordinates: hidden.coordinates(),
                     reached: &reached,
                     unreached: &unreached,
-                    rows: |v: &SVector<f64, N>| {
-                        hidden.rows_in_velocity(system, q, v, t, &self.inputs)
-                    },
+                    rows: &rows,
                 };
-                return legendre::dynamic_velocity(system, newton, q, p, &forms, guess, &dynamic);
+                return legendre::constrained_velocity(
+                    system,
+                    newton,
+                    q,
+                    p,
+                    &forms,
+                    guess,
+                    Some(&dynamic),
+                );
             }
         }
         if hidden.dynamic() > 0 {
@@ -382,7 +390,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         let forms = self.velocity_forms(q, guess, hidden);
         let newton = sized(newton, N + forms.nrows(), &mut spare)?;
         if forms.nrows() > 0 {
-            legendre::constrained_velocity(system, newton, q, p, &forms, guess)
+            legendre::constrained_velocity(system, newton, q, p, &forms, guess, None)
         } else {
             legendre::velocity(system, newton, q, p, guess, dead).map(|v| (v, DVector::zeros(0)))
         }
@@ -1080,7 +1088,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     /// velocity the constraints allow whose momentum differs from `p` by a constraint impulse,
     /// solving `∂L/∂v(q, v) = p + Cᵀν`, `C v = 0`: `A(q) v = 0`, `dg(q) v = 0`, `dc(q) v = 0`.
     /// Degenerate rows that are first-order equations (a resistor beside a capacitor) fix their
-    /// coordinates' velocities at `(q, t)` instead (see `legendre::dynamic_velocity`).
+    /// coordinates' velocities at `(q, t)` instead (see `legendre::constrained_velocity`).
     fn velocity(
         &self,
         newton: &mut Newton,

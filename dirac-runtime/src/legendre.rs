@@ -91,6 +91,22 @@ pub(crate) fn velocity<S: DiracSystem<N>, const N: usize>(
 /// The velocities of coordinates without kinetic energy are fixed by `C v = 0`; where they are
 /// not (the matrix `[[∂²L/∂v², −Cᵀ], [C, 0]]` is singular), Newton fails. `newton` must be sized
 /// for `N + C.nrows()` unknowns.
+///
+/// Where some degenerate rows are first-order equations (`dynamic`: a resistor beside a
+/// capacitor), their velocities are fixed by those equations, not by `p` (a coordinate `d`
+/// without kinetic energy has `∂L/∂v_d = ϑ_d(q)`, whatever `v`). The momentum rows of the
+/// degenerate coordinates are then replaced by
+///
+/// ```text
+/// Pᵀ (∂L/∂v_D − p_D − (Cᵀν)_D) = 0,      Wᵀ R_D(q, v, t) = 0,
+/// ```
+///
+/// where `W` spans the combinations of the degenerate rows that no constraint force reaches
+/// (`Wᵀ C_Dᵀ = 0`, so the multipliers drop out of `Wᵀ R_D`, and these rows are the model's
+/// first-order equations at `(q, t)`) and `P` the others (whose momentum rows fix the
+/// impulses on `D`). The rows stay as many as the unknowns, and the velocity satisfies the
+/// constraints and the first-order equations at `q` exactly, so that a state started from
+/// `(q, p)` passes the start checks.
 pub(crate) fn constrained_velocity<S: DiracSystem<N>, const N: usize>(
     system: &S,
     newton: &mut Newton,
@@ -98,6 +114,7 @@ pub(crate) fn constrained_velocity<S: DiracSystem<N>, const N: usize>(
     p: &SVector<f64, N>,
     forms: &DMatrix<f64>,
     guess: &SVector<f64, N>,
+    dynamic: Option<&DynamicRows<'_, N>>,
 ) -> Result<(SVector<f64, N>, DVector<f64>), NewtonFailure> {
     let m = forms.nrows();
     let mut x = DVector::zeros(N + m);
@@ -117,6 +134,9 @@ pub(crate) fn constrained_velocity<S: DiracSystem<N>, const N: usize>(
         j.view_mut((0, 0), (N, N)).copy_from(&l.mixed);
         j.view_mut((0, N), (N, m)).copy_from(&(-forms.transpose()));
         j.view_mut((N, 0), (m, N)).copy_from(forms);
+        if let Some(dynamic) = dynamic {
+            scale = scale.max(dynamic.replace_rows(&v, r, j));
+        }
         scale.max(forms.amax() * v.amax())
     })?;
     let v = SVector::from_column_slice(&x.as_slice()[..N]);
@@ -124,98 +144,49 @@ pub(crate) fn constrained_velocity<S: DiracSystem<N>, const N: usize>(
 }
 
 /// The degenerate rows of a constrained model that contain velocities (a resistor beside a
-/// capacitor): what [`dynamic_velocity`] needs besides the model.
-pub(crate) struct DynamicRows<'a, F> {
+/// capacitor), for [`constrained_velocity`].
+pub(crate) struct DynamicRows<'a, const N: usize> {
     /// The degenerate coordinates `D`.
     pub coordinates: &'a [usize],
-    /// An orthonormal basis (columns over `D`) of the combinations of their rows that the
+    /// An orthonormal basis `P` (columns over `D`) of the combinations of their rows that the
     /// constraint forces reach.
     pub reached: &'a DMatrix<f64>,
-    /// A basis of the combinations they do not reach.
+    /// A basis `W` of the combinations they do not reach.
     pub unreached: &'a DMatrix<f64>,
     /// `v ↦ (R_D(q, v, t), ∂R_D/∂v, size of its terms)`, the rows without multipliers.
-    pub rows: F,
+    pub rows: &'a dyn Fn(&SVector<f64, N>) -> RowsInVelocity,
 }
 
-/// The velocity of a constrained model some of whose degenerate rows are first-order equations:
-/// their velocities are fixed by those equations, not by `p` (a coordinate `d` without kinetic
-/// energy has `∂L/∂v_d = ϑ_d(q)`, whatever `v`). Solves for `(v, ν)`
-///
-/// ```text
-/// ∂L/∂v_i = p_i + (Cᵀν)_i               (the coordinates with kinetic energy),
-/// Pᵀ (∂L/∂v_D − p_D − (Cᵀν)_D) = 0,      Wᵀ R_D(q, v, t) = 0,      C v = 0,
-/// ```
-///
-/// where `W` spans the combinations of the degenerate rows that no constraint force reaches
-/// (`Wᵀ C_Dᵀ = 0`, so the multipliers drop out of `Wᵀ R_D`, and these rows are the model's
-/// first-order equations at `(q, t)`) and `P` the others (whose momentum rows fix the
-/// impulses on `D`). The rows are as many as the unknowns, `N + C.nrows()`, which `newton` must
-/// be sized for. The velocity then satisfies the constraints and the first-order equations at
-/// `q` exactly, so that a state started from `(q, p)` passes the start checks.
-pub(crate) fn dynamic_velocity<S, F, const N: usize>(
-    system: &S,
-    newton: &mut Newton,
-    q: &SVector<f64, N>,
-    p: &SVector<f64, N>,
-    forms: &DMatrix<f64>,
-    guess: &SVector<f64, N>,
-    dynamic: &DynamicRows<'_, F>,
-) -> Result<(SVector<f64, N>, DVector<f64>), NewtonFailure>
-where
-    S: DiracSystem<N>,
-    F: Fn(&SVector<f64, N>) -> (DVector<f64>, DMatrix<f64>, f64),
-{
-    let m = forms.nrows();
-    let dead = dynamic.coordinates;
-    let (reached, unreached) = (dynamic.reached, dynamic.unreached);
-    let mut x = DVector::zeros(N + m);
-    x.rows_mut(0, N).copy_from(guess);
-    newton.solve(&mut x, |x, r, j| {
-        let v = SVector::<f64, N>::from_column_slice(&x.as_slice()[..N]);
-        let nu = x.rows(N, m);
-        let l = seeded(system, q, &v, Seed::VELOCITY, Seed::VELOCITY);
-        let impulse = forms.transpose() * nu;
-        let mut scale = l.first.abs().sup(&p.abs()).amax();
-        // The momentum rows, then the degenerate ones replaced by their combinations.
-        let mut momentum = DVector::zeros(N);
-        let mut by_x = DMatrix::zeros(N, N + m);
-        for i in 0..N {
-            momentum[i] = l.first[i] - p[i] - impulse[i];
-            scale = scale.max(impulse[i].abs());
-            by_x.view_mut((i, 0), (1, N)).copy_from(&l.mixed.row(i));
-            by_x.view_mut((i, N), (1, m))
-                .copy_from(&(-forms.column(i).transpose()));
-        }
-        r.rows_mut(0, N).copy_from(&momentum);
-        j.view_mut((0, 0), (N, N + m)).copy_from(&by_x);
-        let (rows, rows_by_v, size) = (dynamic.rows)(&v);
-        scale = scale.max(size);
+/// Rows, their Jacobian in `v`, and the size of their terms.
+pub(crate) type RowsInVelocity = (DVector<f64>, DMatrix<f64>, f64);
+
+impl<const N: usize> DynamicRows<'_, N> {
+    /// Replaces the momentum rows of `D` in `(r, j)` by their `P` combinations and the
+    /// first-order equations `Wᵀ R_D`; returns the size of the terms of `R_D`.
+    fn replace_rows(&self, v: &SVector<f64, N>, r: &mut DVector<f64>, j: &mut DMatrix<f64>) -> f64 {
+        let dead = self.coordinates;
         let on_dead =
-            |m: &DMatrix<f64>| DMatrix::from_fn(dead.len(), m.ncols(), |r, c| m[(dead[r], c)]);
-        let momentum_dead = on_dead(&DMatrix::from_column_slice(N, 1, momentum.as_slice()));
-        let reached_rows = reached.transpose() * momentum_dead;
-        let reached_jacobian = reached.transpose() * on_dead(&by_x);
-        let equations = unreached.transpose() * rows;
-        let equations_by_v = unreached.transpose() * rows_by_v;
+            |m: &DMatrix<f64>| DMatrix::from_fn(dead.len(), m.ncols(), |a, c| m[(dead[a], c)]);
+        let momentum = DVector::from_iterator(dead.len(), dead.iter().map(|&d| r[d]));
+        let reached_rows = self.reached.transpose() * momentum;
+        let reached_jacobian = self.reached.transpose() * on_dead(j);
+        let (rows, rows_by_v, size) = (self.rows)(v);
+        let equations = self.unreached.transpose() * rows;
+        let equations_by_v = self.unreached.transpose() * rows_by_v;
+        let reached = self.reached.ncols();
         for (k, &d) in dead.iter().enumerate() {
-            if k < reached.ncols() {
+            j.row_mut(d).fill(0.0);
+            if k < reached {
                 r[d] = reached_rows[k];
                 j.row_mut(d).copy_from(&reached_jacobian.row(k));
             } else {
-                let k = k - reached.ncols();
-                r[d] = equations[k];
-                j.row_mut(d).fill(0.0);
-                j.view_mut((d, 0), (1, N)).copy_from(&equations_by_v.row(k));
+                r[d] = equations[k - reached];
+                j.view_mut((d, 0), (1, N))
+                    .copy_from(&equations_by_v.row(k - reached));
             }
         }
-        let rate = forms * v;
-        r.rows_mut(N, m).copy_from(&rate);
-        j.view_mut((N, 0), (m, N)).copy_from(forms);
-        j.view_mut((N, N), (m, m)).fill(0.0);
-        scale.max(forms.amax() * v.amax())
-    })?;
-    let v = SVector::from_column_slice(&x.as_slice()[..N]);
-    Ok((v, x.rows(N, m).into_owned()))
+        size
+    }
 }
 
 /// The velocity of a Lagrangian linear in the velocities, `L = ϑ(q)·v − H(q)`, at `q`: its
