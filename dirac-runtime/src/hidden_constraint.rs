@@ -124,7 +124,7 @@ impl HiddenConstraints {
     }
 
     /// The degenerate coordinates at `(q, v)`, their combinations not examined (`count` 0):
-    /// enough for [`balance`](Self::balance).
+    /// enough for [`rows_in_velocity`](Self::rows_in_velocity).
     pub fn rows_of<S: DiracSystem<N>, const N: usize>(
         system: &S,
         q: &SVector<f64, N>,
@@ -141,20 +141,6 @@ impl HiddenConstraints {
         &self.dead
     }
 
-    /// Their Euler–Lagrange rows without the multipliers, `R_D(q, v, t)`, and the size of the
-    /// terms summed into them.
-    pub fn balance<S: DiracSystem<N>, const N: usize>(
-        &self,
-        system: &S,
-        q: &SVector<f64, N>,
-        v: &SVector<f64, N>,
-        t: f64,
-        inputs: &[f64],
-    ) -> (DVector<f64>, f64) {
-        let (value, _, _, scale) = self.rows(system, q, v, t, inputs);
-        (value, scale)
-    }
-
     /// For the velocity solve of degenerate rows that contain velocities: an orthonormal basis
     /// `P` (columns over `D`) of the combinations of those rows the constraint forces reach,
     /// and a basis `W` of those they do not (`W ⟂ P`, together all of `R^D`).
@@ -167,7 +153,8 @@ impl HiddenConstraints {
         (null_space(&w.transpose()), w)
     }
 
-    /// `R_D(q, v, t)` with its Jacobian in `v`, and the size of its terms.
+    /// Their Euler–Lagrange rows without the multipliers, `R_D(q, v, t)`, with its Jacobian in
+    /// `v` and the size of the terms summed into them.
     pub fn rows_in_velocity<S: DiracSystem<N>, const N: usize>(
         &self,
         system: &S,

@@ -55,7 +55,7 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
         return Ok(());
     }
     // Rows D of  ∂L/∂q + F − d/dt ∂L/∂v + Aᵀμ + dgᵀλ = 0, with d/dt ∂L/∂v_D = Σ_j ∂²L/∂q_j∂v_D v_j.
-    let (unbalanced, size) = rows.balance(system, q0, v0, t0, inputs);
+    let (unbalanced, _, size) = rows.rows_in_velocity(system, q0, v0, t0, inputs);
     let (dead, forms) = (rows.coordinates(), HiddenConstraints::forms(system, q0));
     let matrix = DMatrix::from_fn(dead.len(), forms.nrows(), |r, c| forms[(c, dead[r])]);
     let residual = if forms.nrows() == 0 {
