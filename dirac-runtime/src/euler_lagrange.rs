@@ -870,7 +870,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         self.layout = self.layout.with_projection(if projected { N } else { 0 });
     }
 
-    /// The last step's solution (constant chart velocity, the same multipliers), or the path
+    /// The stepper's prediction from the last steps (their solutions extrapolated), or the path
     /// `ξ_j = c_j h ξ̇` along the state's velocity with zero multipliers.
     fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>) {
         let space = self.discrete.space();

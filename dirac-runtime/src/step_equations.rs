@@ -133,7 +133,9 @@ pub trait StepEquations<const N: usize> {
     }
 
     /// Prepares the step from `state` and writes the predictor into `x`. `previous` holds the
-    /// solution of the last accepted step, when there is one.
+    /// stepper's prediction from the accepted steps, when there is one: the last solution, or
+    /// the last two extrapolated linearly (`2 x_k − x_{k−1}`; not across a start or a change of
+    /// inputs).
     fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>);
 
     /// Writes the residual `F(x)` and adds its Jacobian into `jacobian` (zeroed by the caller);

@@ -94,6 +94,10 @@ pub struct Stepper<S, const N: usize, E = EulerLagrange<S, N, Euclidean>> {
     unknowns: DVector<f64>,
     /// The unknowns of the last accepted step: the next predictor.
     previous: Option<DVector<f64>>,
+    /// The unknowns of the step before it (none after a start or a change of inputs).
+    earlier: Option<DVector<f64>>,
+    /// The predictor extrapolated from the last two steps (scratch).
+    extrapolated: DVector<f64>,
     report: Option<NewtonReport>,
     /// Constraint violation of the last step.
     violation: f64,
@@ -294,12 +298,17 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
                 value,
             });
         }
+        if self.equations.inputs()[index] != value {
+            self.earlier = None;
+        }
         self.equations.inputs_mut()[index] = value;
         Ok(())
     }
 
     /// Sets every input at once, in the order of the system's `inputs(...)`.
     pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
+        // A step after a change of inputs is predicted from the last one alone.
+        self.earlier = None;
         self.equations.set_inputs(values)
     }
 
@@ -352,6 +361,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             steps: 0,
             unknowns: DVector::zeros(unknowns),
             previous: None,
+            earlier: None,
+            extrapolated: DVector::zeros(unknowns),
             report: None,
             violation: 0.0,
             system: PhantomData,
@@ -459,6 +470,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         if unknowns != self.unknowns.len() {
             self.newton = Newton::new(unknowns, *self.newton.options())?;
             self.unknowns = DVector::zeros(unknowns);
+            self.extrapolated = DVector::zeros(unknowns);
         }
         Ok(())
     }
@@ -471,6 +483,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         self.state = Some(state);
         self.steps = 0;
         self.previous = None;
+        self.earlier = None;
         self.report = None;
     }
 
@@ -498,8 +511,18 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// Solves the next step without making it current: the state is unchanged whatever happens.
     fn solve_step(&mut self) -> Result<Proposal<N>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
+        // The last two solutions extrapolated linearly (the path's points and the multipliers
+        // change smoothly from step to step: O(h³) off where the last one alone is O(h²)).
+        let predictor = match (&self.previous, &self.earlier) {
+            (Some(previous), Some(earlier)) if previous.len() == self.extrapolated.len() => {
+                self.extrapolated.copy_from(previous);
+                self.extrapolated.axpy(-1.0, earlier, 2.0);
+                Some(&self.extrapolated)
+            }
+            (previous, _) => previous.as_ref(),
+        };
         let equations = &mut self.equations;
-        equations.predict(&state, self.previous.as_ref(), &mut self.unknowns);
+        equations.predict(&state, predictor, &mut self.unknowns);
         let result = self.newton.solve(&mut self.unknowns, |x, r, j| {
             equations.assemble(&state, x, r, j)
         });
@@ -519,9 +542,12 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let count = self.multipliers.len();
         self.multipliers
             .copy_from_slice(&self.unknowns.as_slice()[first..first + count]);
+        std::mem::swap(&mut self.previous, &mut self.earlier);
         match &mut self.previous {
-            Some(previous) => previous.copy_from(&self.unknowns),
-            None => self.previous = Some(self.unknowns.clone()),
+            Some(previous) if previous.len() == self.unknowns.len() => {
+                previous.copy_from(&self.unknowns)
+            }
+            _ => self.previous = Some(self.unknowns.clone()),
         }
         self.violation = proposal.violation;
         self.steps += 1;

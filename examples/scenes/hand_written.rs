@@ -43,6 +43,9 @@ pub struct HandMidpoint {
     pub q: SVector<f64, 2>,
     pub p: SVector<f64, 2>,
     increment: SVector<f64, 2>,
+    /// The increment of the step before (none at the start): the predictor extrapolates the
+    /// last two, as the generated stepper does.
+    earlier: Option<SVector<f64, 2>>,
     newton: Newton,
     x: DVector<f64>,
     /// Newton iterations of the last step.
@@ -59,6 +62,7 @@ impl HandMidpoint {
             q: q0,
             p: p0,
             increment: v0 * h,
+            earlier: None,
             newton: Newton::new(2, NewtonOptions::default())
                 .expect("the default options are valid"),
             x: DVector::zeros(2),
@@ -70,7 +74,11 @@ impl HandMidpoint {
     /// `p_{k+1} = h/2 L_q + L_v`.
     pub fn step(&mut self) -> Result<(), dirac::NewtonFailure> {
         let (q0, p0, h, system) = (self.q, self.p, self.h, &self.system);
-        self.x.copy_from(&(q0 + self.increment));
+        let predicted = match self.earlier {
+            Some(earlier) => self.increment * 2.0 - earlier,
+            None => self.increment,
+        };
+        self.x.copy_from(&(q0 + predicted));
         let mut p1 = SVector::zeros();
         let report = self.newton.solve(&mut self.x, |x, r, j| {
             let q1 = SVector::<f64, 2>::new(x[0], x[1]);
@@ -82,6 +90,7 @@ impl HandMidpoint {
         })?;
         self.last_iterations = report.iterations;
         let q1 = SVector::<f64, 2>::new(self.x[0], self.x[1]);
+        self.earlier = Some(self.increment);
         self.increment = q1 - q0;
         self.q = q1;
         self.p = p1;
