@@ -10,7 +10,7 @@ use dirac::prelude::*;
 use dirac::step_equations::State;
 use scenes::circuit::{self, LcCircuit};
 use scenes::{cartesian_pendulum, knife_edge, port, rolling_disk};
-use support::slope;
+use support::{assert_order, slope};
 
 /// L in series with C2 and (C1 ∥ C3) with unequal capacitances.
 const UNEQUAL: LcCircuit = LcCircuit {
@@ -499,13 +499,7 @@ fn a_resistor_parallel_to_a_capacitor_keeps_its_orders() {
                 (stepper.q() - parallel_rc_at(t)).amax()
             })
             .collect();
-        let measured = slope(&hs, &errors);
-        println!("{}: {measured:.2} {errors:?}", quadrature.name());
-        assert!(
-            (measured - order).abs() < 0.3,
-            "{}: {measured} {errors:?}",
-            quadrature.name()
-        );
+        assert_order(&quadrature.name(), &hs, &errors, order);
     }
 }
 
@@ -571,12 +565,11 @@ fn a_maxwell_element_keeps_its_orders() {
                 (stepper.q() - vector![exact[0], exact[2]]).amax()
             })
             .collect();
-        let measured = slope(&hs, &errors);
-        println!("Maxwell, {}: {measured:.2} {errors:?}", quadrature.name());
-        assert!(
-            (measured - order).abs() < 0.3,
-            "{}: {measured} {errors:?}",
-            quadrature.name()
+        assert_order(
+            &format!("Maxwell, {}", quadrature.name()),
+            &hs,
+            &errors,
+            order,
         );
     }
 }

@@ -9,7 +9,7 @@ mod support;
 
 use dirac::prelude::*;
 use scenes::lotka_volterra::{self, LotkaVolterra};
-use support::slope;
+use support::{assert_order, slope};
 
 /// The same system in the gauge ϑ = (q2 + ln q2 / q1, q1) (ϑ changed by the gradient of q1 q2).
 #[dirac_system(
@@ -187,13 +187,7 @@ fn orders_hold_in_a_transcendental_gauge() {
             .iter()
             .map(|&h| error_at(LV_SINE, quadrature.clone(), h, t, &exact))
             .collect();
-        let measured = slope(&hs, &errors);
-        println!("{}: {measured:.2} {errors:?}", quadrature.name());
-        assert!(
-            (measured - order).abs() < 0.3,
-            "{}: order {measured}, {errors:?}",
-            quadrature.name()
-        );
+        assert_order(&quadrature.name(), &hs, &errors, order);
     }
 }
 
@@ -305,12 +299,11 @@ fn the_projected_step_has_full_order_in_every_gauge() {
             );
         }
         for (gauge, errors) in [("ϑ", &first), ("ϑ + ∇(q2 sin q1)", &sine)] {
-            let measured = slope(&hs, errors);
-            println!("{} in {gauge}: {measured:.2} {errors:?}", quadrature.name());
-            assert!(
-                (measured - order).abs() < 0.3,
-                "{} in {gauge}: order {measured}, {errors:?}",
-                quadrature.name()
+            assert_order(
+                &format!("{} in {gauge}", quadrature.name()),
+                &hs,
+                errors,
+                order,
             );
         }
     }
@@ -529,12 +522,7 @@ fn a_particle_drifting_in_a_magnetic_field() {
             }
             errors.push((stepper.q() - exact).amax());
         }
-        let measured = slope(&hs, &errors);
-        assert!(
-            (measured - order).abs() < 0.3,
-            "{}: order {measured}, {errors:?}",
-            quadrature.name()
-        );
+        assert_order(&quadrature.name(), &hs, &errors, order);
     }
 }
 
@@ -631,12 +619,11 @@ fn a_lagrangian_linear_in_some_velocities() {
                 (q - vector![exact[0], exact[1], exact[2]]).amax()
             })
             .collect();
-        let measured = slope(&hs, &errors);
-        println!("coupled, {}: {measured:.2} {errors:?}", quadrature.name());
-        assert!(
-            (measured - order).abs() < 0.3,
-            "{}: order {measured}, {errors:?}",
-            quadrature.name()
+        assert_order(
+            &format!("coupled, {}", quadrature.name()),
+            &hs,
+            &errors,
+            order,
         );
     }
     let err = coupled_stepper(Quadrature::trapezoid(), 0.1).unwrap_err();

@@ -12,6 +12,17 @@ pub fn slope(hs: &[f64], errors: &[f64]) -> f64 {
     sxy / sxx
 }
 
+/// Measures the order of `errors` over the steps `hs`, prints it, and asserts it is `expected`
+/// to ±0.3.
+pub fn assert_order(what: &str, hs: &[f64], errors: &[f64], expected: f64) {
+    let measured = slope(hs, errors);
+    println!("{what}: {measured:.2} {errors:?}");
+    assert!(
+        (measured - expected).abs() < 0.3,
+        "{what}: order {measured}, expected {expected}, {errors:?}"
+    );
+}
+
 /// The largest energy error `|E − E_0|` in the first and in the last tenth of a run. A
 /// symplectic method's error oscillates, so the two are alike; a drifting one grows.
 pub fn energy_error_first_and_last_tenth(energy: &[f64]) -> (f64, f64) {
