@@ -48,8 +48,8 @@ pub mod prelude {
     pub use dirac_runtime::nalgebra::{SMatrix, SVector};
     pub use dirac_runtime::{
         ConfigurationSpace, ConstraintPoint, DiracError, DiracSystem, DiscreteLagrangian, DualNum,
-        Euclidean, FirstOrderScheme, HolonomicScheme, NewtonOptions, Positive, Quadrature, Rule,
-        Scalar, Stepper, Trajectory,
+        Euclidean, FirstOrderScheme, HolonomicScheme, Input, NewtonOptions, Positive, Quadrature,
+        Rule, Scalar, Stepper, Trajectory,
     };
 }
 

@@ -260,6 +260,17 @@ fn driven_rlc_reaches_the_phasor_amplitude() {
     assert!(stepper.set_inputs(&[1.0, 2.0]).is_err());
     stepper.set_inputs(&[0.5]).unwrap();
     assert_eq!(stepper.inputs(), &[0.5]);
+    // A handle resolved once sets the same input; a bad value changes nothing.
+    let u = stepper.input("u").unwrap();
+    assert_eq!(u.index(), 0);
+    stepper.set_input_value(u, 0.25).unwrap();
+    assert_eq!(stepper.inputs(), &[0.25]);
+    assert!(stepper.set_input_value(u, f64::INFINITY).is_err());
+    assert_eq!(stepper.inputs(), &[0.25]);
+    assert!(matches!(
+        stepper.input("v"),
+        Err(DiracError::UnknownInput(_))
+    ));
 }
 
 /// Constraint one-forms of a Galerkin step are held at the nodes of its Gauss rule: a Lobatto

@@ -20,6 +20,7 @@ use crate::error::DiracError;
 use crate::euler_lagrange::{EulerLagrange, check_finite};
 use crate::first_order_scheme::FirstOrderScheme;
 use crate::holonomic_scheme::HolonomicScheme;
+use crate::input::Input;
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 use crate::quadrature::Quadrature;
@@ -281,9 +282,18 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     }
 
     /// Sets the input called `name` (held constant over the following steps until set again).
+    /// In a loop, resolve the name once with [`input`](Self::input) and use
+    /// [`set_input_value`](Self::set_input_value).
     pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), DiracError> {
-        let index = (0..S::INPUTS)
+        let input = self.input(name)?;
+        self.set_input_value(input, value)
+    }
+
+    /// The input called `name`, or `UnknownInput` naming the system's inputs.
+    pub fn input(&self, name: &str) -> Result<Input, DiracError> {
+        (0..S::INPUTS)
             .find(|&i| self.system().input_name(i) == name)
+            .map(Input::new)
             .ok_or_else(|| {
                 let names: Vec<String> = (0..S::INPUTS)
                     .map(|i| self.system().input_name(i))
@@ -291,14 +301,27 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
                 DiracError::UnknownInput(format!(
                     "no input called `{name}`; the inputs are {names:?}"
                 ))
-            })?;
+            })
+    }
+
+    /// Sets `input` (held constant over the following steps until set again); a value that is
+    /// not finite is refused and changes nothing.
+    pub fn set_input_value(&mut self, input: Input, value: f64) -> Result<(), DiracError> {
+        let index = input.index();
+        if index >= S::INPUTS {
+            return Err(DiracError::UnknownInput(format!(
+                "input {index} of a system with {} input(s)",
+                S::INPUTS
+            )));
+        }
         if !value.is_finite() {
             return Err(DiracError::NonFinite {
-                what: format!("input {name}"),
+                what: format!("input {}", self.system().input_name(index)),
                 value,
             });
         }
         if self.equations.inputs()[index] != value {
+            // A step after a change of inputs is predicted from the last one alone.
             self.earlier = None;
         }
         self.equations.inputs_mut()[index] = value;
@@ -307,9 +330,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
 
     /// Sets every input at once, in the order of the system's `inputs(...)`.
     pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
-        // A step after a change of inputs is predicted from the last one alone.
-        self.earlier = None;
-        self.equations.set_inputs(values)
+        let changed = self.equations.inputs() != values;
+        self.equations.set_inputs(values)?;
+        if changed {
+            // A step after a change of inputs is predicted from the last one alone.
+            self.earlier = None;
+        }
+        Ok(())
     }
 
     /// Current input values.

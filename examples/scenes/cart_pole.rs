@@ -97,6 +97,7 @@ pub fn closed_loop(h: f64, theta0: f64, steps: usize) -> Result<Vec<Sample>, Dir
     let k = linearisation_and_gain(h, 0.1)?.k;
     let mut stepper = Stepper::from_system(SCENE, h)?;
     stepper.start_from_velocity(vector![0.0, theta0], SVector::zeros())?;
+    let force = stepper.input("u")?;
     let mut samples = Vec::with_capacity(steps + 1);
     for _ in 0..=steps {
         let u = -(&k * state(&stepper))[(0, 0)];
@@ -106,7 +107,7 @@ pub fn closed_loop(h: f64, theta0: f64, steps: usize) -> Result<Vec<Sample>, Dir
             theta: stepper.q()[1],
             u,
         });
-        stepper.set_input("u", u)?;
+        stepper.set_input_value(force, u)?;
         stepper.step()?;
     }
     Ok(samples)

@@ -154,9 +154,10 @@ pub fn driven_amplitude(h: f64) -> Result<(f64, f64, f64), DiracError> {
     stepper.start_from_velocity(q0(), SVector::zeros())?;
     let (mut peak, mut balance): (f64, f64) = (0.0, 0.0);
     let mut energy = stepper.energy()?;
+    let source = stepper.input("u")?;
     for k in 0..(80.0 / h).round() as usize {
         let u = (omega * (k as f64 + 0.5) * h).sin();
-        stepper.set_input("u", u)?;
+        stepper.set_input_value(source, u)?;
         let q_l = stepper.q()[0];
         stepper.step()?;
         let dq = stepper.q()[0] - q_l;
