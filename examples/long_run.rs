@@ -11,12 +11,17 @@ use dirac::prelude::*;
 use scenes::pendulum;
 
 fn main() -> Result<(), DiracError> {
-    let (steps, every) = (10_000_000, 1_000);
-    let mut stepper = Stepper::new(pendulum::SCENE, Quadrature::midpoint(), 0.1)?;
+    let (h, t_end, every) = (0.1, 1e6, 1_000);
+    let steps = (t_end / h) as u64;
+    let mut stepper = Stepper::new(pendulum::SCENE, Quadrature::midpoint(), h)?;
     stepper.start_from_momentum(vector![1.0], vector![0.0])?;
-    let mut trajectory = stepper.trajectory();
+    let bar = scenes::progress::bar(0.0, t_end, h);
     let start = Instant::now();
-    stepper.record(&mut trajectory, steps, every)?;
+    let run = Run::until(t_end)
+        .every(every)
+        .observe(scenes::progress::observer(&bar));
+    let trajectory = stepper.solve(run)?.trajectory;
+    bar.finish_and_clear();
     let wall = start.elapsed();
     let energy = trajectory.energy();
     let e0 = energy[0];
@@ -26,8 +31,8 @@ fn main() -> Result<(), DiracError> {
         max_error(&energy[..tenth]),
         max_error(&energy[energy.len() - tenth..]),
     );
-    // t, q, p and the energy per sample (N = 1), in f64.
-    let bytes = trajectory.len() * 4 * std::mem::size_of::<f64>();
+    // t, q, v, p and the energy per sample (N = 1), in f64.
+    let bytes = trajectory.len() * 5 * std::mem::size_of::<f64>();
     println!("{steps} midpoint steps of the pendulum at h = 0.1 in {wall:.2?}");
     println!(
         "max |E − E0|: first tenth {first:.3e}, last tenth {last:.3e} (ratio {:.3})",

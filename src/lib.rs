@@ -48,8 +48,9 @@ pub mod prelude {
     pub use dirac_runtime::nalgebra::{SMatrix, SVector};
     pub use dirac_runtime::{
         ConfigurationSpace, ConstraintPoint, DiracError, DiracSystem, DiscreteLagrangian, DualNum,
-        Euclidean, FirstOrderScheme, HolonomicScheme, Input, NewtonOptions, Positive, Quadrature,
-        Rule, Scalar, Stepper, Trajectory,
+        Crossing, Direction, Euclidean, Event, FirstOrderScheme, HolonomicScheme, Input,
+        NewtonOptions, Positive, Progress, Quadrature, Rule, Run, Sample, Scalar, Solution, Status,
+        Stepper, Trajectory,
     };
 }
 

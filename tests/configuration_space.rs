@@ -76,8 +76,8 @@ fn a_nonlinear_retraction_converges_to_the_closed_form_with_the_quadratures_orde
     // down to well above round-off.
     for (quadrature, order, counts) in [
         (Quadrature::midpoint(), 2.0, [50, 100, 200, 400]),
-        (Quadrature::gauss(2).unwrap(), 4.0, [20, 40, 80, 160]),
-        (Quadrature::gauss(3).unwrap(), 6.0, [20, 24, 30, 40]),
+        (Quadrature::galerkin(2).unwrap(), 4.0, [20, 40, 80, 160]),
+        (Quadrature::galerkin(3).unwrap(), 6.0, [20, 24, 30, 40]),
     ] {
         let hs: Vec<f64> = counts.iter().map(|&n| t_end / f64::from(n)).collect();
         let errors: Vec<f64> = hs
@@ -119,12 +119,12 @@ fn the_chart_changes_the_scheme_but_not_the_solution() {
 #[test]
 fn forces_are_read_in_the_chart() {
     // Damped wall particle against a Euclidean reference at a step 64 times smaller.
-    let reference = wall_run(Euclidean, 0.3, Quadrature::gauss(3).unwrap(), 0.005, 1.0);
+    let reference = wall_run(Euclidean, 0.3, Quadrature::galerkin(3).unwrap(), 0.005, 1.0);
     let hs = [0.04, 0.02, 0.01, 0.005];
     let errors: Vec<f64> = hs
         .iter()
         .map(|&h| {
-            let (q, p) = wall_run(Positive, 0.3, Quadrature::gauss(2).unwrap(), h, 1.0);
+            let (q, p) = wall_run(Positive, 0.3, Quadrature::galerkin(2).unwrap(), h, 1.0);
             (q - reference.0).abs().max((p - reference.1).abs())
         })
         .collect();

@@ -248,7 +248,7 @@ fn every_constrained_scene_restarts_from_its_own_state() {
     let disk = |h| rolling_disk::stepper(Quadrature::midpoint(), h).unwrap();
     check_restart("rolling disk", disk, 0.05, rolling_disk::exact, 50, 100);
     // A constrained Galerkin step (one-forms at the Gauss nodes) restarts the same way.
-    let disk_galerkin = |h| rolling_disk::stepper(Quadrature::gauss(2).unwrap(), h).unwrap();
+    let disk_galerkin = |h| rolling_disk::stepper(Quadrature::galerkin(2).unwrap(), h).unwrap();
     check_restart(
         "rolling disk, galerkin(2)",
         disk_galerkin,
@@ -262,7 +262,7 @@ fn every_constrained_scene_restarts_from_its_own_state() {
 /// The pendulum angle at `t` from rest at 1 rad, by `galerkin(3)` at h = 1e-3 (error < 1e-12).
 fn angle_pendulum_at(t: f64) -> f64 {
     let mut stepper =
-        Stepper::new(scenes::pendulum::SCENE, Quadrature::gauss(3).unwrap(), 1e-3).unwrap();
+        Stepper::new(scenes::pendulum::SCENE, Quadrature::galerkin(3).unwrap(), 1e-3).unwrap();
     stepper
         .start_from_velocity(vector![1.0], vector![0.0])
         .unwrap();
@@ -477,7 +477,7 @@ fn a_resistor_parallel_to_a_capacitor_keeps_its_orders() {
     };
     for quadrature in [
         Quadrature::trapezoid(),
-        Quadrature::galerkin(1, Rule::GaussLegendre(2)).unwrap(),
+        Quadrature::galerkin_with_rule(1, Rule::GaussLegendre(2)).unwrap(),
     ] {
         let err = start(quadrature, 0.05).unwrap_err();
         assert!(matches!(err, DiracError::InvalidQuadrature(_)), "{err}");
@@ -486,8 +486,8 @@ fn a_resistor_parallel_to_a_capacitor_keeps_its_orders() {
     let t = 2.0;
     for (quadrature, hs, order) in [
         (Quadrature::midpoint(), [0.1, 0.05, 0.025], 2.0),
-        (Quadrature::gauss(2).unwrap(), [0.2, 0.1, 0.05], 4.0),
-        (Quadrature::gauss(3).unwrap(), [0.4, 0.2, 0.1], 6.0),
+        (Quadrature::galerkin(2).unwrap(), [0.2, 0.1, 0.05], 4.0),
+        (Quadrature::galerkin(3).unwrap(), [0.4, 0.2, 0.1], 6.0),
     ] {
         let errors: Vec<f64> = hs
             .iter()
@@ -553,7 +553,7 @@ fn a_maxwell_element_keeps_its_orders() {
     let exact = maxwell_at(t);
     for (quadrature, hs, order) in [
         (Quadrature::midpoint(), [0.1, 0.05, 0.025], 2.0),
-        (Quadrature::gauss(2).unwrap(), [0.2, 0.1, 0.05], 4.0),
+        (Quadrature::galerkin(2).unwrap(), [0.2, 0.1, 0.05], 4.0),
     ] {
         let errors: Vec<f64> = hs
             .iter()
@@ -609,8 +609,8 @@ fn holonomic_galerkin_of_degree_two_is_fourth_order() {
     let exact = cartesian_pendulum::q0(angle_pendulum_at(t));
     let hs = [0.2, 0.1, 0.05, 0.025];
     for quadrature in [
-        Quadrature::gauss(2).unwrap(),
-        Quadrature::galerkin(2, Rule::GaussLobatto(3)).unwrap(),
+        Quadrature::galerkin(2).unwrap(),
+        Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3)).unwrap(),
     ] {
         let errors: Vec<f64> = hs
             .iter()
@@ -639,7 +639,7 @@ fn holonomic_galerkin_of_degree_two_is_fourth_order() {
     // come out in the order of their names.
     let mut hanging = Stepper::new(
         cartesian_pendulum::SCENE,
-        Quadrature::gauss(2).unwrap(),
+        Quadrature::galerkin(2).unwrap(),
         0.1,
     )
     .unwrap();
@@ -662,7 +662,7 @@ fn holonomic_galerkin_of_degree_two_is_fourth_order() {
     // RATTLE with galerkin(2): the stored momentum is tangent (unit mass: q·p = 0).
     let mut rattle = Stepper::new(
         cartesian_pendulum::SCENE,
-        Quadrature::gauss(2).unwrap(),
+        Quadrature::galerkin(2).unwrap(),
         0.1,
     )
     .unwrap()
@@ -684,8 +684,8 @@ fn holonomic_galerkin_of_degree_two_is_fourth_order() {
 fn one_forms_at_the_nodes_of_galerkin_steps_keep_the_orders() {
     let cases = [
         (Quadrature::midpoint(), 2.0, [0.04, 0.02, 0.01, 0.005]),
-        (Quadrature::gauss(2).unwrap(), 4.0, [0.2, 0.1, 0.05, 0.025]),
-        (Quadrature::gauss(3).unwrap(), 6.0, [0.4, 0.2, 0.1, 0.05]),
+        (Quadrature::galerkin(2).unwrap(), 4.0, [0.2, 0.1, 0.05, 0.025]),
+        (Quadrature::galerkin(3).unwrap(), 6.0, [0.4, 0.2, 0.1, 0.05]),
     ];
     for (quadrature, order, hs) in cases {
         let name = quadrature.name();
@@ -738,11 +738,11 @@ fn one_forms_at_the_nodes_of_galerkin_steps_keep_the_orders() {
         }
     }
     // Lobatto rules have a node more than the path has free points: refused for one-forms.
-    let lobatto = Quadrature::galerkin(2, Rule::GaussLobatto(3)).unwrap();
+    let lobatto = Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3)).unwrap();
     let err = Stepper::new(knife_edge::SCENE, lobatto, 0.1).unwrap_err();
     assert!(matches!(err, DiracError::InvalidQuadrature(_)), "{err}");
     // A Galerkin step has no constraint point: asking for one is refused at the start.
-    let mut end = Stepper::new(knife_edge::SCENE, Quadrature::gauss(2).unwrap(), 0.1)
+    let mut end = Stepper::new(knife_edge::SCENE, Quadrature::galerkin(2).unwrap(), 0.1)
         .unwrap()
         .with_constraint_point(ConstraintPoint::End);
     let err = end
@@ -757,8 +757,8 @@ fn one_forms_at_the_nodes_of_galerkin_steps_keep_the_orders() {
 #[test]
 fn knife_edge_energy_with_galerkin_steps_does_not_drift() {
     for (quadrature, bound) in [
-        (Quadrature::gauss(2).unwrap(), 1e-5),
-        (Quadrature::gauss(3).unwrap(), 1e-12),
+        (Quadrature::galerkin(2).unwrap(), 1e-5),
+        (Quadrature::galerkin(3).unwrap(), 1e-12),
     ] {
         let mut stepper = Stepper::new(knife_edge::SCENE, quadrature.clone(), 0.05).unwrap();
         stepper

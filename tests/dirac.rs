@@ -136,8 +136,8 @@ fn cartesian_pendulum_keeps_its_length_and_matches_the_angle_pendulum() {
     stepper
         .start_from_velocity(cartesian_pendulum::q0(1.0), SVector::zeros())
         .unwrap();
-    let mut trajectory = stepper.trajectory();
-    stepper.record(&mut trajectory, 1_000_000, 41).unwrap();
+    let run = Run::steps(1_000_000).every(41);
+    let trajectory = stepper.solve(run).unwrap().trajectory;
     let mut worst: f64 = 0.0;
     for _ in 0..1000 {
         stepper.step().unwrap();
@@ -279,13 +279,13 @@ fn driven_rlc_reaches_the_phasor_amplitude() {
 /// (order 4, `tests/constrained.rs`), degree 3 refused (it measured order 4 too, not 6).
 #[test]
 fn constrained_systems_refuse_quadratures_they_cannot_hold() {
-    let lobatto = Quadrature::galerkin(2, Rule::GaussLobatto(3)).unwrap();
+    let lobatto = Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3)).unwrap();
     let err = Stepper::new(circuit::LC, lobatto, 0.01).unwrap_err();
     assert!(matches!(err, DiracError::InvalidQuadrature(_)), "{err}");
-    assert!(Stepper::new(circuit::LC, Quadrature::gauss(2).unwrap(), 0.01).is_ok());
+    assert!(Stepper::new(circuit::LC, Quadrature::galerkin(2).unwrap(), 0.01).is_ok());
     let err = Stepper::new(
         cartesian_pendulum::SCENE,
-        Quadrature::gauss(3).unwrap(),
+        Quadrature::galerkin(3).unwrap(),
         0.01,
     )
     .unwrap_err();
@@ -293,7 +293,7 @@ fn constrained_systems_refuse_quadratures_they_cannot_hold() {
     assert!(
         Stepper::new(
             cartesian_pendulum::SCENE,
-            Quadrature::gauss(2).unwrap(),
+            Quadrature::galerkin(2).unwrap(),
             0.01
         )
         .is_ok()

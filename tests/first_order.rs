@@ -120,8 +120,8 @@ fn orders_do_not_depend_on_the_gauge() {
     let exact = reference(t);
     let cases: [(Quadrature, [f64; 4], f64); 3] = [
         (Quadrature::midpoint(), [0.1, 0.05, 0.025, 0.0125], 2.0),
-        (Quadrature::gauss(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
-        (Quadrature::gauss(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
+        (Quadrature::galerkin(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
+        (Quadrature::galerkin(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
     ];
     for (quadrature, hs, order) in cases {
         let first: Vec<f64> = hs
@@ -180,8 +180,8 @@ fn orders_hold_in_a_transcendental_gauge() {
     let exact = reference(t);
     for (quadrature, hs, order) in [
         (Quadrature::midpoint(), [0.1, 0.05, 0.025, 0.0125], 2.0),
-        (Quadrature::gauss(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
-        (Quadrature::gauss(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
+        (Quadrature::galerkin(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
+        (Quadrature::galerkin(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
     ] {
         let errors: Vec<f64> = hs
             .iter()
@@ -198,7 +198,7 @@ fn orders_hold_in_a_transcendental_gauge() {
 fn lobatto_rules_are_refused() {
     for quadrature in [
         Quadrature::trapezoid(),
-        Quadrature::galerkin(2, Rule::GaussLobatto(3)).unwrap(),
+        Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3)).unwrap(),
     ] {
         let mut stepper = Stepper::new(LV, quadrature, 0.1).unwrap();
         let err = stepper.start_from_position(q0()).unwrap_err();
@@ -208,7 +208,7 @@ fn lobatto_rules_are_refused() {
     }
     // A Gauss rule with more nodes than the path's degree would collocate at some of them only
     // (order 1): refused.
-    let overintegrated = Quadrature::galerkin(1, Rule::GaussLegendre(2)).unwrap();
+    let overintegrated = Quadrature::galerkin_with_rule(1, Rule::GaussLegendre(2)).unwrap();
     let mut stepper = Stepper::new(LV, overintegrated, 0.1).unwrap();
     let err = stepper.start_from_position(q0()).unwrap_err();
     assert!(matches!(err, DiracError::InvalidQuadrature(_)), "{err}");
@@ -224,8 +224,8 @@ fn the_hamiltonian_over_a_long_run() {
     let h0 = hamiltonian(&q0());
     for (quadrature, bound, growth) in [
         (Quadrature::midpoint(), 2e-3, 1.2),
-        (Quadrature::gauss(2).unwrap(), 2e-5, 12.0),
-        (Quadrature::gauss(3).unwrap(), 1e-8, 12.0),
+        (Quadrature::galerkin(2).unwrap(), 2e-5, 12.0),
+        (Quadrature::galerkin(3).unwrap(), 1e-8, 12.0),
     ] {
         let mut stepper = Stepper::new(LV_SINE, quadrature.clone(), 0.05).unwrap();
         stepper.start_from_position(q0()).unwrap();
@@ -279,8 +279,8 @@ fn the_projected_step_has_full_order_in_every_gauge() {
     let scheme = FirstOrderScheme::SymmetricProjection;
     for (quadrature, hs, order) in [
         (Quadrature::midpoint(), [0.1, 0.05, 0.025, 0.0125], 2.0),
-        (Quadrature::gauss(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
-        (Quadrature::gauss(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
+        (Quadrature::galerkin(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
+        (Quadrature::galerkin(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
     ] {
         let errors = |gauge: usize| -> Vec<f64> {
             hs.iter()
@@ -325,8 +325,8 @@ fn the_projected_step_keeps_the_hamiltonian_without_drift() {
     let scheme = FirstOrderScheme::SymmetricProjection;
     for (quadrature, bound) in [
         (Quadrature::midpoint(), 3e-3),
-        (Quadrature::gauss(2).unwrap(), 2e-6),
-        (Quadrature::gauss(3).unwrap(), 5e-10),
+        (Quadrature::galerkin(2).unwrap(), 2e-6),
+        (Quadrature::galerkin(3).unwrap(), 5e-10),
     ] {
         let name = quadrature.name();
         for (gauge, (first, last)) in [
@@ -462,7 +462,7 @@ fn point_vortices_keep_their_hamiltonian_and_impulses() {
         }
         e
     };
-    for quadrature in [Quadrature::midpoint(), Quadrature::gauss(2).unwrap()] {
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
         let mut stepper = Stepper::new(vortices, quadrature.clone(), 0.05).unwrap();
         stepper.start_from_position(q0).unwrap();
         let (i0, e0) = (impulses(&q0), energy(&q0));
@@ -508,8 +508,8 @@ fn a_particle_drifting_in_a_magnetic_field() {
     let exact = vector![10.0_f64.cos(), 10.0_f64.sin()];
     for (quadrature, hs, order) in [
         (Quadrature::midpoint(), [0.2, 0.1, 0.05, 0.025], 2.0),
-        (Quadrature::gauss(2).unwrap(), [0.4, 0.2, 0.1, 0.05], 4.0),
-        (Quadrature::gauss(3).unwrap(), [0.4, 0.2, 0.1, 0.05], 6.0),
+        (Quadrature::galerkin(2).unwrap(), [0.4, 0.2, 0.1, 0.05], 4.0),
+        (Quadrature::galerkin(3).unwrap(), [0.4, 0.2, 0.1, 0.05], 6.0),
     ] {
         let mut errors = Vec::new();
         for &h in &hs {
@@ -605,8 +605,8 @@ fn a_lagrangian_linear_in_some_velocities() {
     let exact = coupled_reference(t);
     for (quadrature, hs, order) in [
         (Quadrature::midpoint(), [0.1, 0.05, 0.025, 0.0125], 2.0),
-        (Quadrature::gauss(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
-        (Quadrature::gauss(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
+        (Quadrature::galerkin(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
+        (Quadrature::galerkin(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
     ] {
         let errors: Vec<f64> = hs
             .iter()
@@ -629,7 +629,7 @@ fn a_lagrangian_linear_in_some_velocities() {
     let err = coupled_stepper(Quadrature::trapezoid(), 0.1).unwrap_err();
     assert!(matches!(err, DiracError::InvalidQuadrature(_)), "{err}");
     // The velocity: the vector field on q1, q2 at the current state.
-    let mut stepper = coupled_stepper(Quadrature::gauss(2).unwrap(), 0.05).unwrap();
+    let mut stepper = coupled_stepper(Quadrature::galerkin(2).unwrap(), 0.05).unwrap();
     for _ in 0..20 {
         stepper.step().unwrap();
     }
@@ -640,7 +640,7 @@ fn a_lagrangian_linear_in_some_velocities() {
         "{v:?} vs {field:?}"
     );
     // A restart from (q, p) continues the run.
-    let mut again = Stepper::new(COUPLED, Quadrature::gauss(2).unwrap(), 0.05).unwrap();
+    let mut again = Stepper::new(COUPLED, Quadrature::galerkin(2).unwrap(), 0.05).unwrap();
     again.start_from_momentum(q, stepper.p()).unwrap();
     for _ in 0..20 {
         stepper.step().unwrap();
@@ -685,7 +685,7 @@ struct WithAMasslessSpring;
 #[test]
 fn hidden_constraints_beside_rows_linear_in_their_velocities_are_refused() {
     let mut stepper =
-        Stepper::new(WithAMasslessSpring, Quadrature::gauss(2).unwrap(), 0.05).unwrap();
+        Stepper::new(WithAMasslessSpring, Quadrature::galerkin(2).unwrap(), 0.05).unwrap();
     let err = stepper
         .start_from_velocity(vector![2.0, 1.0, 0.5, 0.5], vector![-2.0, -1.0, 0.0, 0.0])
         .unwrap_err();
@@ -697,7 +697,7 @@ fn hidden_constraints_beside_rows_linear_in_their_velocities_are_refused() {
 /// was (no resizing of its unknowns mid-run), and a restart from its own state uses the new one.
 #[test]
 fn the_scheme_is_taken_up_by_the_next_start() {
-    let quadrature = Quadrature::gauss(2).unwrap();
+    let quadrature = Quadrature::galerkin(2).unwrap();
     let mut collocated = Stepper::new(LV, quadrature.clone(), 0.05).unwrap();
     collocated.start_from_position(q0()).unwrap();
     let mut changed = Stepper::new(LV, quadrature.clone(), 0.05).unwrap();

@@ -14,8 +14,8 @@ fn oscillator_error_bounds() {
     let bounds = [
         (Quadrature::midpoint(), 4e-4),
         (Quadrature::trapezoid(), 2e-4),
-        (Quadrature::gauss(2).unwrap(), 1e-7),
-        (Quadrature::gauss(3).unwrap(), 1e-11),
+        (Quadrature::galerkin(2).unwrap(), 1e-7),
+        (Quadrature::galerkin(3).unwrap(), 1e-11),
     ];
     for (quadrature, bound) in bounds {
         let error = oscillator::max_error(quadrature.clone(), 0.1).unwrap();
@@ -48,7 +48,7 @@ fn midpoint_keeps_the_oscillator_energy_exactly() {
 /// reaches the golden digits (measured 5e-13); the midpoint rule is within its O(h²) error.
 #[test]
 fn pendulum_golden_values() {
-    let error = pendulum::error_at_5(Quadrature::gauss(3).unwrap(), 0.05).unwrap();
+    let error = pendulum::error_at_5(Quadrature::galerkin(3).unwrap(), 0.05).unwrap();
     assert!(error < 2e-12, "{error:e}");
     let error = pendulum::error_at_5(Quadrature::midpoint(), 0.05).unwrap();
     assert!(error < 1e-3 && error > 1e-5, "{error:e}");

@@ -20,8 +20,8 @@ fn energy_error_is_bounded_without_drift_over_a_million_steps() {
     stepper
         .start_from_momentum(vector![1.0], vector![0.0])
         .unwrap();
-    let mut trajectory = Trajectory::new(stepper.coordinate_names()).unwrap();
-    stepper.record(&mut trajectory, 1_000_000, 37).unwrap();
+    let run = Run::steps(1_000_000).every(37);
+    let trajectory = stepper.solve(run).unwrap().trajectory;
     let (first, last) = energy_error_first_and_last_tenth(trajectory.energy());
     assert!(
         last <= 1.1 * first,

@@ -198,12 +198,12 @@ impl DiracSystem<1> for Pendulum {
 
 #[test]
 fn a_lagrangian_stepper_continues_from_another_steppers_state() {
-    let mut first = Stepper::new(Pendulum, Quadrature::gauss(2).unwrap(), 0.1).unwrap();
+    let mut first = Stepper::new(Pendulum, Quadrature::galerkin(2).unwrap(), 0.1).unwrap();
     first
         .start_from_velocity(vector![1.0], vector![0.0])
         .unwrap();
     first.run(50).unwrap();
-    let mut second = Stepper::new(Pendulum, Quadrature::gauss(2).unwrap(), 0.1).unwrap();
+    let mut second = Stepper::new(Pendulum, Quadrature::galerkin(2).unwrap(), 0.1).unwrap();
     second
         .start_from_state(*first.state().expect("started"))
         .expect("a running stepper's state is a valid start");
@@ -220,7 +220,7 @@ fn the_lagrangian_equations_validate_what_the_stepper_would() {
     use dirac::euler_lagrange::EulerLagrange;
     // One-forms with a Lobatto rule of degree 2, and a negative step, are refused by the
     // equations themselves, so Stepper::with_equations cannot bypass the checks.
-    let lobatto = Quadrature::galerkin(2, Rule::GaussLobatto(3)).unwrap();
+    let lobatto = Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3)).unwrap();
     let discrete = DiscreteLagrangian::new(scenes::circuit::LC, lobatto, 0.01);
     assert!(matches!(
         EulerLagrange::new(discrete),

@@ -110,5 +110,5 @@ fn galerkin(call: &ExprCall) -> syn::Result<TokenStream> {
     } else {
         quote!(::dirac::Rule::GaussLegendre(#nodes))
     };
-    Ok(quote_spanned!(call.span()=> ::dirac::Quadrature::galerkin(#degree, #rule)))
+    Ok(quote_spanned!(call.span()=> ::dirac::Quadrature::galerkin_with_rule(#degree, #rule)))
 }

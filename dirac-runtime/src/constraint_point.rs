@@ -14,6 +14,7 @@
 /// assert_eq!(ConstraintPoint::End.theta(), 1.0);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum ConstraintPoint {
     /// `q_c = q_k`: the seed's (+) scheme.
     Start,

@@ -393,8 +393,8 @@ mod tests {
         for quadrature in [
             Quadrature::midpoint(),
             Quadrature::trapezoid(),
-            Quadrature::gauss(2).unwrap(),
-            Quadrature::gauss(3).unwrap(),
+            Quadrature::galerkin(2).unwrap(),
+            Quadrature::galerkin(3).unwrap(),
         ] {
             check(Euclidean, quadrature.clone());
             check(Positive, quadrature);

@@ -111,6 +111,9 @@ pub enum DiracError {
         /// What could not be held.
         why: String,
     },
+    /// A run's time span, save times or events do not fit the stepper (the message says how).
+    #[error("invalid run: {0}")]
+    InvalidRun(String),
     /// Writing a trajectory failed.
     #[error("could not write the trajectory: {0}")]
     Io(String),

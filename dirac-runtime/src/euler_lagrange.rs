@@ -20,6 +20,7 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::configuration_space::{ConfigurationSpace, StepCovectors};
 use crate::constraint::{self, ConstraintPoint, StepConstraints};
+use crate::dense_output::{Sample, end_slope_correction};
 use crate::derivatives::{Dual, Seed, seeded};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
@@ -51,7 +52,7 @@ use crate::system::DiracSystem;
 ///     }
 /// }
 /// // Galerkin with 3 points per step: two internal points and q_{k+1}, one coordinate each.
-/// let discrete = DiscreteLagrangian::new(Oscillator, Quadrature::gauss(3)?, 0.1);
+/// let discrete = DiscreteLagrangian::new(Oscillator, Quadrature::galerkin(3)?, 0.1);
 /// let equations = EulerLagrange::new(discrete)?;
 /// assert_eq!(equations.unknowns(), 3);
 /// assert_eq!(equations.unknown_name(2), "q0 (q_{k+1})");
@@ -673,6 +674,48 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
 
     fn h(&self) -> f64 {
         self.discrete.h()
+    }
+
+    fn method(&self) -> String {
+        self.discrete.quadrature().name()
+    }
+
+    fn dense(&self, ends: [&Sample<N>; 2], x: &DVector<f64>, theta: f64) -> Option<Sample<N>> {
+        let [a, b] = ends;
+        let (space, system) = (self.discrete.space(), self.discrete.system());
+        let (quadrature, h) = (self.discrete.quadrature(), self.discrete.h());
+        // The step's points in the chart at q_k: the internal points (from the shifted start of
+        // a projected step) and the stored end.
+        let shift = if self.projected() {
+            x.fixed_rows::<N>(self.layout.projection()).into_owned()
+        } else {
+            SVector::zeros()
+        };
+        let end = space.local(&a.q, &b.q)?;
+        let points: Vec<SVector<f64, N>> = (1..self.layout.points())
+            .map(|j| x.fixed_rows::<N>(self.layout.point(j)) + shift)
+            .chain(std::iter::once(end))
+            .collect();
+        let (_, start_rate) = quadrature.path_through(0.0, &points, h);
+        let (_, end_rate) = quadrature.path_through(1.0, &points, h);
+        let d0 = space.chart_velocity(&a.q, &a.v)? - start_rate;
+        let d1 = space.chart_rate(&a.q, &end, &b.v)? - end_rate;
+        let (path, rate) = quadrature.path_through(theta, &points, h);
+        let (correction, rate_correction) =
+            end_slope_correction(theta, h, points.len(), &d0, &d1);
+        let (xi, xi_dot) = (path + correction, rate + rate_correction);
+        let q = space.retract(&a.q, &xi);
+        let v = space.push_forward(&a.q, &xi, &xi_dot);
+        let momentum = |q, v| legendre::momentum(system, q, v);
+        let p = momentum(&q, &v)
+            + (a.p - momentum(&a.q, &a.v)) * (1.0 - theta)
+            + (b.p - momentum(&b.q, &b.v)) * theta;
+        Some(Sample {
+            t: a.t + theta * h,
+            q,
+            v,
+            p,
+        })
     }
 
     fn unknowns(&self) -> usize {

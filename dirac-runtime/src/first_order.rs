@@ -292,7 +292,7 @@ mod tests {
     #[test]
     fn the_projected_step_has_an_exact_jacobian() {
         for s in 1..=3 {
-            let quadrature = Quadrature::gauss(s).unwrap();
+            let quadrature = Quadrature::galerkin(s).unwrap();
             let discrete = DiscreteLagrangian::new(Gauged, quadrature, 0.1);
             let q = SVector::<f64, 2>::new(2.0, 1.3);
             let p = SVector::<f64, 2>::new(0.3, -0.2);

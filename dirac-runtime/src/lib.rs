@@ -6,8 +6,8 @@
 //! [`quadrature`] → [`discrete_lagrangian`] (slot derivatives in the chart), `force` (discrete
 //! Lagrange–d'Alembert forces) and [`constraint`] (multiplier rows) → [`euler_lagrange`] (the
 //! step's residual, unknowns and update, behind the [`step_equations`] seam) → [`newton`] →
-//! [`stepper`] → [`trajectory`], with [`step_derivatives`] (the step map's derivatives by the
-//! implicit function theorem). Every derivative of the model's functions is taken by dual
+//! [`stepper`] (over a [`run`], with [`dense_output`] and [`event`]s) → [`trajectory`], with
+//! [`step_derivatives`] (the step map's derivatives by the implicit function theorem). Every derivative of the model's functions is taken by dual
 //! numbers in one private module, `derivatives`.
 #![warn(missing_docs)]
 
@@ -15,8 +15,10 @@ pub mod configuration_space;
 pub mod constraint;
 mod constraint_point;
 mod derivatives;
+pub mod dense_output;
 pub mod discrete_lagrangian;
 pub mod error;
+pub mod event;
 pub mod euler_lagrange;
 mod first_order;
 mod first_order_scheme;
@@ -30,6 +32,7 @@ pub mod legendre;
 mod lu;
 pub mod newton;
 pub mod quadrature;
+pub mod run;
 pub mod scalar;
 pub mod step_derivatives;
 pub mod step_equations;
@@ -40,19 +43,22 @@ pub mod trajectory;
 pub use configuration_space::{ConfigurationSpace, Euclidean, Positive};
 pub use constraint::ConstraintPoint;
 pub use discrete_lagrangian::DiscreteLagrangian;
+pub use dense_output::Sample;
 pub use error::DiracError;
+pub use event::{Crossing, Direction, Event};
 pub use first_order_scheme::FirstOrderScheme;
 pub use holonomic_scheme::HolonomicScheme;
 pub use input::Input;
 pub use lu::SingularPivot;
 pub use newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 pub use quadrature::{Quadrature, Rule};
+pub use run::{Progress, Run, Solution, Status};
 pub use scalar::Scalar;
 pub use step_derivatives::{StepDerivatives, StepHessians};
 pub use step_equations::{State, StepEquations};
 pub use stepper::Stepper;
 pub use system::DiracSystem;
-pub use trajectory::{Interrupted, Trajectory};
+pub use trajectory::{Interrupted, Metadata, Trajectory};
 
 pub use nalgebra;
 pub use num_dual;

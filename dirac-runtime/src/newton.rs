@@ -39,6 +39,7 @@ use crate::lu::{self, SingularPivot};
 /// assert!(nan.validate().is_err());
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct NewtonOptions {
     /// Relative tolerance on the residual, in `[0, 1)`.
     pub residual_tolerance: f64,

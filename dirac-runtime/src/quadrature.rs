@@ -18,6 +18,7 @@ use crate::error::DiracError;
 
 /// The quadrature rule on `[0, 1]` used to integrate the Lagrangian along one step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Rule {
     /// Gauss–Legendre with this many nodes (interior nodes only).
     GaussLegendre(usize),
@@ -30,13 +31,18 @@ pub enum Rule {
 ///
 /// ```
 /// use dirac_runtime::{Quadrature, Rule};
-/// let q = Quadrature::galerkin(2, Rule::GaussLegendre(2))?;
+/// let q = Quadrature::galerkin_with_rule(2, Rule::GaussLegendre(2))?;
 /// assert_eq!(q.degree(), 2);
 /// assert_eq!(q.name(), "galerkin(2, gauss_legendre(2))");
 /// assert!((q.weights().iter().sum::<f64>() - 1.0).abs() < 1e-15);
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "QuadratureSpec", into = "QuadratureSpec")
+)]
 pub struct Quadrature {
     degree: usize,
     rule: Rule,
@@ -82,10 +88,10 @@ impl Quadrature {
     ///
     /// ```
     /// use dirac_runtime::{Quadrature, Rule};
-    /// assert!(Quadrature::galerkin(3, Rule::GaussLegendre(3)).is_ok());
-    /// assert!(Quadrature::galerkin(3, Rule::GaussLegendre(2)).is_err());
+    /// assert!(Quadrature::galerkin_with_rule(3, Rule::GaussLegendre(3)).is_ok());
+    /// assert!(Quadrature::galerkin_with_rule(3, Rule::GaussLegendre(2)).is_err());
     /// ```
-    pub fn galerkin(degree: usize, rule: Rule) -> Result<Self, DiracError> {
+    pub fn galerkin_with_rule(degree: usize, rule: Rule) -> Result<Self, DiracError> {
         let invalid = |msg: String| Err(DiracError::InvalidQuadrature(msg));
         if degree == 0 || degree > MAX_DEGREE {
             return invalid(format!(
@@ -111,15 +117,17 @@ impl Quadrature {
         Ok(Self::build(degree, rule))
     }
 
-    /// The Galerkin method of degree `s` with `s` Gauss–Legendre nodes (order `2s`).
+    /// The Galerkin method of degree `s` with `s` Gauss–Legendre nodes (order `2s`): the
+    /// attribute's `galerkin(s)`.
     ///
     /// ```
-    /// let q = dirac_runtime::Quadrature::gauss(2)?;
+    /// let q = dirac_runtime::Quadrature::galerkin(2)?;
     /// assert_eq!(q.internal_points(), 1);
+    /// assert_eq!(q.name(), "galerkin(2)");
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn gauss(degree: usize) -> Result<Self, DiracError> {
-        Self::galerkin(degree, Rule::GaussLegendre(degree))
+    pub fn galerkin(degree: usize) -> Result<Self, DiracError> {
+        Self::galerkin_with_rule(degree, Rule::GaussLegendre(degree))
     }
 
     fn build(degree: usize, rule: Rule) -> Self {
@@ -221,13 +229,62 @@ impl Quadrature {
         (xi, rate)
     }
 
-    /// A short name in the attribute's syntax: `midpoint`, `trapezoid` or `galerkin(s, rule(r))`.
+    /// The path through `0, points[0], …, points[s−1]` (equispaced in `[0, 1]`) at any fraction
+    /// `theta` of the step: its value and its rate in time (dense output).
+    pub(crate) fn path_through<const N: usize>(
+        &self,
+        theta: f64,
+        points: &[SVector<f64, N>],
+        h: f64,
+    ) -> (SVector<f64, N>, SVector<f64, N>) {
+        let grid: Vec<f64> = (0..=self.degree)
+            .map(|j| j as f64 / self.degree as f64)
+            .collect();
+        let mut xi = SVector::zeros();
+        let mut rate = SVector::zeros();
+        for (j, z) in points.iter().enumerate() {
+            xi += z * lagrange(&grid, j + 1, theta);
+            rate += z * (lagrange_derivative(&grid, j + 1, theta) / h);
+        }
+        (xi, rate)
+    }
+
+    /// A short name in the attribute's syntax: `midpoint`, `trapezoid`, `galerkin(s)` or
+    /// `galerkin(s, rule(r))`.
     pub fn name(&self) -> String {
         match (self.degree, self.rule) {
             (1, Rule::GaussLegendre(1)) => "midpoint".into(),
             (1, Rule::GaussLobatto(2)) => "trapezoid".into(),
+            (s, Rule::GaussLegendre(r)) if s == r => format!("galerkin({s})"),
             (s, Rule::GaussLegendre(r)) => format!("galerkin({s}, gauss_legendre({r}))"),
             (s, Rule::GaussLobatto(r)) => format!("galerkin({s}, gauss_lobatto({r}))"),
+        }
+    }
+}
+
+/// What a quadrature is serialized as: its degree and rule (the tables are rebuilt, and checked,
+/// when it is read back).
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+struct QuadratureSpec {
+    degree: usize,
+    rule: Rule,
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<QuadratureSpec> for Quadrature {
+    type Error = DiracError;
+    fn try_from(spec: QuadratureSpec) -> Result<Self, DiracError> {
+        Self::galerkin_with_rule(spec.degree, spec.rule)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<Quadrature> for QuadratureSpec {
+    fn from(quadrature: Quadrature) -> Self {
+        Self {
+            degree: quadrature.degree,
+            rule: quadrature.rule,
         }
     }
 }
@@ -342,7 +399,7 @@ mod tests {
     #[test]
     fn gauss_legendre_is_exact_to_degree_2r_minus_1() {
         for r in 1..=8 {
-            let q = Quadrature::galerkin(1, Rule::GaussLegendre(r)).unwrap();
+            let q = Quadrature::galerkin_with_rule(1, Rule::GaussLegendre(r)).unwrap();
             for k in 0..(2 * r as i32) {
                 let exact = 1.0 / (k as f64 + 1.0);
                 assert!((integrate(&q, k) - exact).abs() < 1e-14, "r={r} k={k}");
@@ -359,7 +416,7 @@ mod tests {
     #[test]
     fn gauss_lobatto_is_exact_to_degree_2r_minus_3() {
         for r in 2..=8 {
-            let q = Quadrature::galerkin(1, Rule::GaussLobatto(r)).unwrap();
+            let q = Quadrature::galerkin_with_rule(1, Rule::GaussLobatto(r)).unwrap();
             assert_eq!(q.nodes()[0], 0.0);
             assert!((q.nodes()[r - 1] - 1.0).abs() < 1e-15);
             for k in 0..(2 * r as i32 - 2) {
@@ -371,7 +428,7 @@ mod tests {
 
     #[test]
     fn basis_interpolates_polynomials_and_their_derivatives() {
-        let q = Quadrature::gauss(3).unwrap();
+        let q = Quadrature::galerkin(3).unwrap();
         // p(t) = 1 + 2t − t³ sampled at 0, 1/3, 2/3, 1.
         let p = |t: f64| 1.0 + 2.0 * t - t.powi(3);
         let dp = |t: f64| 2.0 - 3.0 * t * t;
@@ -398,9 +455,9 @@ mod tests {
 
     #[test]
     fn underdetermined_and_oversized_rules_are_rejected() {
-        assert!(Quadrature::galerkin(0, Rule::GaussLegendre(1)).is_err());
-        assert!(Quadrature::galerkin(2, Rule::GaussLobatto(2)).is_err());
-        assert!(Quadrature::galerkin(2, Rule::GaussLegendre(MAX_NODES + 1)).is_err());
-        assert!(Quadrature::galerkin(MAX_DEGREE + 1, Rule::GaussLegendre(9)).is_err());
+        assert!(Quadrature::galerkin_with_rule(0, Rule::GaussLegendre(1)).is_err());
+        assert!(Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(2)).is_err());
+        assert!(Quadrature::galerkin_with_rule(2, Rule::GaussLegendre(MAX_NODES + 1)).is_err());
+        assert!(Quadrature::galerkin_with_rule(MAX_DEGREE + 1, Rule::GaussLegendre(9)).is_err());
     }
 }

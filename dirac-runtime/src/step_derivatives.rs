@@ -100,7 +100,7 @@ impl<const N: usize> StepDerivatives<N> {
 ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
 ///     }
 /// }
-/// let mut stepper = Stepper::new(Oscillator, Quadrature::gauss(2)?, 0.1)?;
+/// let mut stepper = Stepper::new(Oscillator, Quadrature::galerkin(2)?, 0.1)?;
 /// stepper.start_from_velocity(vector![1.0], vector![0.3])?;
 /// let (_, hessians) = stepper.step_second_order()?;
 /// assert!(hessians.q[0].amax() < 1e-14 && hessians.p[0].amax() < 1e-14);

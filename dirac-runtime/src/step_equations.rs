@@ -10,6 +10,7 @@
 
 use nalgebra::{DMatrix, DVector, SVector};
 
+use crate::dense_output::Sample;
 use crate::error::DiracError;
 use crate::newton::{Newton, NewtonFailure};
 use crate::step_derivatives::StepDerivatives;
@@ -107,6 +108,11 @@ pub trait StepEquations<const N: usize> {
     /// The step size.
     fn h(&self) -> f64;
 
+    /// The method, for a trajectory's metadata (by default [`NAME`](Self::NAME)).
+    fn method(&self) -> String {
+        Self::NAME.to_string()
+    }
+
     /// Number of unknowns of a step (read again after [`begin`](Self::begin): it may depend on
     /// what the equations find at the start of a run).
     fn unknowns(&self) -> usize;
@@ -196,6 +202,15 @@ pub trait StepEquations<const N: usize> {
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, NewtonFailure>;
+
+    /// Dense output: the solution at fraction `theta ∈ [0, 1]` of the step between `ends` (the
+    /// state it started from and the one it reached, with their exact velocities) solved by `x`
+    /// (see [`dense_output`](crate::dense_output)). `None` where the equations have no path to
+    /// interpolate (the default): the stepper then refuses dense output with `Unsupported`.
+    fn dense(&self, ends: [&Sample<N>; 2], x: &DVector<f64>, theta: f64) -> Option<Sample<N>> {
+        let _ = (ends, x, theta);
+        None
+    }
 
     /// The energy at position `q` with velocity `v` and momentum `p`.
     fn energy(&self, q: &SVector<f64, N>, p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64;

@@ -7,9 +7,12 @@
 //! p_{k+1} = D_2 L_d(q_k, q_{k+1})
 //! ```
 //!
-//! A failed step returns an error and changes nothing.
+//! A failed step returns an error and changes nothing. Runs over a time span, with saved
+//! times, events and an observer, are in [`integrate`](self::integrate).
 
 use std::marker::PhantomData;
+
+mod integrate;
 
 use nalgebra::{DVector, SVector};
 
@@ -27,7 +30,7 @@ use crate::quadrature::Quadrature;
 use crate::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
-use crate::trajectory::{Interrupted, Trajectory};
+use crate::trajectory::{Metadata, Trajectory};
 
 /// The relative consistency an initial state must have with the model's constraints, at the
 /// default solver tolerance.
@@ -71,7 +74,7 @@ struct Proposal<const N: usize> {
 ///     }
 /// }
 ///
-/// let mut stepper = Stepper::new(Oscillator { m: 1.0, k: 0.5 }, Quadrature::gauss(2)?, 0.1)?;
+/// let mut stepper = Stepper::new(Oscillator { m: 1.0, k: 0.5 }, Quadrature::galerkin(2)?, 0.1)?;
 /// stepper.start_from_momentum(vector![0.5], vector![0.0])?;
 /// let trajectory = stepper.run(10)?;
 /// let exact = 0.5 * 0.5_f64.sqrt().cos();
@@ -86,6 +89,10 @@ pub struct Stepper<S, const N: usize, E = EulerLagrange<S, N, Euclidean>> {
     /// sample).
     velocity_newton: Newton,
     state: Option<State<N>>,
+    /// The state the last step started from (none before the first step of a run).
+    before: Option<State<N>>,
+    /// The time the next start from a position, velocity or momentum begins at.
+    initial_time: f64,
     /// Time of the initial state.
     start: f64,
     /// The initial state, which the equations examined when the run began.
@@ -143,7 +150,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         self
     }
 
-    /// Starts from position `q0` and velocity `v0` at `t = 0`, with `p0 = ∂L/∂v(q0, v0)`.
+    /// Starts from position `q0` and velocity `v0` at the [start time](Self::with_start_time), with `p0 = ∂L/∂v(q0, v0)`.
     /// Fails if `(q0, v0)` violates a constraint, including the hidden constraints of
     /// coordinates without kinetic energy.
     pub fn start_from_velocity(
@@ -155,11 +162,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         check_finite(self.system(), "initial velocity", &v0)?;
         let p0 = legendre::momentum(self.system(), &q0, &v0);
         check_finite(self.system(), "initial momentum", &p0)?;
-        self.start_from_state(State::new(0.0, q0, p0, v0))
+        self.start_from_state(State::new(self.initial_time, q0, p0, v0))
     }
 
     /// Starts a Lagrangian linear in the velocities, `L = ϑ(q)·v − H(q)`, from its position
-    /// alone at `t = 0`: its momentum is `ϑ(q0)` and its velocity solves its first-order
+    /// alone at the [start time](Self::with_start_time): its momentum is `ϑ(q0)` and its velocity solves its first-order
     /// equations `(ϑ'ᵀ − ϑ') v = ∇H`. Fails for a model with kinetic energy (whose state needs a
     /// velocity or momentum too) or with constraints.
     ///
@@ -190,13 +197,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
             ));
         }
         let theta = legendre::momentum(self.system(), &q0, &zero);
-        let v0 = self.velocity_at(0.0, &q0, &theta, &zero, false)?;
+        let t0 = self.initial_time;
+        let v0 = self.velocity_at(t0, &q0, &theta, &zero, false)?;
         let p0 = legendre::momentum(self.system(), &q0, &v0);
         check_finite(self.system(), "initial momentum", &p0)?;
-        self.start_from_state(State::new(0.0, q0, p0, v0))
+        self.start_from_state(State::new(t0, q0, p0, v0))
     }
 
-    /// Starts from position `q0` and momentum `p0` at `t = 0`. The velocity is found by a
+    /// Starts from position `q0` and momentum `p0` at the [start time](Self::with_start_time). The velocity is found by a
     /// globalised Newton solve of `∂L/∂v(q0, v) = p0` from `v = 0`; when that fails (several
     /// velocities share the momentum, or `v = 0` is far from the answer), use
     /// [`start_from_momentum_near`](Self::start_from_momentum_near).
@@ -208,7 +216,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         self.start_from_momentum_near(q0, p0, SVector::zeros())
     }
 
-    /// Starts from position `q0` and momentum `p0` at `t = 0`, solving for the velocity from
+    /// Starts from position `q0` and momentum `p0` at the [start time](Self::with_start_time), solving for the velocity from
     /// the guess `v_guess`.
     pub fn start_from_momentum_near(
         &mut self,
@@ -219,8 +227,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         check_finite(self.system(), "initial position", &q0)?;
         check_finite(self.system(), "initial momentum", &p0)?;
         check_finite(self.system(), "velocity guess", &v_guess)?;
-        let v0 = self.velocity_at(0.0, &q0, &p0, &v_guess, false)?;
-        self.start_from_state(State::new(0.0, q0, p0, v0))
+        let t0 = self.initial_time;
+        let v0 = self.velocity_at(t0, &q0, &p0, &v_guess, false)?;
+        self.start_from_state(State::new(t0, q0, p0, v0))
     }
 
     /// Advances one step and returns the first and second derivatives of the step map at the
@@ -263,7 +272,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     ///     }
     /// }
     /// let h = |q: &SVector<f64, 2>| q[0] + q[1] - q[0].ln() - 2.0 * q[1].ln();
-    /// let mut stepper = Stepper::new(LotkaVolterra, Quadrature::gauss(2)?, 0.05)?
+    /// let mut stepper = Stepper::new(LotkaVolterra, Quadrature::galerkin(2)?, 0.05)?
     ///     .with_first_order_scheme(FirstOrderScheme::SymmetricProjection);
     /// let q0 = vector![2.0, 1.0];
     /// stepper.start_from_position(q0)?;
@@ -383,6 +392,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             equations,
             newton,
             state: None,
+            before: None,
+            initial_time: 0.0,
             start: 0.0,
             origin: None,
             steps: 0,
@@ -394,6 +405,30 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             violation: 0.0,
             system: PhantomData,
         })
+    }
+
+    /// Sets the time the next start from a position, velocity or momentum begins at (0 by
+    /// default; [`start_from_state`](Self::start_from_state) takes the state's own time).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Free;
+    /// # impl DiracSystem<1> for Free {
+    /// #     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         v[0] * v[0] * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Free, Quadrature::midpoint(), 0.25)?.with_start_time(10.0);
+    /// stepper.start_from_velocity(vector![0.0], vector![1.0])?;
+    /// let trajectory = stepper.run_until(11.0)?;
+    /// assert_eq!(trajectory.t().last(), Some(&11.0));
+    /// assert_eq!(trajectory.len(), 5);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn with_start_time(mut self, t0: f64) -> Self {
+        self.initial_time = t0;
+        self
     }
 
     /// Replaces the Newton options (tolerances, iteration cap, root acceptance); fails on
@@ -432,14 +467,13 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         solved.map_err(|f| self.failure(Problem::Velocity, f))
     }
 
-    /// The energy of a recorded `state`, reached after `steps` steps, with its velocity solved
-    /// from `guess` in the stepper's own workspace.
-    fn sample_energy(
+    /// The velocity of a recorded `state`, reached after `steps` steps, solved from `guess` in
+    /// the stepper's own workspace.
+    fn sample_velocity(
         &mut self,
         state: &State<N>,
         guess: &SVector<f64, N>,
-        steps: u64,
-    ) -> Result<f64, DiracError> {
+    ) -> Result<SVector<f64, N>, DiracError> {
         let unknowns = self.equations.velocity_unknowns();
         if self.velocity_newton.unknowns() != unknowns {
             self.velocity_newton = Newton::new(unknowns, velocity_options(self.newton.options()))?;
@@ -448,8 +482,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let solved = self
             .equations
             .velocity_in_run(&mut self.velocity_newton, t, q, p, guess);
-        let v = solved.map_err(|f| self.failure(Problem::Velocity, f))?;
-        self.energy_at(state, &v, steps)
+        solved.map_err(|f| self.failure(Problem::Velocity, f))
     }
 
     /// Starts from `state` after the equations have checked it (see
@@ -508,6 +541,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         self.start = state.t;
         self.origin = Some(state);
         self.state = Some(state);
+        self.before = None;
         self.steps = 0;
         self.previous = None;
         self.earlier = None;
@@ -578,82 +612,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         }
         self.violation = proposal.violation;
         self.steps += 1;
-        self.state = Some(proposal.next);
+        self.before = self.state.replace(proposal.next);
         self.report = Some(proposal.report);
-    }
-
-    /// Runs `steps` steps and returns the trajectory, starting with the current state.
-    ///
-    /// A step that fails (or whose energy cannot be computed) ends the run with
-    /// [`Interrupted`], which keeps the trajectory up to the last good step, where the stepper
-    /// stays; `?` turns it into its [`DiracError`].
-    pub fn run(&mut self, steps: usize) -> Result<Trajectory<N>, Box<Interrupted<N>>> {
-        let mut trajectory = self.trajectory();
-        match self.record(&mut trajectory, steps, 1) {
-            Ok(()) => Ok(trajectory),
-            Err(error) => Err(Box::new(Interrupted { trajectory, error })),
-        }
-    }
-
-    /// Appends the current state and then every `every`-th of the next `steps` states to
-    /// `trajectory`. On error the stepper stays at the last good step and the trajectory keeps
-    /// every sample recorded up to it; a sampled step is made current only once its energy could
-    /// be computed (unsampled steps are not asked for their energy).
-    pub fn record(
-        &mut self,
-        trajectory: &mut Trajectory<N>,
-        steps: usize,
-        every: usize,
-    ) -> Result<(), DiracError> {
-        let state = self.state.ok_or(DiracError::NotStarted)?;
-        if trajectory.multiplier_names().len() != self.multipliers.len() {
-            return Err(DiracError::Dimension(format!(
-                "the trajectory records {} multipliers and the system has {}; start it with \
-                 Stepper::trajectory",
-                trajectory.multiplier_names().len(),
-                self.multipliers.len()
-            )));
-        }
-        let every = every.max(1);
-        let energy = self.sample_energy(&state, &state.velocity, self.steps)?;
-        self.push_sample(trajectory, &state, energy)?;
-        for k in 1..=steps {
-            let before = self.state.ok_or(DiracError::NotStarted)?;
-            let proposal = self.solve_step()?;
-            if k % every == 0 {
-                // The step's velocity hint is its mean velocity, half a step behind its end:
-                // extrapolated by half the change since the last one, it is O(h²) off.
-                let hint = proposal.next.velocity;
-                let guess = hint + (hint - before.velocity) * 0.5;
-                let energy = self.sample_energy(&proposal.next, &guess, self.steps + 1)?;
-                let next = proposal.next;
-                self.accept(proposal);
-                self.push_sample(trajectory, &next, energy)?;
-            } else {
-                self.accept(proposal);
-            }
-        }
-        Ok(())
-    }
-
-    fn push_sample(
-        &self,
-        trajectory: &mut Trajectory<N>,
-        state: &State<N>,
-        energy: f64,
-    ) -> Result<(), DiracError> {
-        if self.multipliers.is_empty() {
-            trajectory.push(state.t, state.q, state.p, energy)
-        } else {
-            trajectory.push_constrained(
-                state.t,
-                state.q,
-                state.p,
-                energy,
-                self.violation,
-                self.multipliers(),
-            )
-        }
     }
 
     /// Multipliers of the last step: one per constraint one-form, then one per holonomic
@@ -747,12 +707,23 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// An empty trajectory with this system's coordinate (and multiplier) columns.
     pub fn trajectory(&self) -> Trajectory<N> {
         let names = self.coordinate_names();
+        let options = self.newton.options();
+        let model = std::any::type_name::<E::System>();
+        let metadata = Metadata {
+            model: model.rsplit("::").next().unwrap_or(model).to_string(),
+            quadrature: self.equations.method(),
+            h: self.h(),
+            t0: self.state.map_or(self.initial_time, |s| s.t),
+            residual_tolerance: options.residual_tolerance,
+            step_tolerance: options.step_tolerance,
+        };
         if self.multipliers.is_empty() {
             Trajectory::new(names)
         } else {
             Trajectory::with_multipliers(names, self.equations.multiplier_names())
         }
         .expect("one name per coordinate, from coordinate_names")
+        .with_metadata(metadata)
     }
 
     /// Coordinate names, from the system.

@@ -1,4 +1,5 @@
-//! Recorded trajectories: time, positions, momenta and energy, with CSV output.
+//! Recorded trajectories: time, positions, velocities, momenta and energy, with the run's
+//! metadata, columns by name and CSV output.
 
 use std::io::Write;
 use std::path::Path;
@@ -7,28 +8,53 @@ use nalgebra::SVector;
 
 use thiserror::Error;
 
+use crate::dense_output::Sample;
 use crate::error::DiracError;
+use crate::event::Crossing;
 
-/// A sampled trajectory `(t, q, p, E)` of a system with `N` coordinates.
+/// What produced a trajectory: the model, the method and the solver's tolerances.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Metadata {
+    /// The model's type name.
+    pub model: String,
+    /// The quadrature, in the attribute's syntax ([`Quadrature::name`](crate::Quadrature::name)).
+    pub quadrature: String,
+    /// The step size.
+    pub h: f64,
+    /// The time the run started from.
+    pub t0: f64,
+    /// Newton's relative residual tolerance.
+    pub residual_tolerance: f64,
+    /// Newton's relative update tolerance.
+    pub step_tolerance: f64,
+}
+
+/// A sampled trajectory `(t, q, v, p, E)` of a system with `N` coordinates.
 ///
 /// ```
-/// use dirac_runtime::Trajectory;
+/// use dirac_runtime::{Sample, Trajectory};
 /// use nalgebra::vector;
 /// let mut trajectory = Trajectory::new(vec!["x".into()])?;
 /// assert!(Trajectory::<1>::new(vec![]).is_err()); // one name per coordinate
-/// trajectory.push(0.0, vector![1.0], vector![0.0], 0.5)?;
-/// trajectory.push(0.1, vector![0.99], vector![-0.1], 0.5001)?;
+/// let sample = |t, q, v| Sample { t, q: vector![q], v: vector![v], p: vector![v] };
+/// trajectory.push(&sample(0.0, 1.0, 0.0), 0.5)?;
+/// trajectory.push(&sample(0.1, 0.99, -0.1), 0.5001)?;
 /// let mut csv = Vec::new();
 /// trajectory.write_csv(&mut csv)?;
-/// assert!(String::from_utf8(csv).unwrap().starts_with("t,x,p_x,energy\n0,1,0,0.5\n"));
+/// assert!(String::from_utf8(csv).unwrap().starts_with("t,x,v_x,p_x,energy\n0,1,0,0,0.5\n"));
 /// assert!((trajectory.max_energy_error() - 1e-4).abs() < 1e-12);
+/// assert_eq!(trajectory.column("v_x"), Some(vec![0.0, -0.1]));
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Trajectory<const N: usize> {
     names: Vec<String>,
+    metadata: Option<Metadata>,
     t: Vec<f64>,
     q: Vec<SVector<f64, N>>,
+    v: Vec<SVector<f64, N>>,
     p: Vec<SVector<f64, N>>,
     energy: Vec<f64>,
     /// Names of the multipliers (empty for an unconstrained system).
@@ -57,8 +83,10 @@ impl<const N: usize> Trajectory<N> {
         }
         Ok(Self {
             names,
+            metadata: None,
             t: Vec::new(),
             q: Vec::new(),
+            v: Vec::new(),
             p: Vec::new(),
             energy: Vec::new(),
             multiplier_names,
@@ -67,12 +95,23 @@ impl<const N: usize> Trajectory<N> {
         })
     }
 
+    /// The same trajectory, recording what produced it.
+    pub fn with_metadata(self, metadata: Metadata) -> Self {
+        Self {
+            metadata: Some(metadata),
+            ..self
+        }
+    }
+
+    /// What produced the trajectory (set by [`Stepper`](crate::Stepper)'s runs).
+    pub fn metadata(&self) -> Option<&Metadata> {
+        self.metadata.as_ref()
+    }
+
     /// Appends a sample of a constrained system: one multiplier per name given at construction.
     pub fn push_constrained(
         &mut self,
-        t: f64,
-        q: SVector<f64, N>,
-        p: SVector<f64, N>,
+        sample: &Sample<N>,
         energy: f64,
         violation: f64,
         multipliers: &[f64],
@@ -84,7 +123,7 @@ impl<const N: usize> Trajectory<N> {
                 multipliers.len()
             )));
         }
-        self.append(t, q, p, energy);
+        self.append(sample, energy);
         self.violation.push(violation);
         self.multipliers.push(multipliers.to_vec());
         Ok(())
@@ -112,27 +151,22 @@ impl<const N: usize> Trajectory<N> {
 
     /// Appends a sample of an unconstrained system; a trajectory that records multipliers takes
     /// [`push_constrained`](Self::push_constrained) instead (an error here).
-    pub fn push(
-        &mut self,
-        t: f64,
-        q: SVector<f64, N>,
-        p: SVector<f64, N>,
-        energy: f64,
-    ) -> Result<(), DiracError> {
+    pub fn push(&mut self, sample: &Sample<N>, energy: f64) -> Result<(), DiracError> {
         if !self.multiplier_names.is_empty() {
             return Err(DiracError::Dimension(format!(
                 "the trajectory records {} multipliers: use push_constrained",
                 self.multiplier_names.len()
             )));
         }
-        self.append(t, q, p, energy);
+        self.append(sample, energy);
         Ok(())
     }
 
-    fn append(&mut self, t: f64, q: SVector<f64, N>, p: SVector<f64, N>, energy: f64) {
-        self.t.push(t);
-        self.q.push(q);
-        self.p.push(p);
+    fn append(&mut self, sample: &Sample<N>, energy: f64) {
+        self.t.push(sample.t);
+        self.q.push(sample.q);
+        self.v.push(sample.v);
+        self.p.push(sample.p);
         self.energy.push(energy);
     }
 
@@ -161,6 +195,11 @@ impl<const N: usize> Trajectory<N> {
         &self.q
     }
 
+    /// Velocities.
+    pub fn v(&self) -> &[SVector<f64, N>] {
+        &self.v
+    }
+
     /// Momenta.
     pub fn p(&self) -> &[SVector<f64, N>] {
         &self.p
@@ -171,6 +210,16 @@ impl<const N: usize> Trajectory<N> {
         &self.energy
     }
 
+    /// Sample `k`.
+    pub fn sample(&self, k: usize) -> Option<Sample<N>> {
+        (k < self.len()).then(|| Sample {
+            t: self.t[k],
+            q: self.q[k],
+            v: self.v[k],
+            p: self.p[k],
+        })
+    }
+
     /// `max_k |E_k − E_0|`: the largest energy error against the first sample (0 when empty).
     pub fn max_energy_error(&self) -> f64 {
         let Some(&e0) = self.energy.first() else {
@@ -179,38 +228,50 @@ impl<const N: usize> Trajectory<N> {
         self.energy.iter().fold(0.0, |m, e| m.max((e - e0).abs()))
     }
 
-    /// Writes `t, <coordinates>, p_<coordinates>, energy` as CSV with a header row.
+    /// The names of the columns, in the CSV's order: `t`, the coordinates, `v_<coordinate>`,
+    /// `p_<coordinate>`, `energy`, and for a constrained system `constraint_violation` and the
+    /// multipliers.
+    pub fn column_names(&self) -> Vec<String> {
+        let constrained = !self.multiplier_names.is_empty();
+        std::iter::once("t".to_string())
+            .chain(self.names.iter().cloned())
+            .chain(self.names.iter().map(|n| format!("v_{n}")))
+            .chain(self.names.iter().map(|n| format!("p_{n}")))
+            .chain(std::iter::once("energy".to_string()))
+            .chain(constrained.then(|| "constraint_violation".to_string()))
+            .chain(self.multiplier_names.iter().cloned())
+            .collect()
+    }
+
+    /// The column called `name` (one of [`column_names`](Self::column_names)), `None` if there
+    /// is none.
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let index = self.column_names().iter().position(|c| c == name)?;
+        Some((0..self.len()).map(|k| self.row(k)[index]).collect())
+    }
+
+    /// Row `k` in the order of [`column_names`](Self::column_names).
+    fn row(&self, k: usize) -> Vec<f64> {
+        let mut row = Vec::with_capacity(3 * N + 3 + self.multiplier_names.len());
+        row.push(self.t[k]);
+        row.extend(self.q[k].iter());
+        row.extend(self.v[k].iter());
+        row.extend(self.p[k].iter());
+        row.push(self.energy[k]);
+        if let (Some(v), Some(m)) = (self.violation.get(k), self.multipliers.get(k)) {
+            row.push(*v);
+            row.extend(m.iter());
+        }
+        row
+    }
+
+    /// Writes the columns ([`column_names`](Self::column_names)) as CSV with a header row.
     pub fn write_csv<W: Write>(&self, writer: W) -> Result<(), DiracError> {
         let io = |e: csv::Error| DiracError::Io(e.to_string());
         let mut w = csv::Writer::from_writer(writer);
-        let header = std::iter::once("t".to_string())
-            .chain(self.names.iter().cloned())
-            .chain(self.names.iter().map(|n| format!("p_{n}")))
-            .chain(std::iter::once("energy".to_string()))
-            .chain(
-                self.violation
-                    .first()
-                    .map(|_| "constraint_violation".to_string()),
-            )
-            .chain((0..self.multipliers.first().map_or(0, Vec::len)).map(|i| {
-                self.multiplier_names
-                    .get(i)
-                    .cloned()
-                    .unwrap_or_else(|| format!("mu_{i}"))
-            }));
-        w.write_record(header).map_err(io)?;
-        let mut row = Vec::with_capacity(2 * N + 2);
+        w.write_record(self.column_names()).map_err(io)?;
         for k in 0..self.len() {
-            row.clear();
-            row.push(self.t[k]);
-            row.extend(self.q[k].iter());
-            row.extend(self.p[k].iter());
-            row.push(self.energy[k]);
-            if let (Some(v), Some(m)) = (self.violation.get(k), self.multipliers.get(k)) {
-                row.push(*v);
-                row.extend(m.iter());
-            }
-            w.write_record(row.iter().map(|x| x.to_string()))
+            w.write_record(self.row(k).iter().map(|x| x.to_string()))
                 .map_err(io)?;
         }
         w.flush().map_err(|e| DiracError::Io(e.to_string()))
@@ -229,7 +290,8 @@ impl<const N: usize> Trajectory<N> {
     }
 }
 
-/// A run that stopped at a failing step: the trajectory up to the last good step, and why.
+/// A run that stopped at a failing step: the trajectory and events up to the last good step,
+/// and why.
 ///
 /// `?` converts it into its [`DiracError`] (dropping the trajectory); match on it to keep the
 /// steps made.
@@ -256,6 +318,8 @@ impl<const N: usize> Trajectory<N> {
 pub struct Interrupted<const N: usize> {
     /// Every sample recorded before the failing step.
     pub trajectory: Trajectory<N>,
+    /// The event crossings located before the failing step.
+    pub events: Vec<Crossing<N>>,
     /// Why the step failed.
     #[source]
     pub error: DiracError,

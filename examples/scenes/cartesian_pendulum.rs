@@ -35,11 +35,11 @@ pub fn angle(q: &SVector<f64, 2>) -> f64 {
 }
 
 pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
-    let (h, steps) = (0.05, 2000);
+    let (h, t_end) = (0.05, 100.0);
     let name = quadrature.name();
     let mut stepper = Stepper::new(SCENE, quadrature, h)?;
     stepper.start_from_velocity(q0(1.0), SVector::zeros())?;
-    let (trajectory, wall) = timed(&mut stepper, steps, 1)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
     trajectory.save_csv(format!(
         "output/cartesian_pendulum_{}.csv",
         super::oscillator::file_name(&name)
@@ -49,7 +49,7 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         scene: "pendulum (x, y)",
         quadrature: name,
         h,
-        steps,
+        steps: stepper.steps(),
         max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!(

@@ -94,11 +94,11 @@ pub fn lc_at_10(
 }
 
 pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
-    let (h, steps) = (0.01, 1000);
+    let (h, t_end) = (0.01, 10.0);
     let name = quadrature.name();
     let mut stepper = Stepper::new(LC, quadrature.clone(), h)?;
     stepper.start_from_velocity(q0(), SVector::zeros())?;
-    let (trajectory, wall) = timed(&mut stepper, steps, 1)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
     trajectory.save_csv(format!(
         "output/lc_circuit_{}.csv",
         super::oscillator::file_name(&name)
@@ -108,7 +108,7 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         scene: "LC circuit",
         quadrature: name,
         h,
-        steps,
+        steps: stepper.steps(),
         max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!(
@@ -119,11 +119,11 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
 }
 
 pub fn rlc_report(quadrature: Quadrature) -> Result<Report, DiracError> {
-    let (h, steps) = (0.01, 1000);
+    let (h, t_end) = (0.01, 10.0);
     let name = quadrature.name();
     let mut stepper = Stepper::new(RLC, quadrature, h)?;
     stepper.start_from_velocity(q0(), SVector::zeros())?;
-    let (trajectory, wall) = timed(&mut stepper, steps, 1)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
     trajectory.save_csv(format!(
         "output/rlc_circuit_{}.csv",
         super::oscillator::file_name(&name)
@@ -133,7 +133,7 @@ pub fn rlc_report(quadrature: Quadrature) -> Result<Report, DiracError> {
         scene: "RLC circuit",
         quadrature: name,
         h,
-        steps,
+        steps: stepper.steps(),
         max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!("|q(10) − exact| = {error:.2e} (energy decays through R)"),
@@ -179,7 +179,7 @@ pub fn driven_report() -> Result<Report, DiracError> {
         scene: "driven RLC",
         quadrature: "midpoint".into(),
         h,
-        steps: (80.0 / h) as usize,
+        steps: (80.0 / h) as u64,
         max_energy_error: None,
         wall: start.elapsed(),
         check: format!(

@@ -58,10 +58,10 @@ pub fn state_at(quadrature: Quadrature, h: f64, t: f64) -> Result<SVector<f64, 4
 }
 
 pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
-    let (h, steps) = (0.01, 1000);
+    let (h, t_end) = (0.01, 10.0);
     let name = quadrature.name();
     let mut stepper = stepper(quadrature, h)?;
-    let (trajectory, wall) = timed(&mut stepper, steps, 1)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
     trajectory.save_csv(format!(
         "output/double_pendulum_{}.csv",
         super::oscillator::file_name(&name)
@@ -71,7 +71,7 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         scene: "double pendulum",
         quadrature: name,
         h,
-        steps,
+        steps: stepper.steps(),
         max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!("T = 10; Newton iterations on the last step: {newton}"),

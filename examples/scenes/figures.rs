@@ -48,10 +48,10 @@ fn convergence() -> Result<&'static str, Box<dyn Error>> {
     let quadratures = [
         Quadrature::midpoint(),
         Quadrature::trapezoid(),
-        Quadrature::gauss(2)?,
-        Quadrature::gauss(3)?,
-        Quadrature::galerkin(2, Rule::GaussLobatto(3))?,
-        Quadrature::galerkin(3, Rule::GaussLobatto(4))?,
+        Quadrature::galerkin(2)?,
+        Quadrature::galerkin(3)?,
+        Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3))?,
+        Quadrature::galerkin_with_rule(3, Rule::GaussLobatto(4))?,
     ];
     let mut series = Vec::new();
     for quadrature in quadratures {

@@ -31,11 +31,11 @@ pub fn angular_momentum(q: &SVector<f64, 2>, p: &SVector<f64, 2>) -> f64 {
 }
 
 pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
-    let (h, steps) = (0.01, 10_000);
+    let (h, t_end) = (0.01, 100.0);
     let name = quadrature.name();
     let mut stepper = Stepper::new(SCENE, quadrature, h)?;
     stepper.start_from_momentum(q0(), p0())?;
-    let (trajectory, wall) = timed(&mut stepper, steps, 10)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 10)?;
     trajectory.save_csv(format!(
         "output/kepler_{}.csv",
         super::oscillator::file_name(&name)
@@ -51,7 +51,7 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         scene: "kepler",
         quadrature: name,
         h,
-        steps,
+        steps: stepper.steps(),
         max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!("max relative angular momentum error = {drift:.2e}"),

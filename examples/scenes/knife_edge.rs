@@ -56,9 +56,9 @@ pub fn error_at(point: ConstraintPoint, h: f64, t: f64) -> Result<f64, DiracErro
 }
 
 pub fn report_point(point: ConstraintPoint) -> Result<Report, DiracError> {
-    let (h, steps) = (0.01, 1000);
+    let (h, t_end) = (0.01, 10.0);
     let mut stepper = stepper(point, h)?;
-    let (trajectory, wall) = timed(&mut stepper, steps, 1)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
     let name = format!("midpoint, constraint at {point:?}");
     trajectory.save_csv(format!("output/knife_edge_{point:?}.csv").to_lowercase())?;
     let drift = trajectory.energy().last().unwrap_or(&0.0) - trajectory.energy()[0];
@@ -66,7 +66,7 @@ pub fn report_point(point: ConstraintPoint) -> Result<Report, DiracError> {
         scene: "knife edge",
         quadrature: name,
         h,
-        steps,
+        steps: stepper.steps(),
         max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!(

@@ -16,6 +16,7 @@ pub mod oscillator;
 pub mod pendulum;
 pub mod plot;
 pub mod port;
+pub mod progress;
 pub mod rolling_disk;
 
 use std::time::{Duration, Instant};
@@ -28,7 +29,7 @@ pub struct Report {
     pub scene: &'static str,
     pub quadrature: String,
     pub h: f64,
-    pub steps: usize,
+    pub steps: u64,
     /// `max |E − E0|`; `None` where energy is not conserved by design (a driven system).
     pub max_energy_error: Option<f64>,
     pub wall: Duration,
@@ -36,16 +37,20 @@ pub struct Report {
     pub check: String,
 }
 
-/// Runs `stepper` for `steps` steps, recording every `every`-th state, and times it.
+/// Runs `stepper` to `t_end`, recording every `every`-th state, with a progress bar, and times it.
 pub fn timed<S: DiracSystem<N>, const N: usize>(
     stepper: &mut Stepper<S, N>,
-    steps: usize,
+    t_end: f64,
     every: usize,
 ) -> Result<(Trajectory<N>, Duration), DiracError> {
-    let mut trajectory = stepper.trajectory();
+    let bar = progress::bar(stepper.t(), t_end, stepper.h());
     let start = Instant::now();
-    stepper.record(&mut trajectory, steps, every)?;
-    Ok((trajectory, start.elapsed()))
+    let run = Run::until(t_end)
+        .every(every)
+        .observe(progress::observer(&bar));
+    let solution = stepper.solve(run)?;
+    bar.finish_and_clear();
+    Ok((solution.trajectory, start.elapsed()))
 }
 
 /// The quadratures every scene is run with in the tour: two second-order rules and the Gauss
@@ -54,8 +59,8 @@ pub fn quadratures() -> Vec<Quadrature> {
     vec![
         Quadrature::midpoint(),
         Quadrature::trapezoid(),
-        Quadrature::gauss(2).expect("degree 2 is valid"),
-        Quadrature::gauss(3).expect("degree 3 is valid"),
+        Quadrature::galerkin(2).expect("degree 2 is valid"),
+        Quadrature::galerkin(3).expect("degree 3 is valid"),
     ]
 }
 

@@ -28,7 +28,7 @@ pub fn exact(t: f64) -> f64 {
 pub fn max_error(quadrature: Quadrature, h: f64) -> Result<f64, DiracError> {
     let mut stepper = Stepper::new(SCENE, quadrature, h)?;
     stepper.start_from_momentum(vector![Q0], vector![0.0])?;
-    let trajectory = stepper.run((1.0 / h).round() as usize)?;
+    let trajectory = stepper.run_until(1.0)?;
     Ok(trajectory
         .t()
         .iter()
@@ -38,17 +38,17 @@ pub fn max_error(quadrature: Quadrature, h: f64) -> Result<f64, DiracError> {
 }
 
 pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
-    let (h, steps) = (0.1, 10);
+    let (h, t_end) = (0.1, 1.0);
     let name = quadrature.name();
     let mut stepper = Stepper::new(SCENE, quadrature.clone(), h)?;
     stepper.start_from_momentum(vector![Q0], vector![0.0])?;
-    let (trajectory, wall) = timed(&mut stepper, steps, 1)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
     trajectory.save_csv(format!("output/oscillator_{}.csv", file_name(&name)))?;
     Ok(Report {
         scene: "oscillator",
         quadrature: name,
         h,
-        steps,
+        steps: stepper.steps(),
         max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!(

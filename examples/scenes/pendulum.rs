@@ -36,11 +36,11 @@ pub fn error_at_5(quadrature: Quadrature, h: f64) -> Result<f64, DiracError> {
 }
 
 pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
-    let (h, steps) = (0.05, 20_000);
+    let (h, t_end) = (0.05, 1000.0);
     let name = quadrature.name();
     let mut stepper = Stepper::new(SCENE, quadrature.clone(), h)?;
     stepper.start_from_momentum(vector![1.0], vector![0.0])?;
-    let (trajectory, wall) = timed(&mut stepper, steps, 10)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 10)?;
     trajectory.save_csv(format!(
         "output/pendulum_{}.csv",
         super::oscillator::file_name(&name)
@@ -49,7 +49,7 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         scene: "pendulum",
         quadrature: name,
         h,
-        steps,
+        steps: stepper.steps(),
         max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!("|(q,p)(5) − exact| = {:.2e}", error_at_5(quadrature, h)?),

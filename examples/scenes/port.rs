@@ -46,11 +46,11 @@ pub fn at_20(h: f64) -> Result<(SVector<f64, 2>, f64), DiracError> {
 }
 
 pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
-    let (h, steps) = (0.01, 2000);
+    let (h, t_end) = (0.01, 20.0);
     let name = quadrature.name();
     let mut stepper = Stepper::new(SCENE, quadrature, h)?;
     stepper.start_from_velocity(q0(), SVector::zeros())?;
-    let (trajectory, wall) = timed(&mut stepper, steps, 1)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
     trajectory.save_csv(format!(
         "output/port_{}.csv",
         super::oscillator::file_name(&name)
@@ -60,7 +60,7 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
         scene: "port",
         quadrature: name,
         h,
-        steps,
+        steps: stepper.steps(),
         max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!(

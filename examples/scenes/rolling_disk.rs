@@ -58,15 +58,15 @@ pub fn stepper(quadrature: Quadrature, h: f64) -> Result<Stepper<RollingDisk, 4>
 
 /// 200 steps of h = 0.05 (T = 10) against the closed form.
 pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
-    let (h, steps) = (0.05, 200);
+    let (h, t_end) = (0.05, 10.0);
     let name = quadrature.name();
     let mut stepper = stepper(quadrature, h)?;
-    let (trajectory, wall) = timed(&mut stepper, steps, 1)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
     Ok(Report {
         scene: "rolling disk",
         quadrature: name,
         h,
-        steps,
+        steps: stepper.steps(),
         max_energy_error: Some(trajectory.max_energy_error()),
         wall,
         check: format!(

@@ -1,0 +1,322 @@
+//! Runs: many steps with what a run saves, the events it locates and its observer, and the
+//! dense output of the last step.
+
+use std::ops::ControlFlow;
+
+use nalgebra::SVector;
+
+use super::Stepper;
+use crate::dense_output::Sample;
+use crate::error::DiracError;
+use crate::event::{self, Crossing};
+use crate::run::{self, Progress, Run, Solution, Status};
+use crate::step_equations::{State, StepEquations};
+use crate::trajectory::{Interrupted, Trajectory};
+
+impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
+    /// Runs `steps` steps and returns the trajectory of every state, starting with the current
+    /// one ([`solve`](Self::solve) with [`Run::steps`]).
+    ///
+    /// A step that fails (or whose energy cannot be computed) ends the run with
+    /// [`Interrupted`], which keeps the trajectory up to the last good step, where the stepper
+    /// stays; `?` turns it into its [`DiracError`].
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Free;
+    /// # impl DiracSystem<1> for Free {
+    /// #     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         v[0] * v[0] * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Free, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![0.0], vector![1.0])?;
+    /// let trajectory = stepper.run(10)?;
+    /// assert_eq!((trajectory.len(), stepper.steps()), (11, 10));
+    /// assert!((trajectory.q()[10][0] - 1.0).abs() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn run(&mut self, steps: u64) -> Result<Trajectory<N>, Box<Interrupted<N>>> {
+        self.solve(Run::steps(steps)).map(|solution| solution.trajectory)
+    }
+
+    /// Runs to time `t_end` (the fewest whole steps that reach it; see [`Run::until`]) and
+    /// returns the trajectory of every state, starting with the current one. Failures as for
+    /// [`run`](Self::run).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Free;
+    /// # impl DiracSystem<1> for Free {
+    /// #     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         v[0] * v[0] * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Free, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![0.0], vector![1.0])?;
+    /// let trajectory = stepper.run_until(1.05)?; // 11 steps: the first time ≥ 1.05 is 1.1
+    /// assert_eq!(stepper.steps(), 11);
+    /// assert!((stepper.t() - 1.1).abs() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn run_until(&mut self, t_end: f64) -> Result<Trajectory<N>, Box<Interrupted<N>>> {
+        self.solve(Run::until(t_end))
+            .map(|solution| solution.trajectory)
+    }
+
+    /// Carries out `run` from the current state: its steps, saved samples, events and observer
+    /// (see [`Run`]). A failing step ends it with [`Interrupted`], which keeps the samples and
+    /// events up to the last good step, where the stepper stays; a sampled step is made
+    /// current only once its energy could be computed. An invalid run (a span that ends
+    /// before the current time, save times outside it) is refused before the first step.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Event, Quadrature, Run, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// struct Oscillator;
+    /// impl DiracSystem<1> for Oscillator {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::galerkin(3)?, 0.2)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// // q = cos t crosses zero at π/2 + kπ.
+    /// let zero = Event::new("q = 0", |_t, q: &SVector<f64, 1>, _v: &SVector<f64, 1>| q[0]);
+    /// let solution = stepper.solve(Run::until(10.0).every(10).event(zero))?;
+    /// let times: Vec<f64> = solution.events.iter().map(|c| c.sample.t).collect();
+    /// assert_eq!(times.len(), 3);
+    /// assert!((times[1] - 1.5 * std::f64::consts::PI).abs() < 1e-6);
+    /// assert_eq!(solution.trajectory.len(), 6); // t = 0, 2, 4, 6, 8, 10
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn solve(&mut self, run: Run<'_, N>) -> Result<Solution<N>, Box<Interrupted<N>>> {
+        let mut solution = Solution {
+            trajectory: self.trajectory(),
+            events: Vec::new(),
+            status: Status::Reached,
+        };
+        match self.carry_out(run, &mut solution) {
+            Ok(()) => Ok(solution),
+            Err(error) => Err(Box::new(Interrupted {
+                trajectory: solution.trajectory,
+                events: solution.events,
+                error,
+            })),
+        }
+    }
+
+    /// The solution at time `t` inside the last step (dense output, see
+    /// [`dense_output`](crate::dense_output)): its velocity is the time derivative of its
+    /// position, and at the step's ends it is the stepper's state. An error before the first
+    /// step of a run, for a time outside the last step, or for step equations without dense
+    /// output.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::galerkin(2)?, 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.step()?;
+    /// let inside = stepper.interpolate(0.05)?;
+    /// assert!((inside.q[0] - 0.05_f64.cos()).abs() < 1e-6);
+    /// assert!((inside.v[0] + 0.05_f64.sin()).abs() < 1e-5);
+    /// assert!(stepper.interpolate(0.2).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn interpolate(&self, t: f64) -> Result<Sample<N>, DiracError> {
+        let after = self.state.ok_or(DiracError::NotStarted)?;
+        let before = self.before.ok_or_else(|| {
+            DiracError::InvalidRun("dense output needs a step: none was taken yet".into())
+        })?;
+        let h = self.h();
+        let slack = 1e-12 * (after.t.abs() + h);
+        if !(t >= before.t - slack && t <= after.t + slack) {
+            return Err(DiracError::InvalidRun(format!(
+                "t = {t} lies outside the last step [{}, {}]",
+                before.t, after.t
+            )));
+        }
+        let ends = [before, after].map(|state| {
+            let v = self.velocity_at(state.t, &state.q, &state.p, &state.velocity, true)?;
+            Ok::<_, DiracError>(sample(&state, v))
+        });
+        let [a, b] = ends;
+        let (a, b) = (a?, b?);
+        let mut inside = self.dense_sample(&a, &b, run::fraction(&a, t, h))?;
+        inside.t = t;
+        Ok(inside)
+    }
+
+    /// The dense output at fraction `theta` of the last step, between the samples `a` and `b`.
+    fn dense_sample(
+        &self,
+        a: &Sample<N>,
+        b: &Sample<N>,
+        theta: f64,
+    ) -> Result<Sample<N>, DiracError> {
+        let x = self.previous.as_ref().ok_or(DiracError::NotStarted)?;
+        self.equations
+            .dense([a, b], x, theta)
+            .ok_or_else(|| DiracError::Unsupported(format!("dense output of {}", E::NAME)))
+    }
+
+    /// The run's loop; `solution` keeps what was saved whatever happens.
+    fn carry_out(&mut self, mut run: Run<'_, N>, solution: &mut Solution<N>) -> Result<(), DiracError> {
+        let start = self.state.ok_or(DiracError::NotStarted)?;
+        let h = self.h();
+        let (total, saveat) = run.plan(start.t, h)?;
+        let saveat = saveat.map(<[f64]>::to_vec);
+        let (dense, every) = (run.dense(), run.stride() as u64);
+        let trajectory = &mut solution.trajectory;
+        let v = self.sample_velocity(&start, &start.velocity)?;
+        let mut current = sample(&start, v);
+        let mut saved = 0;
+        match &saveat {
+            None => self.save(trajectory, &current, None)?,
+            Some(times) => {
+                while saved < times.len() && times[saved] <= start.t {
+                    let at = Sample { t: times[saved], ..current };
+                    self.save(trajectory, &at, None)?;
+                    saved += 1;
+                }
+            }
+        }
+        let mut signs = run
+            .events
+            .iter_mut()
+            .map(|event| event.value(&current))
+            .collect::<Result<Vec<f64>, _>>()?;
+        for k in 1..=total {
+            let last = k == total;
+            let proposal = self.solve_step()?;
+            let sampled = saveat.is_none() && (k % every == 0 || last);
+            // The velocity is solved where it is used; otherwise the state's hint stands in.
+            let exact = sampled || dense;
+            let (reached, energy) = if exact {
+                // The step's velocity hint is its mean velocity, half a step behind its end:
+                // extrapolated by half the change since the last one, it is O(h²) off.
+                let hint = proposal.next.velocity;
+                let guess = hint + (hint - current.v) * 0.5;
+                let v = self.sample_velocity(&proposal.next, &guess)?;
+                let energy = match sampled {
+                    true => Some(self.energy_at(&proposal.next, &v, self.steps + 1)?),
+                    false => None,
+                };
+                (sample(&proposal.next, v), energy)
+            } else {
+                (sample(&proposal.next, proposal.next.velocity), None)
+            };
+            self.accept(proposal);
+            let previous = std::mem::replace(&mut current, reached);
+            if let Some(times) = &saveat {
+                while saved < times.len() && (times[saved] <= current.t || last) {
+                    let theta = run::fraction(&previous, times[saved], h);
+                    let inside = self.dense_sample(&previous, &current, theta)?;
+                    self.save(trajectory, &Sample { t: times[saved], ..inside }, None)?;
+                    saved += 1;
+                }
+            }
+            let mut stop = None;
+            if !run.events.is_empty() {
+                let found = solution.events.len();
+                for (index, event) in run.events.iter_mut().enumerate() {
+                    let sign = event.value(&current)?;
+                    if let Some(direction) = event.crossing(signs[index], sign) {
+                        let theta = event::locate(
+                            |theta| {
+                                let inside = self.dense_sample(&previous, &current, theta)?;
+                                event.value(&inside)
+                            },
+                            signs[index],
+                            sign,
+                        )?;
+                        solution.events.push(Crossing {
+                            event: index,
+                            name: event.name().to_string(),
+                            direction,
+                            sample: self.dense_sample(&previous, &current, theta)?,
+                        });
+                        if event.is_terminal() && stop.is_none() {
+                            stop = Some(Status::Event(index));
+                        }
+                    }
+                    signs[index] = sign;
+                }
+                solution.events[found..].sort_by(|a, b| a.sample.t.total_cmp(&b.sample.t));
+                if let Some(Status::Event(_)) = stop {
+                    // The first terminal crossing of the step is the one that ends the run.
+                    let first = solution.events[found..]
+                        .iter()
+                        .find(|c| run.events[c.event].is_terminal())
+                        .map(|c| c.event);
+                    stop = first.map(Status::Event);
+                }
+            }
+            if let Some(observer) = &mut run.observer {
+                let state = self.state.as_ref().ok_or(DiracError::NotStarted)?;
+                let progress = Progress {
+                    steps: k,
+                    total,
+                    state,
+                };
+                if let ControlFlow::Break(()) = observer(&progress) {
+                    stop = stop.or(Some(Status::Stopped));
+                }
+            }
+            if sampled {
+                self.save(trajectory, &current, energy)?;
+            }
+            if let Some(status) = stop {
+                if saveat.is_none() && !sampled {
+                    if !exact {
+                        let state = self.state.ok_or(DiracError::NotStarted)?;
+                        current.v = self.sample_velocity(&state, &current.v)?;
+                    }
+                    self.save(trajectory, &current, None)?;
+                }
+                solution.status = status;
+                return Ok(());
+            }
+        }
+        Ok(())
+    }
+
+    /// Appends `sample` to `trajectory` with its `energy` (computed when `None`) and the last
+    /// step's multipliers.
+    fn save(
+        &self,
+        trajectory: &mut Trajectory<N>,
+        sample: &Sample<N>,
+        energy: Option<f64>,
+    ) -> Result<(), DiracError> {
+        let state = State::new(sample.t, sample.q, sample.p, sample.v);
+        let energy = match energy {
+            Some(energy) => energy,
+            None => self.energy_at(&state, &sample.v, self.steps)?,
+        };
+        if self.multipliers.is_empty() {
+            trajectory.push(sample, energy)
+        } else {
+            trajectory.push_constrained(sample, energy, self.violation, self.multipliers())
+        }
+    }
+}
+
+/// The sample of `state` with velocity `v`.
+fn sample<const N: usize>(state: &State<N>, v: SVector<f64, N>) -> Sample<N> {
+    Sample {
+        t: state.t,
+        q: state.q,
+        v,
+        p: state.p,
+    }
+}
