@@ -119,7 +119,10 @@ fn constrained(c: &mut Criterion) {
 /// Gauss nodes of a Galerkin step.
 fn newer_classes(c: &mut Criterion) {
     let mut group = c.benchmark_group("model_class_step");
-    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).expect("rule")] {
+    for quadrature in [
+        Quadrature::midpoint(),
+        Quadrature::galerkin(2).expect("rule"),
+    ] {
         let name = quadrature.name();
         let mut lv =
             Stepper::new(scenes::lotka_volterra::SCENE, quadrature.clone(), 0.05).expect("valid");

@@ -47,8 +47,8 @@ pub mod prelude {
     pub use dirac_macros::dirac_system;
     pub use dirac_runtime::nalgebra::{SMatrix, SVector};
     pub use dirac_runtime::{
-        ConfigurationSpace, ConstraintPoint, DiracError, DiracSystem, DiscreteLagrangian, DualNum,
-        Crossing, Direction, Euclidean, Event, FirstOrderScheme, HolonomicScheme, Input,
+        ConfigurationSpace, ConstraintPoint, Crossing, DiracError, DiracSystem, Direction,
+        DiscreteLagrangian, DualNum, Euclidean, Event, FirstOrderScheme, HolonomicScheme, Input,
         NewtonOptions, Positive, Progress, Quadrature, Rule, Run, Sample, Scalar, Solution, Status,
         Stepper, Trajectory,
     };
@@ -58,3 +58,7 @@ pub mod prelude {
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
+
+#[doc = include_str!("../docs/guide.md")]
+#[cfg(doctest)]
+pub struct GuideDoctests;

@@ -261,8 +261,12 @@ fn every_constrained_scene_restarts_from_its_own_state() {
 
 /// The pendulum angle at `t` from rest at 1 rad, by `galerkin(3)` at h = 1e-3 (error < 1e-12).
 fn angle_pendulum_at(t: f64) -> f64 {
-    let mut stepper =
-        Stepper::new(scenes::pendulum::SCENE, Quadrature::galerkin(3).unwrap(), 1e-3).unwrap();
+    let mut stepper = Stepper::new(
+        scenes::pendulum::SCENE,
+        Quadrature::galerkin(3).unwrap(),
+        1e-3,
+    )
+    .unwrap();
     stepper
         .start_from_velocity(vector![1.0], vector![0.0])
         .unwrap();
@@ -684,7 +688,11 @@ fn holonomic_galerkin_of_degree_two_is_fourth_order() {
 fn one_forms_at_the_nodes_of_galerkin_steps_keep_the_orders() {
     let cases = [
         (Quadrature::midpoint(), 2.0, [0.04, 0.02, 0.01, 0.005]),
-        (Quadrature::galerkin(2).unwrap(), 4.0, [0.2, 0.1, 0.05, 0.025]),
+        (
+            Quadrature::galerkin(2).unwrap(),
+            4.0,
+            [0.2, 0.1, 0.05, 0.025],
+        ),
         (Quadrature::galerkin(3).unwrap(), 6.0, [0.4, 0.2, 0.1, 0.05]),
     ];
     for (quadrature, order, hs) in cases {

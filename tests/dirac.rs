@@ -333,6 +333,7 @@ fn only_what_a_model_names_is_there() {
         .to_string();
     assert_eq!(
         header,
-        "t,q_l,q_c1,q_c2,q_c3,p_q_l,p_q_c1,p_q_c2,p_q_c3,energy,constraint_violation,mu_0,mu_1"
+        "t,q_l,q_c1,q_c2,q_c3,v_q_l,v_q_c1,v_q_c2,v_q_c3,p_q_l,p_q_c1,p_q_c2,p_q_c3,energy,\
+         constraint_violation,mu_0,mu_1"
     );
 }

@@ -125,12 +125,14 @@ fn trajectories_write_csv_with_named_columns() {
     trajectory.write_csv(&mut csv).unwrap();
     let text = String::from_utf8(csv).unwrap();
     let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines[0], "t,theta,p_theta,energy");
+    assert_eq!(lines[0], "t,theta,v_theta,p_theta,energy");
     assert_eq!(lines.len(), 5);
     let last: Vec<f64> = lines[4].split(',').map(|x| x.parse().unwrap()).collect();
     assert!((last[0] - 0.3).abs() < 1e-15);
     assert_eq!(last[1], trajectory.q()[3][0]);
-    assert_eq!(last[2], trajectory.p()[3][0]);
+    assert_eq!(last[2], trajectory.v()[3][0]);
+    assert_eq!(last[3], trajectory.p()[3][0]);
+    assert_eq!(last[4], trajectory.energy()[3]);
 }
 
 /// L = v²/2 − √(1 − q): defined for q ≤ 1 only; the force pushes q towards the edge.

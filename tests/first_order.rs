@@ -120,8 +120,16 @@ fn orders_do_not_depend_on_the_gauge() {
     let exact = reference(t);
     let cases: [(Quadrature, [f64; 4], f64); 3] = [
         (Quadrature::midpoint(), [0.1, 0.05, 0.025, 0.0125], 2.0),
-        (Quadrature::galerkin(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
-        (Quadrature::galerkin(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
+        (
+            Quadrature::galerkin(2).unwrap(),
+            [0.2, 0.1, 0.05, 0.025],
+            4.0,
+        ),
+        (
+            Quadrature::galerkin(3).unwrap(),
+            [0.2, 0.1, 0.05, 0.025],
+            6.0,
+        ),
     ];
     for (quadrature, hs, order) in cases {
         let first: Vec<f64> = hs
@@ -180,8 +188,16 @@ fn orders_hold_in_a_transcendental_gauge() {
     let exact = reference(t);
     for (quadrature, hs, order) in [
         (Quadrature::midpoint(), [0.1, 0.05, 0.025, 0.0125], 2.0),
-        (Quadrature::galerkin(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
-        (Quadrature::galerkin(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
+        (
+            Quadrature::galerkin(2).unwrap(),
+            [0.2, 0.1, 0.05, 0.025],
+            4.0,
+        ),
+        (
+            Quadrature::galerkin(3).unwrap(),
+            [0.2, 0.1, 0.05, 0.025],
+            6.0,
+        ),
     ] {
         let errors: Vec<f64> = hs
             .iter()
@@ -279,8 +295,16 @@ fn the_projected_step_has_full_order_in_every_gauge() {
     let scheme = FirstOrderScheme::SymmetricProjection;
     for (quadrature, hs, order) in [
         (Quadrature::midpoint(), [0.1, 0.05, 0.025, 0.0125], 2.0),
-        (Quadrature::galerkin(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
-        (Quadrature::galerkin(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
+        (
+            Quadrature::galerkin(2).unwrap(),
+            [0.2, 0.1, 0.05, 0.025],
+            4.0,
+        ),
+        (
+            Quadrature::galerkin(3).unwrap(),
+            [0.2, 0.1, 0.05, 0.025],
+            6.0,
+        ),
     ] {
         let errors = |gauge: usize| -> Vec<f64> {
             hs.iter()
@@ -605,8 +629,16 @@ fn a_lagrangian_linear_in_some_velocities() {
     let exact = coupled_reference(t);
     for (quadrature, hs, order) in [
         (Quadrature::midpoint(), [0.1, 0.05, 0.025, 0.0125], 2.0),
-        (Quadrature::galerkin(2).unwrap(), [0.2, 0.1, 0.05, 0.025], 4.0),
-        (Quadrature::galerkin(3).unwrap(), [0.2, 0.1, 0.05, 0.025], 6.0),
+        (
+            Quadrature::galerkin(2).unwrap(),
+            [0.2, 0.1, 0.05, 0.025],
+            4.0,
+        ),
+        (
+            Quadrature::galerkin(3).unwrap(),
+            [0.2, 0.1, 0.05, 0.025],
+            6.0,
+        ),
     ] {
         let errors: Vec<f64> = hs
             .iter()

@@ -59,7 +59,9 @@ fn a_run_starts_at_its_start_time_and_ends_at_t_end() {
     let mut stepper = Stepper::new(FORCED, Quadrature::galerkin(2).unwrap(), h)
         .unwrap()
         .with_start_time(t0);
-    stepper.start_from_velocity(vector![x0], vector![v0]).unwrap();
+    stepper
+        .start_from_velocity(vector![x0], vector![v0])
+        .unwrap();
     let trajectory = stepper.run_until(5.0).unwrap();
     assert_eq!(trajectory.t()[0], t0);
     assert_eq!(stepper.steps(), 300);
@@ -67,7 +69,9 @@ fn a_run_starts_at_its_start_time_and_ends_at_t_end() {
     // The force is evaluated at the absolute time: started as if at 0, the answer is off by
     // O(1); at t0 it is off by the method's error.
     let (x, v) = forced_exact(5.0);
-    let error = (stepper.q()[0] - x).abs().max((stepper.v().unwrap()[0] - v).abs());
+    let error = (stepper.q()[0] - x)
+        .abs()
+        .max((stepper.v().unwrap()[0] - v).abs());
     assert!(error < 1e-8, "error {error:e}");
     assert_eq!(trajectory.metadata().unwrap().t0, t0);
     // A span that ends before the current time is refused, and nothing moves.
@@ -85,11 +89,16 @@ fn a_run_starts_at_its_start_time_and_ends_at_t_end() {
 fn saved_times_are_the_dense_output_and_equal_the_states_on_the_grid() {
     let h = 0.1;
     let mut stepper = Stepper::new(pendulum::SCENE, Quadrature::galerkin(2).unwrap(), h).unwrap();
-    stepper.start_from_momentum(vector![1.0], vector![0.0]).unwrap();
+    stepper
+        .start_from_momentum(vector![1.0], vector![0.0])
+        .unwrap();
     let mut other = stepper.clone();
     let every_step = stepper.run_until(2.0).unwrap();
     let times = [0.0, 0.05, 0.5, 0.73, 1.0, 2.0];
-    let saved = other.solve(Run::until(2.0).saveat(times)).unwrap().trajectory;
+    let saved = other
+        .solve(Run::until(2.0).saveat(times))
+        .unwrap()
+        .trajectory;
     assert_eq!(saved.t(), &times);
     for (k, &t) in times.iter().enumerate() {
         let on_grid = (t / h).round();
@@ -106,7 +115,11 @@ fn saved_times_are_the_dense_output_and_equal_the_states_on_the_grid() {
     let before = other.steps();
     for bad in [vec![1.0, 0.5], vec![2.5], vec![f64::NAN]] {
         let refused = other.solve(Run::until(2.2).saveat(bad)).unwrap_err();
-        assert!(matches!(refused.error, DiracError::InvalidRun(_)), "{}", refused.error);
+        assert!(
+            matches!(refused.error, DiracError::InvalidRun(_)),
+            "{}",
+            refused.error
+        );
     }
     assert_eq!(other.steps(), before);
 }
@@ -115,12 +128,17 @@ fn saved_times_are_the_dense_output_and_equal_the_states_on_the_grid() {
 /// `[0, 2]`: positions, velocities, momenta.
 fn dense_errors(quadrature: &Quadrature, h: f64) -> [f64; 3] {
     let mut stepper = Stepper::new(Oscillator, quadrature.clone(), h).unwrap();
-    stepper.start_from_velocity(vector![1.0], vector![0.0]).unwrap();
+    stepper
+        .start_from_velocity(vector![1.0], vector![0.0])
+        .unwrap();
     let steps = (2.0 / h).round() as u64;
     let times: Vec<f64> = (0..steps)
         .flat_map(|k| (1..8).map(move |i| (k as f64 + i as f64 / 8.0) * h))
         .collect();
-    let saved = stepper.solve(Run::steps(steps).saveat(times)).unwrap().trajectory;
+    let saved = stepper
+        .solve(Run::steps(steps).saveat(times))
+        .unwrap()
+        .trajectory;
     let mut errors = [0.0_f64; 3];
     for k in 0..saved.len() {
         let t = saved.t()[k];
@@ -142,7 +160,12 @@ fn dense_output_converges_at_its_measured_order() {
         let errors: Vec<[f64; 3]> = hs.iter().map(|&h| dense_errors(&quadrature, h)).collect();
         for (i, what) in ["q", "v", "p"].iter().enumerate() {
             let e: Vec<f64> = errors.iter().map(|e| e[i]).collect();
-            assert_order(&format!("{} dense {what}", quadrature.name()), &hs, &e, orders[i]);
+            assert_order(
+                &format!("{} dense {what}", quadrature.name()),
+                &hs,
+                &e,
+                orders[i],
+            );
         }
     }
 }
@@ -162,11 +185,17 @@ fn events_locate_the_pendulum_period() {
             .iter()
             .map(|&h| {
                 let mut stepper = Stepper::new(pendulum::SCENE, quadrature.clone(), h).unwrap();
-                stepper.start_from_momentum(vector![q0], vector![0.0]).unwrap();
-                let vertical =
-                    Event::new("vertical", |_t, q: &SVector<f64, 1>, _v: &SVector<f64, 1>| q[0])
-                        .rising();
-                let solution = stepper.solve(Run::until(3.0 * period).event(vertical)).unwrap();
+                stepper
+                    .start_from_momentum(vector![q0], vector![0.0])
+                    .unwrap();
+                let vertical = Event::new(
+                    "vertical",
+                    |_t, q: &SVector<f64, 1>, _v: &SVector<f64, 1>| q[0],
+                )
+                .rising();
+                let solution = stepper
+                    .solve(Run::until(3.0 * period).event(vertical))
+                    .unwrap();
                 let crossings: Vec<&Crossing<1>> = solution.events.iter().collect();
                 assert_eq!(crossings.len(), 3, "h = {h}");
                 for crossing in &crossings {
@@ -177,7 +206,12 @@ fn events_locate_the_pendulum_period() {
                 (crossings[1].sample.t - crossings[0].sample.t - period).abs()
             })
             .collect();
-        assert_order(&format!("{} period", quadrature.name()), &hs, &errors, order);
+        assert_order(
+            &format!("{} period", quadrature.name()),
+            &hs,
+            &errors,
+            order,
+        );
     }
 }
 
@@ -187,17 +221,24 @@ fn events_locate_the_pendulum_period() {
 fn a_terminal_event_ends_the_run_and_the_stepper_goes_on() {
     let h = 0.1;
     let mut stepper = Stepper::new(Oscillator, Quadrature::galerkin(3).unwrap(), h).unwrap();
-    stepper.start_from_velocity(vector![1.0], vector![0.0]).unwrap();
-    let half = Event::new("x = 1/2", |_t, q: &SVector<f64, 1>, _v: &SVector<f64, 1>| {
-        q[0] - 0.5
-    })
+    stepper
+        .start_from_velocity(vector![1.0], vector![0.0])
+        .unwrap();
+    let half = Event::new(
+        "x = 1/2",
+        |_t, q: &SVector<f64, 1>, _v: &SVector<f64, 1>| q[0] - 0.5,
+    )
     .terminal();
     let solution = stepper.solve(Run::until(10.0).event(half)).unwrap();
     assert_eq!(solution.status, Status::Event(0));
     let crossing = &solution.events[0];
     assert_eq!(crossing.direction, Direction::Falling);
     // cos t = 1/2 at t = π/3, to the dense output's accuracy at this step (2.6e-8 in q).
-    assert!((crossing.sample.t - PI / 3.0).abs() < 1e-7, "{}", crossing.sample.t);
+    assert!(
+        (crossing.sample.t - PI / 3.0).abs() < 1e-7,
+        "{}",
+        crossing.sample.t
+    );
     assert!((crossing.sample.v[0] + (PI / 3.0).sin()).abs() < 1e-6);
     assert!((crossing.sample.q[0] - 0.5).abs() < 1e-15);
     assert!(stepper.t() >= crossing.sample.t && stepper.t() < crossing.sample.t + h);
@@ -209,7 +250,9 @@ fn a_terminal_event_ends_the_run_and_the_stepper_goes_on() {
 #[test]
 fn an_observer_sees_every_step_and_can_stop_the_run() {
     let mut stepper = Stepper::new(pendulum::SCENE, Quadrature::midpoint(), 0.01).unwrap();
-    stepper.start_from_momentum(vector![1.0], vector![0.0]).unwrap();
+    stepper
+        .start_from_momentum(vector![1.0], vector![0.0])
+        .unwrap();
     let mut seen = Vec::new();
     let run = Run::until(10.0).every(7).observe(|progress| {
         seen.push((progress.steps, progress.state.t()));
@@ -223,7 +266,11 @@ fn an_observer_sees_every_step_and_can_stop_the_run() {
     let solution = stepper.solve(run).unwrap();
     assert_eq!(solution.status, Status::Stopped);
     assert_eq!(seen.len(), 250);
-    assert!(seen.iter().enumerate().all(|(k, &(steps, _))| steps == k as u64 + 1));
+    assert!(
+        seen.iter()
+            .enumerate()
+            .all(|(k, &(steps, _))| steps == k as u64 + 1)
+    );
     assert_eq!(stepper.steps(), 250);
     let trajectory = &solution.trajectory;
     // Every 7th step, then the last state (250 is not a multiple of 7).
@@ -242,10 +289,13 @@ struct Edge;
 #[test]
 fn a_failed_run_keeps_its_samples_and_events() {
     let mut stepper = Stepper::new(Edge, Quadrature::midpoint(), 0.1).unwrap();
-    stepper.start_from_velocity(vector![0.0], vector![1.0]).unwrap();
-    let half = Event::new("x = 1/2", |_t, q: &SVector<f64, 1>, _v: &SVector<f64, 1>| {
-        q[0] - 0.5
-    });
+    stepper
+        .start_from_velocity(vector![0.0], vector![1.0])
+        .unwrap();
+    let half = Event::new(
+        "x = 1/2",
+        |_t, q: &SVector<f64, 1>, _v: &SVector<f64, 1>| q[0] - 0.5,
+    );
     let interrupted = stepper.solve(Run::until(100.0).event(half)).unwrap_err();
     assert_eq!(interrupted.trajectory.len() as u64, stepper.steps() + 1);
     assert_eq!(interrupted.events.len(), 1);
@@ -265,14 +315,20 @@ fn trajectories_have_velocities_metadata_and_named_columns() {
         })
         .unwrap();
     stepper
-        .start_from_velocity(SVector::zeros(), vector![0.0, 0.0, scenes::knife_edge::OMEGA])
+        .start_from_velocity(
+            SVector::zeros(),
+            vector![0.0, 0.0, scenes::knife_edge::OMEGA],
+        )
         .unwrap();
     let trajectory = stepper.run_until(1.0).unwrap();
     assert_eq!(*trajectory.v().last().unwrap(), stepper.v().unwrap());
     let metadata = trajectory.metadata().unwrap();
     assert_eq!(metadata.model, "KnifeEdge");
     assert_eq!(metadata.quadrature, "midpoint");
-    assert_eq!((metadata.h, metadata.t0, metadata.residual_tolerance), (0.05, 0.0, 1e-13));
+    assert_eq!(
+        (metadata.h, metadata.t0, metadata.residual_tolerance),
+        (0.05, 0.0, 1e-13)
+    );
     let names = trajectory.column_names();
     assert_eq!(names[0], "t");
     assert!(names.contains(&"constraint_violation".to_string()));
@@ -285,15 +341,20 @@ fn trajectories_have_velocities_metadata_and_named_columns() {
     assert_eq!(trajectory.column("no such column"), None);
     let mut csv = Vec::new();
     trajectory.write_csv(&mut csv).unwrap();
-    let header = String::from_utf8(csv).unwrap().lines().next().unwrap().to_string();
+    let header = String::from_utf8(csv)
+        .unwrap()
+        .lines()
+        .next()
+        .unwrap()
+        .to_string();
     assert_eq!(header, names.join(","));
 }
 
 /// `serde` round trips, and a quadrature read back is checked like one built by hand.
 #[test]
 fn serde_round_trips() {
-    let mut stepper = Stepper::new(scenes::circuit::LC, Quadrature::galerkin(2).unwrap(), 0.01)
-        .unwrap();
+    let mut stepper =
+        Stepper::new(scenes::circuit::LC, Quadrature::galerkin(2).unwrap(), 0.01).unwrap();
     stepper
         .start_from_velocity(scenes::circuit::q0(), SVector::zeros())
         .unwrap();
@@ -303,19 +364,37 @@ fn serde_round_trips() {
     assert_eq!(back, trajectory);
     for quadrature in scenes::quadratures() {
         let json = serde_json::to_string(&quadrature).unwrap();
-        assert_eq!(serde_json::from_str::<Quadrature>(&json).unwrap(), quadrature);
+        assert_eq!(
+            serde_json::from_str::<Quadrature>(&json).unwrap(),
+            quadrature
+        );
     }
     let invalid = r#"{"degree":3,"rule":{"GaussLegendre":2}}"#;
     let refused = serde_json::from_str::<Quadrature>(invalid).unwrap_err();
-    assert!(refused.to_string().contains("degree 3 needs at least 3 nodes"), "{refused}");
+    assert!(
+        refused
+            .to_string()
+            .contains("degree 3 needs at least 3 nodes"),
+        "{refused}"
+    );
     let options = NewtonOptions {
         max_iterations: 7,
         ..NewtonOptions::default()
     };
     let json = serde_json::to_string(&options).unwrap();
-    assert_eq!(serde_json::from_str::<NewtonOptions>(&json).unwrap(), options);
-    for point in [ConstraintPoint::Start, ConstraintPoint::Midpoint, ConstraintPoint::End] {
+    assert_eq!(
+        serde_json::from_str::<NewtonOptions>(&json).unwrap(),
+        options
+    );
+    for point in [
+        ConstraintPoint::Start,
+        ConstraintPoint::Midpoint,
+        ConstraintPoint::End,
+    ] {
         let json = serde_json::to_string(&point).unwrap();
-        assert_eq!(serde_json::from_str::<ConstraintPoint>(&json).unwrap(), point);
+        assert_eq!(
+            serde_json::from_str::<ConstraintPoint>(&json).unwrap(),
+            point
+        );
     }
 }

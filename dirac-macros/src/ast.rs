@@ -114,10 +114,13 @@ pub struct Model {
     /// Terms of all force one-forms together.
     pub forces: Vec<Term>,
     pub inputs: Vec<Ident>,
-    /// `::dirac::ConstraintPoint::...` when `constraint_at` is given.
+    /// `__dirac::ConstraintPoint::...` when `constraint_at` is given.
     pub constraint_point: Option<TokenStream>,
     /// Continuations of long chains, each emitted as a method of its own.
     pub parts: Vec<crate::expression::Part>,
+    /// The path of the runtime crate (`crate = ...`, `::dirac` by default), bound to `__dirac`
+    /// in the generated code.
+    pub krate: syn::Path,
 }
 
 /// Number of coordinates as a const expression (a literal when every length is one).

@@ -1,4 +1,4 @@
-//! Emits the struct unchanged and its `impl ::dirac::DiracSystem<N>`.
+//! Emits the struct unchanged and its `impl __dirac::DiracSystem<N>`.
 
 use proc_macro2::{Span, TokenStream};
 use quote::{quote, quote_spanned};
@@ -34,20 +34,31 @@ pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
             errors,
             coordinates,
             item,
+            krate,
         } => {
             let errors = errors.to_compile_errors();
             let stub = coordinates
                 .filter(|c| !c.is_empty())
-                .map(|c| stub(&item, &c));
+                .map(|c| in_scope(&krate, stub(&item, &c)));
             quote!(#errors #item #stub)
         }
+    }
+}
+
+/// The generated `items` in a block where `__dirac` names the runtime crate `krate`.
+fn in_scope(krate: &syn::Path, items: TokenStream) -> TokenStream {
+    quote! {
+        const _: () = {
+            use #krate as __dirac;
+            #items
+        };
     }
 }
 
 fn header(item: &syn::ItemStruct, n: &TokenStream) -> TokenStream {
     let name = &item.ident;
     let (impl_generics, ty_generics, where_clause) = item.generics.split_for_impl();
-    quote!(impl #impl_generics ::dirac::DiracSystem<#n> for #name #ty_generics #where_clause)
+    quote!(impl #impl_generics __dirac::DiracSystem<#n> for #name #ty_generics #where_clause)
 }
 
 fn expand(model: &Model) -> TokenStream {
@@ -109,18 +120,16 @@ fn expand(model: &Model) -> TokenStream {
         }
     });
     let quadrature = &model.quadrature;
-    quote! {
-        #item
-
+    let implementation = quote! {
         #parts
 
         #[automatically_derived]
         #header {
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
-            fn lagrangian<__D: ::dirac::Scalar>(
+            fn lagrangian<__D: __dirac::Scalar>(
                 &self,
-                __q: &::dirac::nalgebra::SVector<__D, #n>,
-                __v: &::dirac::nalgebra::SVector<__D, #n>,
+                __q: &__dirac::nalgebra::SVector<__D, #n>,
+                __v: &__dirac::nalgebra::SVector<__D, #n>,
             ) -> __D {
                 #body
             }
@@ -138,13 +147,15 @@ fn expand(model: &Model) -> TokenStream {
                 __p
             }
 
-            fn quadrature(&self) -> ::core::result::Result<::dirac::Quadrature, ::dirac::DiracError> {
+            fn quadrature(&self) -> ::core::result::Result<__dirac::Quadrature, __dirac::DiracError> {
                 #quadrature
             }
 
             #dirac
         }
-    }
+    };
+    let implementation = in_scope(&model.krate, implementation);
+    quote!(#item #implementation)
 }
 
 /// The inputs bound by name for the forces.
@@ -163,7 +174,7 @@ fn parts(model: &Model, n: &TokenStream, bindings: &dyn Fn(bool) -> TokenStream)
     if model.parts.is_empty() {
         return TokenStream::new();
     }
-    let vector = quote!(&::dirac::nalgebra::SVector<__D, #n>);
+    let vector = quote!(&__dirac::nalgebra::SVector<__D, #n>);
     let methods = model.parts.iter().enumerate().map(|(k, part)| {
         let (parameters, prelude) = match part.context {
             Context::Lagrangian => (quote!(__q: #vector, __v: #vector,), bindings(true)),
@@ -182,7 +193,7 @@ fn parts(model: &Model, n: &TokenStream, bindings: &dyn Fn(bool) -> TokenStream)
             #[doc(hidden)]
             #[inline(never)]
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
-            fn #name<__D: ::dirac::Scalar>(&self, #parameters __chain: #scalar) -> #scalar {
+            fn #name<__D: __dirac::Scalar>(&self, #parameters __chain: #scalar) -> #scalar {
                 #prelude
                 #body
             }
@@ -226,13 +237,13 @@ fn dirac_items(
             const ONE_FORMS: usize = #count;
 
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
-            fn one_form<__D: ::dirac::Scalar>(
+            fn one_form<__D: __dirac::Scalar>(
                 &self,
-                __q: &::dirac::nalgebra::SVector<__D, #n>,
+                __q: &__dirac::nalgebra::SVector<__D, #n>,
                 __a: usize,
-            ) -> ::dirac::nalgebra::SVector<__D, #n> {
+            ) -> __dirac::nalgebra::SVector<__D, #n> {
                 #positions
-                let mut __w = ::dirac::nalgebra::SVector::<__D, #n>::from_element(#zero);
+                let mut __w = __dirac::nalgebra::SVector::<__D, #n>::from_element(#zero);
                 match __a {
                     #(#arms)*
                     _ => {}
@@ -253,9 +264,9 @@ fn dirac_items(
             const HOLONOMIC: usize = #count;
 
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
-            fn holonomic<__D: ::dirac::Scalar>(
+            fn holonomic<__D: __dirac::Scalar>(
                 &self,
-                __q: &::dirac::nalgebra::SVector<__D, #n>,
+                __q: &__dirac::nalgebra::SVector<__D, #n>,
                 __b: usize,
             ) -> __D {
                 #positions
@@ -274,16 +285,16 @@ fn dirac_items(
             const FORCES: bool = true;
 
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
-            fn force<__D: ::dirac::Scalar>(
+            fn force<__D: __dirac::Scalar>(
                 &self,
-                __q: &::dirac::nalgebra::SVector<__D, #n>,
-                __v: &::dirac::nalgebra::SVector<__D, #n>,
+                __q: &__dirac::nalgebra::SVector<__D, #n>,
+                __v: &__dirac::nalgebra::SVector<__D, #n>,
                 t: f64,
                 __inputs: &[__D],
-            ) -> ::dirac::nalgebra::SVector<__D, #n> {
+            ) -> __dirac::nalgebra::SVector<__D, #n> {
                 #state
                 #inputs
-                let mut __f = ::dirac::nalgebra::SVector::<__D, #n>::from_element(#zero);
+                let mut __f = __dirac::nalgebra::SVector::<__D, #n>::from_element(#zero);
                 #sum
                 __f
             }
@@ -303,7 +314,7 @@ fn dirac_items(
     }
     if let Some(point) = &model.constraint_point {
         items.extend(quote! {
-            fn constraint_point(&self) -> ::dirac::ConstraintPoint {
+            fn constraint_point(&self) -> __dirac::ConstraintPoint {
                 #point
             }
         });
@@ -318,10 +329,10 @@ fn stub(item: &syn::ItemStruct, coordinates: &[Coordinate]) -> TokenStream {
     let header = header(item, &n);
     quote! {
         #header {
-            fn lagrangian<__D: ::dirac::Scalar>(
+            fn lagrangian<__D: __dirac::Scalar>(
                 &self,
-                _: &::dirac::nalgebra::SVector<__D, #n>,
-                _: &::dirac::nalgebra::SVector<__D, #n>,
+                _: &__dirac::nalgebra::SVector<__D, #n>,
+                _: &__dirac::nalgebra::SVector<__D, #n>,
             ) -> __D {
                 ::core::unreachable!("#[dirac_system] reported a compile error")
             }

@@ -25,7 +25,10 @@ mod validate;
 ///   or `lagrangian = path::to::function`, a generic
 ///   `fn<D: Scalar>(&Model, &SVector<D, N>, &SVector<D, N>) -> D` for big models;
 /// - `quadrature = midpoint | trapezoid | galerkin(s) | galerkin(s, gauss_legendre(r)) |
-///   galerkin(s, gauss_lobatto(r))`: the default quadrature (`midpoint` if omitted).
+///   galerkin(s, gauss_lobatto(r))`: the default quadrature (`midpoint` if omitted);
+/// - `crate = path`: where the generated code finds the runtime (`::dirac` by default;
+///   `crate = dirac_runtime` for a crate that depends on `dirac-runtime` and `dirac-macros`
+///   directly).
 ///
 /// Every malformed input is a compile error on the offending tokens.
 ///

@@ -18,10 +18,10 @@ pub fn parse(expr: &Expr) -> syn::Result<TokenStream> {
     let span = expr.span();
     match expr {
         Expr::Path(p) if p.path.is_ident("midpoint") => {
-            Ok(quote_spanned!(span=> ::core::result::Result::Ok(::dirac::Quadrature::midpoint())))
+            Ok(quote_spanned!(span=> ::core::result::Result::Ok(__dirac::Quadrature::midpoint())))
         }
         Expr::Path(p) if p.path.is_ident("trapezoid") => {
-            Ok(quote_spanned!(span=> ::core::result::Result::Ok(::dirac::Quadrature::trapezoid())))
+            Ok(quote_spanned!(span=> ::core::result::Result::Ok(__dirac::Quadrature::trapezoid())))
         }
         Expr::Call(call) if callee(call).as_deref() == Some("galerkin") => galerkin(call),
         _ => Err(syn::Error::new(
@@ -106,9 +106,9 @@ fn galerkin(call: &ExprCall) -> syn::Result<TokenStream> {
         ));
     }
     let rule = if lobatto {
-        quote!(::dirac::Rule::GaussLobatto(#nodes))
+        quote!(__dirac::Rule::GaussLobatto(#nodes))
     } else {
-        quote!(::dirac::Rule::GaussLegendre(#nodes))
+        quote!(__dirac::Rule::GaussLegendre(#nodes))
     };
-    Ok(quote_spanned!(call.span()=> ::dirac::Quadrature::galerkin_with_rule(#degree, #rule)))
+    Ok(quote_spanned!(call.span()=> __dirac::Quadrature::galerkin_with_rule(#degree, #rule)))
 }

@@ -240,3 +240,32 @@ fn edge_lengths_are_errors() {
         assert!(parses(&output), "{args}");
     }
 }
+
+/// `crate = path` binds the runtime for every generated path; without it, `::dirac` does.
+#[test]
+fn the_runtime_is_reached_by_the_given_path() {
+    let lagrangian = "coordinates(x), lagrangian = 0.5 * dot(x).powi(2) - m * x";
+    let item = "struct S { m: f64 }";
+    let custom = expand(&format!("crate = dirac_runtime, {lagrangian}"), item).unwrap();
+    let default = expand(lagrangian, item).unwrap();
+    for (output, path) in [
+        (&custom, "use dirac_runtime as __dirac"),
+        (&default, "use :: dirac as __dirac"),
+    ] {
+        let text = output.to_string();
+        assert!(!is_error(output) && parses(output), "{text}");
+        assert_eq!(text.matches(path).count(), 1, "{text}");
+        // Every other mention of the runtime goes through the alias.
+        assert_eq!(
+            text.matches("dirac ::").count(),
+            text.matches("__dirac ::").count(),
+            "{text}"
+        );
+    }
+    let refused = expand(&format!("crate = 1 + 2, {lagrangian}"), item).unwrap();
+    assert!(
+        refused
+            .to_string()
+            .contains("takes the path of the runtime crate")
+    );
+}

@@ -14,7 +14,8 @@ use crate::expression::{Context, Part, Rewriter, Scope, bounds, is_reserved, res
 use crate::{expression, one_form, quadrature};
 
 const KEYS: &str = "`coordinates(...)`, `lagrangian = ...`, `quadrature = ...`, \
-     `constraints(...)`, `holonomic(...)`, `forces(...)`, `inputs(...)` and `constraint_at = ...`";
+     `constraints(...)`, `holonomic(...)`, `forces(...)`, `inputs(...)`, `constraint_at = ...` \
+     and `crate = ...`";
 
 /// Every error found, each with the span of the user's tokens; reported together. Validation,
 /// the rewriter and the one-form splitter all push into one.
@@ -65,6 +66,8 @@ pub enum Outcome {
         coordinates: Option<Vec<Coordinate>>,
         /// The struct as it is to be emitted (without a repeated attribute).
         item: Box<syn::ItemStruct>,
+        /// The path of the runtime (for the stub).
+        krate: syn::Path,
     },
 }
 
@@ -80,6 +83,7 @@ struct Entries {
     forces: Option<Vec<Expr>>,
     inputs: Option<Vec<Ident>>,
     constraint_at: Option<Expr>,
+    krate: Option<Expr>,
 }
 
 /// The items of `key(a, b, ...)`; `empty` is the message for an empty list.
@@ -130,12 +134,13 @@ fn entries(arguments: Arguments, errors: &mut Errors) -> Entries {
             ("lagrangian", Meta::NameValue(nv)) => e.lagrangian = Some(nv.value),
             ("quadrature", Meta::NameValue(nv)) => e.quadrature = Some(nv.value),
             ("constraint_at", Meta::NameValue(nv)) => e.constraint_at = Some(nv.value),
+            ("crate", Meta::NameValue(nv)) => e.krate = Some(nv.value),
             ("coordinates" | "constraints" | "holonomic" | "forces" | "inputs", other) => errors
                 .push(
                     other.span(),
                     format!("write `{key}` as a list: {key}(a, b, ...)"),
                 ),
-            ("lagrangian" | "quadrature" | "constraint_at", other) => {
+            ("lagrangian" | "quadrature" | "constraint_at" | "crate", other) => {
                 errors.push(other.span(), format!("write `{key} = ...`"))
             }
             (_, other) => errors.push(
@@ -171,7 +176,8 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     let mut errors = Errors::default();
     let parts = RefCell::new(Vec::new());
     repeated_attributes(&mut item, &mut errors);
-    let e = entries(arguments, &mut errors);
+    let mut e = entries(arguments, &mut errors);
+    let krate = runtime_path(e.krate.take(), &mut errors);
     let parameters = parameters(&item, &mut errors);
     if e.forces.is_some() {
         for p in parameters.iter().filter(|p| p.name == "t") {
@@ -214,7 +220,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     };
     let quadrature = match e.quadrature {
         None => Some(quote!(::core::result::Result::Ok(
-            ::dirac::Quadrature::midpoint()
+            __dirac::Quadrature::midpoint()
         ))),
         Some(expr) => match quadrature::parse(&expr) {
             Ok(tokens) => Some(tokens),
@@ -225,11 +231,11 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         },
     };
     let constraint_point = e.constraint_at.and_then(|expr| match &expr {
-        Expr::Path(p) if p.path.is_ident("start") => Some(quote!(::dirac::ConstraintPoint::Start)),
+        Expr::Path(p) if p.path.is_ident("start") => Some(quote!(__dirac::ConstraintPoint::Start)),
         Expr::Path(p) if p.path.is_ident("midpoint") => {
-            Some(quote!(::dirac::ConstraintPoint::Midpoint))
+            Some(quote!(__dirac::ConstraintPoint::Midpoint))
         }
-        Expr::Path(p) if p.path.is_ident("end") => Some(quote!(::dirac::ConstraintPoint::End)),
+        Expr::Path(p) if p.path.is_ident("end") => Some(quote!(__dirac::ConstraintPoint::End)),
         other => {
             errors.push(
                 other.span(),
@@ -297,13 +303,31 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 inputs,
                 constraint_point,
                 parts: parts.into_inner(),
+                krate,
             }))
         }
         (coordinates, ..) => Outcome::Invalid {
             errors,
             coordinates,
             item: Box::new(item),
+            krate,
         },
+    }
+}
+
+/// The path the generated code reaches the runtime by: `crate = path` (for users who depend on
+/// `dirac-runtime` and `dirac-macros` directly, or on a re-export), `::dirac` by default.
+fn runtime_path(given: Option<Expr>, errors: &mut Errors) -> syn::Path {
+    match given {
+        None => syn::parse_quote!(::dirac),
+        Some(Expr::Path(path)) if path.qself.is_none() && path.attrs.is_empty() => path.path,
+        Some(other) => {
+            errors.push(
+                other.span(),
+                "`crate = ...` takes the path of the runtime crate, e.g. crate = dirac_runtime",
+            );
+            syn::parse_quote!(::dirac)
+        }
     }
 }
 

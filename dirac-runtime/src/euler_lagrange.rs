@@ -701,8 +701,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         let d0 = space.chart_velocity(&a.q, &a.v)? - start_rate;
         let d1 = space.chart_rate(&a.q, &end, &b.v)? - end_rate;
         let (path, rate) = quadrature.path_through(theta, &points, h);
-        let (correction, rate_correction) =
-            end_slope_correction(theta, h, points.len(), &d0, &d1);
+        let (correction, rate_correction) = end_slope_correction(theta, h, points.len(), &d0, &d1);
         let (xi, xi_dot) = (path + correction, rate + rate_correction);
         let q = space.retract(&a.q, &xi);
         let v = space.push_forward(&a.q, &xi, &xi_dot);

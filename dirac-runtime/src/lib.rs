@@ -14,12 +14,12 @@
 pub mod configuration_space;
 pub mod constraint;
 mod constraint_point;
-mod derivatives;
 pub mod dense_output;
+mod derivatives;
 pub mod discrete_lagrangian;
 pub mod error;
-pub mod event;
 pub mod euler_lagrange;
+pub mod event;
 mod first_order;
 mod first_order_scheme;
 mod force;
@@ -42,8 +42,8 @@ pub mod trajectory;
 
 pub use configuration_space::{ConfigurationSpace, Euclidean, Positive};
 pub use constraint::ConstraintPoint;
-pub use discrete_lagrangian::DiscreteLagrangian;
 pub use dense_output::Sample;
+pub use discrete_lagrangian::DiscreteLagrangian;
 pub use error::DiracError;
 pub use event::{Crossing, Direction, Event};
 pub use first_order_scheme::FirstOrderScheme;

@@ -33,7 +33,9 @@ pub enum Rule {
 /// use dirac_runtime::{Quadrature, Rule};
 /// let q = Quadrature::galerkin_with_rule(2, Rule::GaussLegendre(2))?;
 /// assert_eq!(q.degree(), 2);
-/// assert_eq!(q.name(), "galerkin(2, gauss_legendre(2))");
+/// assert_eq!(q.name(), "galerkin(2)");
+/// let lobatto = Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3))?;
+/// assert_eq!(lobatto.name(), "galerkin(2, gauss_lobatto(3))");
 /// assert!((q.weights().iter().sum::<f64>() - 1.0).abs() < 1e-15);
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```

@@ -115,10 +115,7 @@ impl<'a, const N: usize> Run<'a, N> {
     }
 
     /// Calls `observer` after every step; [`ControlFlow::Break`] ends the run there.
-    pub fn observe(
-        self,
-        observer: impl FnMut(&Progress<'_, N>) -> ControlFlow<()> + 'a,
-    ) -> Self {
+    pub fn observe(self, observer: impl FnMut(&Progress<'_, N>) -> ControlFlow<()> + 'a) -> Self {
         Self {
             observer: Some(Box::new(observer)),
             ..self
@@ -164,7 +161,8 @@ impl<'a, const N: usize> Run<'a, N> {
         let last = t + steps as f64 * h;
         let slack = 1e-12 * (t.abs() + last.abs() + h);
         if let Some(times) = &self.saveat {
-            if let Some(pair) = times.windows(2).find(|pair| !(pair[0] <= pair[1])) {
+            let descending = |pair: &&[f64]| pair[0] > pair[1] || pair.iter().any(|t| t.is_nan());
+            if let Some(pair) = times.windows(2).find(descending) {
                 return Err(DiracError::InvalidRun(format!(
                     "save times must be ascending: {} comes before {}",
                     pair[0], pair[1]

@@ -8,7 +8,7 @@
 //! ```
 //!
 //! A failed step returns an error and changes nothing. Runs over a time span, with saved
-//! times, events and an observer, are in [`integrate`](self::integrate).
+//! times, events and an observer, are in `stepper/integrate.rs` ([`Stepper::solve`]).
 
 use std::marker::PhantomData;
 
@@ -118,11 +118,43 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     /// A stepper for `system` on `Rⁿ` with `quadrature` and step `h`. Fails on a non-positive
     /// or non-finite step, a non-finite parameter, or a constrained system with a quadrature of
     /// degree above 1 (constraints are imposed on the step's end points only).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let stepper = Stepper::new(Oscillator, Quadrature::galerkin(2)?, 0.1)?;
+    /// assert_eq!((stepper.h(), stepper.quadrature().name()), (0.1, "galerkin(2)".to_string()));
+    /// assert!(Stepper::new(Oscillator, Quadrature::midpoint(), -0.1).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn new(system: S, quadrature: Quadrature, h: f64) -> Result<Self, DiracError> {
         Self::on_space(system, Euclidean, quadrature, h)
     }
 
     /// A stepper with the system's own quadrature (the one named in `#[dirac_system]`).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracError, DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::SVector;
+    /// struct Oscillator;
+    /// impl DiracSystem<1> for Oscillator {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn quadrature(&self) -> Result<Quadrature, DiracError> {
+    ///         Quadrature::galerkin(3)
+    ///     }
+    /// }
+    /// let stepper = Stepper::from_system(Oscillator, 0.1)?;
+    /// assert_eq!(stepper.quadrature().name(), "galerkin(3)");
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn from_system(system: S, h: f64) -> Result<Self, DiracError> {
         let quadrature = system.quadrature()?;
         Self::new(system, quadrature, h)
@@ -134,6 +166,24 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
 {
     /// A stepper for `system` whose steps work in the charts of `space` (see
     /// [`configuration_space`](crate::configuration_space)); otherwise as [`Stepper::new`].
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::Positive;
+    /// // Every point of every step stays positive.
+    /// let mut stepper = Stepper::on_space(Oscillator, Positive, Quadrature::galerkin(2)?, 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run(10)?;
+    /// assert!((stepper.q()[0] - 1.0_f64.cos()).abs() < 1e-5); // order 4
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn on_space(
         system: S,
         space: C,
@@ -145,6 +195,26 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     }
 
     /// Evaluates the constraint one-forms at `point` of each step instead of the system's default.
+    ///
+    /// ```
+    /// # use dirac_runtime::{ConstraintPoint, DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// A knife edge in the plane: it moves only along its heading, sin φ ẋ − cos φ ẏ = 0.
+    /// struct KnifeEdge;
+    /// impl DiracSystem<3> for KnifeEdge {
+    ///     const ONE_FORMS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * 0.5
+    ///     }
+    ///     fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, _a: usize) -> SVector<D, 3> {
+    ///         SVector::from([q[2].sin(), -q[2].cos(), D::from(0.0)])
+    ///     }
+    /// }
+    /// let stepper = Stepper::new(KnifeEdge, Quadrature::midpoint(), 0.1)?
+    ///     .with_constraint_point(ConstraintPoint::Start);
+    /// assert_eq!(stepper.constraint_point(), ConstraintPoint::Start);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn with_constraint_point(mut self, point: ConstraintPoint) -> Self {
         self.equations.set_constraint_point(point);
         self
@@ -153,6 +223,22 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     /// Starts from position `q0` and velocity `v0` at the [start time](Self::with_start_time), with `p0 = ∂L/∂v(q0, v0)`.
     /// Fails if `(q0, v0)` violates a constraint, including the hidden constraints of
     /// coordinates without kinetic energy.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.5])?;
+    /// assert_eq!((stepper.t(), stepper.p()[0]), (0.0, 0.5));
+    /// assert!(stepper.start_from_velocity(vector![f64::NAN], vector![0.0]).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn start_from_velocity(
         &mut self,
         q0: SVector<f64, N>,
@@ -208,6 +294,21 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     /// globalised Newton solve of `∂L/∂v(q0, v) = p0` from `v = 0`; when that fails (several
     /// velocities share the momentum, or `v = 0` is far from the answer), use
     /// [`start_from_momentum_near`](Self::start_from_momentum_near).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_momentum(vector![1.0], vector![0.5])?;
+    /// assert!((stepper.v()?[0] - 0.5).abs() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn start_from_momentum(
         &mut self,
         q0: SVector<f64, N>,
@@ -218,6 +319,21 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
 
     /// Starts from position `q0` and momentum `p0` at the [start time](Self::with_start_time), solving for the velocity from
     /// the guess `v_guess`.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_momentum_near(vector![1.0], vector![0.5], vector![0.4])?;
+    /// assert!((stepper.v()?[0] - 0.5).abs() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn start_from_momentum_near(
         &mut self,
         q0: SVector<f64, N>,
@@ -236,6 +352,24 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     /// state it started from (see [`StepHessians`]); for models on `Rⁿ` without constraints
     /// (with forces and inputs), others are refused with `Unsupported`. On error the state is
     /// unchanged.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// let (first, second) = stepper.step_second_order()?;
+    /// // A linear model: the step map is linear, its second derivatives vanish.
+    /// assert!(first.symplecticity_defect() < 1e-14);
+    /// assert!(second.q.iter().chain(&second.p).all(|h| h.amax() < 1e-12));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn step_second_order(
         &mut self,
     ) -> Result<(StepDerivatives<N>, StepHessians<N>), DiracError> {
@@ -253,6 +387,30 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
 
     /// Chooses what a step does with the momentum of a model with holonomic constraints
     /// (default [`HolonomicScheme::Shake`]).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, HolonomicScheme, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// A pendulum in Cartesian coordinates: x² + y² = 1.
+    /// struct Pendulum;
+    /// impl DiracSystem<2> for Pendulum {
+    ///     const HOLONOMIC: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1]) * 0.5 - q[1]
+    ///     }
+    ///     fn holonomic<D: Scalar>(&self, q: &SVector<D, 2>, _b: usize) -> D {
+    ///         q[0] * q[0] + q[1] * q[1] - 1.0
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Pendulum, Quadrature::midpoint(), 0.01)?
+    ///     .with_holonomic_scheme(HolonomicScheme::Rattle);
+    /// stepper.start_from_velocity(vector![1.0, 0.0], vector![0.0, 0.0])?;
+    /// stepper.run(100)?;
+    /// assert!((stepper.q().norm() - 1.0).abs() < 1e-12);
+    /// // RATTLE keeps the velocity tangent to the circle too.
+    /// assert!(stepper.q().dot(&stepper.v()?).abs() < 1e-10);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn with_holonomic_scheme(mut self, scheme: HolonomicScheme) -> Self {
         self.equations.set_holonomic_scheme(scheme);
         self
@@ -286,6 +444,25 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     }
 
     /// Where the constraint one-forms are evaluated on a step.
+    ///
+    /// ```
+    /// # use dirac_runtime::{ConstraintPoint, DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// A knife edge in the plane: it moves only along its heading, sin φ ẋ − cos φ ẏ = 0.
+    /// struct KnifeEdge;
+    /// impl DiracSystem<3> for KnifeEdge {
+    ///     const ONE_FORMS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * 0.5
+    ///     }
+    ///     fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, _a: usize) -> SVector<D, 3> {
+    ///         SVector::from([q[2].sin(), -q[2].cos(), D::from(0.0)])
+    ///     }
+    /// }
+    /// let stepper = Stepper::new(KnifeEdge, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.constraint_point(), ConstraintPoint::Midpoint);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn constraint_point(&self) -> ConstraintPoint {
         self.equations.constraint_point()
     }
@@ -293,12 +470,63 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     /// Sets the input called `name` (held constant over the following steps until set again).
     /// In a loop, resolve the name once with [`input`](Self::input) and use
     /// [`set_input_value`](Self::set_input_value).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// stepper.set_input("u", 2.0)?;
+    /// assert_eq!(stepper.inputs(), &[2.0]);
+    /// assert!(stepper.set_input("v", 1.0).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), DiracError> {
         let input = self.input(name)?;
         self.set_input_value(input, value)
     }
 
     /// The input called `name`, or `UnknownInput` naming the system's inputs.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.input("u")?.index(), 0);
+    /// assert!(stepper.input("v").is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn input(&self, name: &str) -> Result<Input, DiracError> {
         (0..S::INPUTS)
             .find(|&i| self.system().input_name(i) == name)
@@ -315,6 +543,37 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
 
     /// Sets `input` (held constant over the following steps until set again); a value that is
     /// not finite is refused and changes nothing.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.01)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// let u = stepper.input("u")?; // resolved once, outside the loop
+    /// for _ in 0..100 {
+    ///     let feedback = -stepper.q()[0]; // a second spring, held over each step
+    ///     stepper.set_input_value(u, feedback)?;
+    ///     stepper.step()?;
+    /// }
+    /// assert!((stepper.q()[0] - 2.0_f64.sqrt().cos()).abs() < 0.05);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn set_input_value(&mut self, input: Input, value: f64) -> Result<(), DiracError> {
         let index = input.index();
         if index >= S::INPUTS {
@@ -338,6 +597,32 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     }
 
     /// Sets every input at once, in the order of the system's `inputs(...)`.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// stepper.set_inputs(&[1.5])?;
+    /// assert_eq!(stepper.inputs(), &[1.5]);
+    /// assert!(stepper.set_inputs(&[1.0, 2.0]).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
         let changed = self.equations.inputs() != values;
         self.equations.set_inputs(values)?;
@@ -349,21 +634,88 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     }
 
     /// Current input values.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.inputs(), &[0.0]); // inputs start at zero
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn inputs(&self) -> &[f64] {
         self.equations.inputs()
     }
 
     /// The system.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.system().coordinate_name(0), "q0");
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn system(&self) -> &S {
         self.equations.discrete().system()
     }
 
     /// The configuration space whose charts the steps work in.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::Euclidean;
+    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.space(), &Euclidean);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn space(&self) -> &C {
         self.equations.discrete().space()
     }
 
     /// The quadrature.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let stepper = Stepper::new(Oscillator, Quadrature::galerkin(2)?, 0.1)?;
+    /// assert_eq!(stepper.quadrature().degree(), 2);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn quadrature(&self) -> &Quadrature {
         self.equations.discrete().quadrature()
     }
@@ -371,6 +723,23 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
 
 impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// A stepper that solves `equations` on each step, with default Newton options.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::{DiscreteLagrangian, euler_lagrange::EulerLagrange};
+    /// let discrete = DiscreteLagrangian::new(Oscillator, Quadrature::midpoint(), 0.1);
+    /// let mut stepper = Stepper::with_equations(EulerLagrange::new(discrete)?)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.step()?;
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn with_equations(equations: E) -> Result<Self, DiracError> {
         let unknowns = equations.unknowns();
         if equations.first_multiplier() + equations.multipliers() > unknowns {
@@ -433,6 +802,23 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
 
     /// Replaces the Newton options (tolerances, iteration cap, root acceptance); fails on
     /// options out of range.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::NewtonOptions;
+    /// let tight = NewtonOptions { residual_tolerance: 1e-14, ..NewtonOptions::default() };
+    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?.with_newton_options(tight)?;
+    /// let negative = NewtonOptions { residual_tolerance: -1.0, ..NewtonOptions::default() };
+    /// assert!(stepper.with_newton_options(negative).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn with_newton_options(mut self, options: NewtonOptions) -> Result<Self, DiracError> {
         self.newton = Newton::new(self.unknowns.len(), options)?;
         self.velocity_newton = Newton::new(
@@ -443,6 +829,21 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// The step equations.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::StepEquations;
+    /// let stepper = Stepper::new(Oscillator, Quadrature::galerkin(2)?, 0.1)?;
+    /// assert_eq!(stepper.equations().unknowns(), 2); // the internal point and the end point
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn equations(&self) -> &E {
         &self.equations
     }
@@ -489,6 +890,22 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// [`StepEquations::check_start`]) and the first step's equations have been found
     /// nonsingular there (a singular Jacobian is `SingularJacobian`, naming the unknowns the
     /// rule does not determine); on error nothing changes.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::State;
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_state(State::new(2.0, vector![1.0], vector![0.0], vector![0.0]))?;
+    /// assert_eq!((stepper.t(), stepper.steps()), (2.0, 0));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn start_from_state(&mut self, state: State<N>) -> Result<(), DiracError> {
         if !state.t.is_finite() {
             return Err(DiracError::NonFinite {
@@ -549,6 +966,24 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// Advances one step. On error the state is unchanged.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::DiracError;
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// assert!(matches!(stepper.step(), Err(DiracError::NotStarted)));
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.step()?;
+    /// assert_eq!((stepper.steps(), stepper.t()), (1, 0.1));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn step(&mut self) -> Result<(), DiracError> {
         let proposal = self.solve_step()?;
         self.accept(proposal);
@@ -559,6 +994,23 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// from: `A = ∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)` and `B = ∂(q_{k+1}, p_{k+1})/∂u` (see
     /// [`StepDerivatives`]). On error (including
     /// `Unsupported` for models the derivatives do not cover yet) the state is unchanged.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// let a = stepper.step_linearised()?;
+    /// // One degree of freedom: symplectic means det A = 1.
+    /// assert!((a.matrix().determinant() - 1.0).abs() < 1e-14);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn step_linearised(&mut self) -> Result<StepDerivatives<N>, DiracError> {
         let proposal = self.solve_step()?;
         let state = self.state.ok_or(DiracError::NotStarted)?;
@@ -620,6 +1072,28 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// constraint. `Ãᵀ μ + dg̃ᵀ λ` is the constraint impulse over the step (the constraint force
     /// times `h`) in the chart at `q_k`; on `Rⁿ`, `A(q_c)ᵀ μ + dg(q_k)ᵀ λ`. Empty for an
     /// unconstrained system; zeros before the first step.
+    ///
+    /// ```
+    /// # use dirac_runtime::{ConstraintPoint, DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// A knife edge in the plane: it moves only along its heading, sin φ ẋ − cos φ ẏ = 0.
+    /// struct KnifeEdge;
+    /// impl DiracSystem<3> for KnifeEdge {
+    ///     const ONE_FORMS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * 0.5
+    ///     }
+    ///     fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, _a: usize) -> SVector<D, 3> {
+    ///         SVector::from([q[2].sin(), -q[2].cos(), D::from(0.0)])
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(KnifeEdge, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![0.0, 0.0, 0.0], vector![1.0, 0.0, 1.0])?;
+    /// assert_eq!(stepper.multipliers(), &[0.0]);
+    /// stepper.step()?;
+    /// assert!(stepper.multipliers()[0] != 0.0); // the blade pushes sideways as it turns
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn multipliers(&self) -> &[f64] {
         &self.multipliers
     }
@@ -627,42 +1101,172 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// Largest constraint violation of the last step: `|Ã(ξ_c) ξ|` over the one-forms, with
     /// `ξ = R_{q_k}⁻¹(q_{k+1})` the stored step in the chart (on `Rⁿ`, `|A(q_c)(q_{k+1} − q_k)|`),
     /// and `|g(q_{k+1})|` over the holonomic constraints (0 before the first step).
+    ///
+    /// ```
+    /// # use dirac_runtime::{ConstraintPoint, DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// A knife edge in the plane: it moves only along its heading, sin φ ẋ − cos φ ẏ = 0.
+    /// struct KnifeEdge;
+    /// impl DiracSystem<3> for KnifeEdge {
+    ///     const ONE_FORMS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * 0.5
+    ///     }
+    ///     fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, _a: usize) -> SVector<D, 3> {
+    ///         SVector::from([q[2].sin(), -q[2].cos(), D::from(0.0)])
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(KnifeEdge, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![0.0, 0.0, 0.0], vector![1.0, 0.0, 1.0])?;
+    /// stepper.run(10)?;
+    /// assert!(stepper.constraint_violation() < 1e-12);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn constraint_violation(&self) -> f64 {
         self.violation
     }
 
     /// The step size.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// assert_eq!(Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?.h(), 0.1);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn h(&self) -> f64 {
         self.equations.h()
     }
 
     /// Steps taken since the start.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run(3)?;
+    /// assert_eq!(stepper.steps(), 3);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn steps(&self) -> u64 {
         self.steps
     }
 
     /// The current state (`None` before the start).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// assert!(stepper.state().is_none());
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// assert_eq!(stepper.state().map(|s| s.q()[0]), Some(1.0));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn state(&self) -> Option<&State<N>> {
         self.state.as_ref()
     }
 
     /// Current time (0 before the start).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run_until(1.0)?;
+    /// assert!((stepper.t() - 1.0).abs() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn t(&self) -> f64 {
         self.state.map_or(0.0, |s| s.t)
     }
 
     /// Current position (zeros before the start).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run_until(1.0)?;
+    /// assert!((stepper.q()[0] - 1.0_f64.cos()).abs() < 1e-2);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn q(&self) -> SVector<f64, N> {
         self.state.map_or(SVector::zeros(), |s| s.q)
     }
 
     /// Current momentum (zeros before the start).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run_until(1.0)?;
+    /// assert!((stepper.p()[0] + 1.0_f64.sin()).abs() < 1e-2);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn p(&self) -> SVector<f64, N> {
         self.state.map_or(SVector::zeros(), |s| s.p)
     }
 
     /// Current velocity: the solution `v` of `∂L/∂v(q, v) = p` (Newton's method with the exact
     /// Hessian, seeded with the last step's velocity).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.step()?;
+    /// assert_eq!(stepper.v()?, stepper.p()); // L = (v² − q²)/2: p = v
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn v(&self) -> Result<SVector<f64, N>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
         self.velocity_at(state.t, &state.q, &state.p, &state.velocity, true)
@@ -670,6 +1274,23 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
 
     /// Energy `⟨p, v⟩ − L(q, v)` of the current state, with `v` from [`v`](Self::v); an error,
     /// never NaN, where it is not finite.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run(1000)?;
+    /// // The midpoint rule keeps this quadratic energy exactly, up to round-off.
+    /// assert!((stepper.energy()? - 0.5).abs() < 1e-13);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn energy(&self) -> Result<f64, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
         self.energy_of(&state, self.steps)
@@ -700,11 +1321,44 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// How Newton's method went on the last step.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// assert!(stepper.last_report().is_none());
+    /// stepper.step()?;
+    /// assert!(stepper.last_report().is_some_and(|r| r.iterations <= 3));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn last_report(&self) -> Option<NewtonReport> {
         self.report
     }
 
     /// An empty trajectory with this system's coordinate (and multiplier) columns.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// let trajectory = stepper.trajectory();
+    /// assert!(trajectory.is_empty());
+    /// assert_eq!(trajectory.column_names(), ["t", "q0", "v_q0", "p_q0", "energy"]);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn trajectory(&self) -> Trajectory<N> {
         let names = self.coordinate_names();
         let options = self.newton.options();
@@ -727,6 +1381,20 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// Coordinate names, from the system.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.coordinate_names(), ["q0"]);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     pub fn coordinate_names(&self) -> Vec<String> {
         (0..N).map(|i| self.equations.coordinate_name(i)).collect()
     }

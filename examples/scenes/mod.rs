@@ -86,29 +86,32 @@ pub fn print_table(reports: &[Report]) {
 }
 
 /// Writes reports as CSV.
-pub fn save_table(reports: &[Report], path: &str) -> std::io::Result<()> {
-    use std::io::Write;
+pub fn save_table(reports: &[Report], path: &str) -> Result<(), csv::Error> {
     if let Some(dir) = std::path::Path::new(path).parent() {
         std::fs::create_dir_all(dir)?;
     }
-    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(
-        f,
-        "scene,quadrature,h,steps,max_energy_error,wall_seconds,check"
-    )?;
+    let mut table = csv::Writer::from_path(path)?;
+    table.write_record([
+        "scene",
+        "quadrature",
+        "h",
+        "steps",
+        "max_energy_error",
+        "wall_seconds",
+        "check",
+    ])?;
     for r in reports {
-        writeln!(
-            f,
-            "{},\"{}\",{},{},{},{},\"{}\"",
-            r.scene,
-            r.quadrature,
-            r.h,
-            r.steps,
+        table.write_record([
+            r.scene.to_string(),
+            r.quadrature.clone(),
+            r.h.to_string(),
+            r.steps.to_string(),
             r.max_energy_error
                 .map_or(String::new(), |e| format!("{e:e}")),
-            r.wall.as_secs_f64(),
-            r.check
-        )?;
+            r.wall.as_secs_f64().to_string(),
+            r.check.clone(),
+        ])?;
     }
+    table.flush()?;
     Ok(())
 }

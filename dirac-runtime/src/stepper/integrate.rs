@@ -38,7 +38,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn run(&mut self, steps: u64) -> Result<Trajectory<N>, Box<Interrupted<N>>> {
-        self.solve(Run::steps(steps)).map(|solution| solution.trajectory)
+        self.solve(Run::steps(steps))
+            .map(|solution| solution.trajectory)
     }
 
     /// Runs to time `t_end` (the fewest whole steps that reach it; see [`Run::until`]) and
@@ -170,7 +171,11 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// The run's loop; `solution` keeps what was saved whatever happens.
-    fn carry_out(&mut self, mut run: Run<'_, N>, solution: &mut Solution<N>) -> Result<(), DiracError> {
+    fn carry_out(
+        &mut self,
+        mut run: Run<'_, N>,
+        solution: &mut Solution<N>,
+    ) -> Result<(), DiracError> {
         let start = self.state.ok_or(DiracError::NotStarted)?;
         let h = self.h();
         let (total, saveat) = run.plan(start.t, h)?;
@@ -184,7 +189,10 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             None => self.save(trajectory, &current, None)?,
             Some(times) => {
                 while saved < times.len() && times[saved] <= start.t {
-                    let at = Sample { t: times[saved], ..current };
+                    let at = Sample {
+                        t: times[saved],
+                        ..current
+                    };
                     self.save(trajectory, &at, None)?;
                     saved += 1;
                 }
@@ -221,7 +229,14 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                 while saved < times.len() && (times[saved] <= current.t || last) {
                     let theta = run::fraction(&previous, times[saved], h);
                     let inside = self.dense_sample(&previous, &current, theta)?;
-                    self.save(trajectory, &Sample { t: times[saved], ..inside }, None)?;
+                    self.save(
+                        trajectory,
+                        &Sample {
+                            t: times[saved],
+                            ..inside
+                        },
+                        None,
+                    )?;
                     saved += 1;
                 }
             }
