@@ -84,7 +84,7 @@ fn energy() -> Result<&'static str, Box<dyn Error>> {
     for quadrature in super::quadratures() {
         let name = quadrature.name();
         let mut stepper = double_pendulum::stepper(quadrature, 0.01)?;
-        let trajectory = stepper.run(2000)?;
+        let trajectory = stepper.run_until(20.0)?;
         let e0 = trajectory.energy()[0];
         let points = trajectory
             .t()
@@ -125,7 +125,7 @@ fn knife_edge_paths() -> Result<&'static str, Box<dyn Error>> {
         ConstraintPoint::End,
     ] {
         let mut stepper = knife_edge::stepper(point, h)?;
-        let trajectory = stepper.run(steps)?;
+        let trajectory = stepper.run_until(steps as f64 * h)?;
         let points = trajectory.q().iter().map(|q| (q[1], q[0])).collect();
         series.push(Series {
             label: format!("constraint at {point:?}"),
@@ -147,7 +147,7 @@ fn lc_circuit() -> Result<&'static str, Box<dyn Error>> {
     let h = 0.1;
     let mut stepper = Stepper::new(circuit::LC, Quadrature::midpoint(), h)?;
     stepper.start_from_velocity(circuit::q0(), SVector::zeros())?;
-    let trajectory = stepper.run(300)?;
+    let trajectory = stepper.run_until(30.0)?;
     let computed = trajectory
         .t()
         .iter()
