@@ -27,7 +27,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "closed loop from θ = 0.3: at t = {t:.1} s, x = {x:.2e}, θ = {theta:.2e}, u = {u:.2e}"
     );
     std::fs::create_dir_all("output")?;
-    scenes::plot::register_font()?;
     println!("wrote {}", scenes::figures::cart_pole_lqr()?);
     Ok(())
 }

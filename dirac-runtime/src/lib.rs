@@ -31,6 +31,8 @@ mod layout;
 pub mod legendre;
 mod lu;
 pub mod newton;
+#[cfg(feature = "plot")]
+pub mod plot;
 pub mod quadrature;
 pub mod run;
 pub mod scalar;
@@ -39,6 +41,7 @@ pub mod step_equations;
 pub mod stepper;
 pub mod system;
 pub mod trajectory;
+pub mod work_precision;
 
 pub use configuration_space::{ConfigurationSpace, Euclidean, Positive};
 pub use constraint::ConstraintPoint;
@@ -59,6 +62,7 @@ pub use step_equations::{State, StepEquations};
 pub use stepper::Stepper;
 pub use system::DiracSystem;
 pub use trajectory::{Interrupted, Metadata, Trajectory};
+pub use work_precision::{Measurement, Study, WorkPrecision};
 
 pub use nalgebra;
 pub use num_dual;

@@ -11,6 +11,7 @@ use std::ops::ControlFlow;
 use crate::dense_output::Sample;
 use crate::error::DiracError;
 use crate::event::{Crossing, Event};
+use crate::newton::NewtonReport;
 use crate::step_equations::State;
 use crate::trajectory::Trajectory;
 
@@ -190,6 +191,8 @@ pub struct Progress<'s, const N: usize> {
     pub total: u64,
     /// The state reached.
     pub state: &'s State<N>,
+    /// How Newton's method went on the step.
+    pub newton: NewtonReport,
 }
 
 /// How a run ended.

@@ -279,15 +279,19 @@ impl<const N: usize> Trajectory<N> {
 
     /// Writes the CSV to a file, creating its directory if needed.
     pub fn save_csv(&self, path: impl AsRef<Path>) -> Result<(), DiracError> {
-        let path = path.as_ref();
-        let io = |e: std::io::Error| DiracError::Io(format!("{}: {e}", path.display()));
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(io)?;
-        }
-        self.write_csv(std::io::BufWriter::new(
-            std::fs::File::create(path).map_err(io)?,
-        ))
+        self.write_csv(create(path.as_ref())?)
     }
+}
+
+/// A buffered new file at `path`, its directory created if needed.
+pub(crate) fn create(path: &Path) -> Result<std::io::BufWriter<std::fs::File>, DiracError> {
+    let io = |e: std::io::Error| DiracError::Io(format!("{}: {e}", path.display()));
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(io)?;
+    }
+    Ok(std::io::BufWriter::new(
+        std::fs::File::create(path).map_err(io)?,
+    ))
 }
 
 /// A run that stopped at a failing step: the trajectory and events up to the last good step,

@@ -6,12 +6,11 @@ use std::error::Error;
 
 use dirac::prelude::*;
 
-use super::plot::{Series, line_chart};
 use super::{cart_pole, circuit, double_pendulum, knife_edge, pendulum};
+use dirac::plot::{Series, line_chart};
 
 /// Writes every figure to `output/` and returns their paths.
 pub fn draw_all() -> Result<Vec<&'static str>, Box<dyn Error>> {
-    super::plot::register_font()?;
     Ok(vec![
         convergence()?,
         energy()?,

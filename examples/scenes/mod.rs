@@ -14,7 +14,6 @@ pub mod knife_edge;
 pub mod lotka_volterra;
 pub mod oscillator;
 pub mod pendulum;
-pub mod plot;
 pub mod port;
 pub mod progress;
 pub mod rolling_disk;

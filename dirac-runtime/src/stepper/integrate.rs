@@ -278,10 +278,12 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             }
             if let Some(observer) = &mut run.observer {
                 let state = self.state.as_ref().ok_or(DiracError::NotStarted)?;
+                let newton = self.report.ok_or(DiracError::NotStarted)?;
                 let progress = Progress {
                     steps: k,
                     total,
                     state,
+                    newton,
                 };
                 if let ControlFlow::Break(()) = observer(&progress) {
                     stop = stop.or(Some(Status::Stopped));

@@ -1,0 +1,189 @@
+//! The speed/accuracy study: errors against closed forms computed independently, the reference it
+//! converges by itself, the chooser picking the cheapest run that truly meets a target, and the
+//! refusals.
+
+#[path = "../examples/scenes/mod.rs"]
+mod scenes;
+
+use dirac::prelude::*;
+use dirac::work_precision::Study;
+use scenes::{knife_edge, pendulum};
+
+/// Unit oscillator, `x = cos t`, `p = −sin t`.
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2) - 0.5 * x * x)]
+#[derive(Debug, Clone, Copy)]
+struct Oscillator;
+
+fn oscillator_at(t: f64) -> Sample<1> {
+    Sample {
+        t,
+        q: vector![t.cos()],
+        v: vector![-t.sin()],
+        p: vector![-t.sin()],
+    }
+}
+
+const STEPS: [f64; 4] = [0.2, 0.1, 0.05, 0.025];
+
+/// `|(q, p)(T) − exact|` by a stepper run here, not by the study.
+fn direct_error(quadrature: Quadrature, h: f64, horizon: f64) -> f64 {
+    let mut stepper = Stepper::new(Oscillator, quadrature, h).unwrap();
+    stepper
+        .start_from_velocity(vector![1.0], vector![0.0])
+        .unwrap();
+    stepper.run_until(horizon).unwrap();
+    let exact = oscillator_at(horizon);
+    (stepper.q() - exact.q)
+        .amax()
+        .max((stepper.p() - exact.p).amax())
+}
+
+#[test]
+fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
+    let horizon = 10.0;
+    let study = Study::new(Oscillator, horizon, |s| {
+        s.start_from_velocity(vector![1.0], vector![0.0])
+    })
+    .steps(STEPS)
+    .repetitions(2)
+    .reference(oscillator_at(horizon))
+    .run()
+    .unwrap();
+    assert!(study.failures.is_empty(), "{:?}", study.failures);
+    assert_eq!(study.measurements.len(), 12);
+    for m in &study.measurements {
+        let quadrature = scenes::quadratures()
+            .into_iter()
+            .find(|q| q.name() == m.quadrature)
+            .unwrap();
+        let direct = direct_error(quadrature, m.h, horizon);
+        assert!(
+            (m.error - direct).abs() <= 1e-14 + 1e-9 * direct,
+            "{m:?} against {direct:e}"
+        );
+        assert_eq!(m.steps, (horizon / m.h).round() as u64);
+        assert!(m.seconds_per_unit_time > 0.0 && m.newton_iterations >= 1.0);
+        // A quadratic energy: the Gauss rules keep it to round-off.
+        assert!(m.energy_error < 1e-13, "{m:?}");
+    }
+    for target in [1e-3, 1e-6, 1e-9] {
+        let choice = study.cheapest(target).unwrap();
+        let quadrature = scenes::quadratures()
+            .into_iter()
+            .find(|q| q.name() == choice.quadrature)
+            .unwrap();
+        assert!(
+            direct_error(quadrature, choice.h, horizon) <= target,
+            "{choice:?}"
+        );
+        assert!(
+            study
+                .measurements
+                .iter()
+                .filter(|m| m.error <= target)
+                .all(|m| m.seconds_per_unit_time >= choice.seconds_per_unit_time)
+        );
+        println!(
+            "target {target:e}: {} at h = {} ({:e})",
+            choice.quadrature, choice.h, choice.error
+        );
+    }
+    // Unreachable targets are refused, naming the most accurate run.
+    let refused = study.cheapest(1e-15).unwrap_err();
+    assert!(refused.to_string().contains("no run reaches"), "{refused}");
+    let png = std::env::temp_dir().join("dirac_work_precision_test.png");
+    study.save_png(&png, "oscillator to T = 10").unwrap();
+    let bytes = std::fs::read(&png).unwrap();
+    assert!(bytes.starts_with(b"\x89PNG") && bytes.len() > 10_000);
+    let mut csv = Vec::new();
+    study.write_csv(&mut csv).unwrap();
+    let text = String::from_utf8(csv).unwrap();
+    assert_eq!(text.lines().count(), 13);
+    assert!(text.starts_with("quadrature,h,steps,error,energy_error,"));
+}
+
+/// Without a reference the study converges one, and it agrees with the pendulum's known q(5),
+/// p(5) (14 digits) to its own error estimate.
+#[test]
+fn the_converged_reference_agrees_with_the_known_answer() {
+    let study = Study::new(pendulum::SCENE, 5.0, |s| {
+        s.start_from_momentum(vector![1.0], vector![0.0])
+    })
+    .steps([0.1, 0.05])
+    .repetitions(1)
+    .run()
+    .unwrap();
+    let reference = study.reference;
+    let off = (reference.q[0] - pendulum::Q5)
+        .abs()
+        .max((reference.p[0] - pendulum::P5).abs());
+    assert!(
+        off < 1e-12,
+        "reference off by {off:e} ({})",
+        study.reference_method
+    );
+    assert!(study.reference_error < 1e-11, "{}", study.reference_error);
+    assert!(study.reference_method.starts_with("galerkin(3)"));
+    for m in &study.measurements {
+        assert!(m.error > 0.0);
+    }
+    // The midpoint rule's energy error is bounded but not round-off: the energy chooser picks a
+    // run that meets its target, the cheapest of those that do.
+    let choice = study.cheapest_in_energy(1e-6).unwrap();
+    assert!(choice.energy_error <= 1e-6);
+    assert!(
+        study
+            .measurements
+            .iter()
+            .filter(|m| m.energy_error <= 1e-6)
+            .all(|m| m.seconds_per_unit_time >= choice.seconds_per_unit_time)
+    );
+    // A target below what the reference resolves is refused.
+    let refused = study.cheapest(study.reference_error).unwrap_err();
+    assert!(
+        refused
+            .to_string()
+            .contains("below what the reference resolves"),
+        "{refused}"
+    );
+}
+
+/// A quadrature the model refuses is reported with its reason; the rest of the grid is measured.
+#[test]
+fn refused_runs_are_reported_and_the_rest_measured() {
+    let lobatto = Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3)).unwrap();
+    let study = Study::new(knife_edge::SCENE, 1.0, |s| {
+        s.start_from_velocity(SVector::zeros(), vector![0.0, 0.0, knife_edge::OMEGA])
+    })
+    .quadratures([Quadrature::midpoint(), lobatto])
+    .steps([0.05])
+    .repetitions(1)
+    .reference(Sample {
+        t: 1.0,
+        q: knife_edge::exact(1.0),
+        v: SVector::zeros(),
+        p: SVector::zeros(),
+    })
+    .run()
+    .unwrap();
+    assert_eq!(study.measurements.len(), 1);
+    assert_eq!(study.failures.len(), 1);
+    assert!(study.failures[0].quadrature.contains("gauss_lobatto"));
+    assert!(study.measurements[0].constraint_violation < 1e-12);
+}
+
+#[test]
+fn an_invalid_study_is_refused() {
+    let start = |s: &mut Stepper<Oscillator, 1>| s.start_from_velocity(vector![1.0], vector![0.0]);
+    let invalid =
+        |study: Study<'_, Oscillator, 1>| matches!(study.run(), Err(DiracError::InvalidRun(_)));
+    assert!(invalid(Study::new(Oscillator, -1.0, start)));
+    assert!(invalid(Study::new(Oscillator, 1.0, start).steps([])));
+    assert!(invalid(
+        Study::new(Oscillator, 1.0, start).steps([0.1, -0.1])
+    ));
+    assert!(invalid(Study::new(Oscillator, 1.0, start).quadratures([])));
+    assert!(invalid(
+        Study::new(Oscillator, 1.0, start).reference(oscillator_at(2.0))
+    ));
+}
