@@ -10,7 +10,7 @@
 mod scenes;
 
 use dirac::prelude::*;
-use dirac::work_precision::Study;
+use dirac::work_precision::{Measurement, Study};
 use scenes::double_pendulum;
 
 fn main() -> Result<(), DiracError> {
@@ -52,28 +52,25 @@ fn main() -> Result<(), DiracError> {
             );
         }
         for target in [1e-3, 1e-6, 1e-9] {
-            match study.cheapest(target) {
-                Ok(m) => println!(
-                    "  error ≤ {target:e}: {} at h = {} ({:.1} µs per unit t)",
-                    m.quadrature,
-                    m.h,
-                    m.seconds_per_unit_time * 1e6
-                ),
-                Err(why) => println!("  error ≤ {target:e}: {why}"),
-            }
+            print_choice("error", target, study.cheapest(target));
         }
         for target in [1e-4, 1e-8] {
-            match study.cheapest_in_energy(target) {
-                Ok(m) => println!(
-                    "  energy error ≤ {target:e}: {} at h = {} ({:.1} µs per unit t)",
-                    m.quadrature,
-                    m.h,
-                    m.seconds_per_unit_time * 1e6
-                ),
-                Err(why) => println!("  energy error ≤ {target:e}: {why}"),
-            }
+            print_choice("energy error", target, study.cheapest_in_energy(target));
         }
         println!("  wrote {name}.csv and {name}.png");
     }
     Ok(())
+}
+
+/// Prints the cheapest run meeting `target` in `what`, or why there is none.
+fn print_choice(what: &str, target: f64, choice: Result<&Measurement, DiracError>) {
+    match choice {
+        Ok(m) => println!(
+            "  {what} ≤ {target:e}: {} at h = {} ({:.1} µs per unit t)",
+            m.quadrature,
+            m.h,
+            m.seconds_per_unit_time * 1e6
+        ),
+        Err(why) => println!("  {what} ≤ {target:e}: {why}"),
+    }
 }
