@@ -7,6 +7,7 @@ pub mod cartesian_pendulum;
 pub mod chain;
 pub mod circuit;
 pub mod double_pendulum;
+pub mod ensemble;
 pub mod figures;
 pub mod hand_written;
 pub mod kepler;
