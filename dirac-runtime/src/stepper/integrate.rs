@@ -260,21 +260,15 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                             direction,
                             sample: self.dense_sample(&previous, &current, theta)?,
                         });
-                        if event.is_terminal() && stop.is_none() {
-                            stop = Some(Status::Event(index));
-                        }
                     }
                     signs[index] = sign;
                 }
                 solution.events[found..].sort_by(|a, b| a.sample.t.total_cmp(&b.sample.t));
-                if let Some(Status::Event(_)) = stop {
-                    // The first terminal crossing of the step is the one that ends the run.
-                    let first = solution.events[found..]
-                        .iter()
-                        .find(|c| run.events[c.event].is_terminal())
-                        .map(|c| c.event);
-                    stop = first.map(Status::Event);
-                }
+                // The step's earliest terminal crossing is the one that ends the run.
+                stop = solution.events[found..]
+                    .iter()
+                    .find(|c| run.events[c.event].is_terminal())
+                    .map(|c| Status::Event(c.event));
             }
             if let Some(observer) = &mut run.observer {
                 let state = self.state.as_ref().ok_or(DiracError::NotStarted)?;
