@@ -323,14 +323,7 @@ fn only_what_a_model_names_is_there() {
         .start_from_velocity(circuit::q0(), SVector::zeros())
         .unwrap();
     let trajectory = stepper.run(2).unwrap();
-    let mut csv = Vec::new();
-    trajectory.write_csv(&mut csv).unwrap();
-    let header = String::from_utf8(csv)
-        .unwrap()
-        .lines()
-        .next()
-        .unwrap()
-        .to_string();
+    let header = support::csv_header(&trajectory);
     assert_eq!(
         header,
         "t,q_l,q_c1,q_c2,q_c3,v_q_l,v_q_c1,v_q_c2,v_q_c3,p_q_l,p_q_c1,p_q_c2,p_q_c3,energy,\

@@ -32,3 +32,11 @@ pub fn energy_error_first_and_last_tenth(energy: &[f64]) -> (f64, f64) {
     let max = |s: &[f64]| s.iter().cloned().fold(0.0, f64::max);
     (max(&errors[..tenth]), max(&errors[errors.len() - tenth..]))
 }
+
+/// The header row of a trajectory's CSV.
+pub fn csv_header<const N: usize>(trajectory: &dirac::Trajectory<N>) -> String {
+    let mut csv = Vec::new();
+    trajectory.write_csv(&mut csv).expect("CSV into memory");
+    let text = String::from_utf8(csv).expect("UTF-8 CSV");
+    text.lines().next().unwrap_or_default().to_string()
+}
