@@ -4,7 +4,8 @@
 //! midpoint rule (the knife edge with each discrete constraint point); Lotka–Volterra (linear
 //! in the velocities) and the rolling disk with the Gauss rules; and the trapezoid rule's
 //! refusal of the ill-posed LC circuit is shown. Pictures: `output/convergence.png`,
-//! `output/energy_error.png`, `output/knife_edge.png`, `output/lc_circuit.png`.
+//! `output/energy_error.png`, `output/knife_edge.png`, `output/lc_circuit.png`,
+//! `output/cart_pole_lqr.png`, `output/long_horizon_energy.png`.
 //!
 //! `cargo run --release --example tour`
 

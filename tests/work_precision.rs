@@ -186,4 +186,9 @@ fn an_invalid_study_is_refused() {
     assert!(invalid(
         Study::new(Oscillator, 1.0, start).reference(oscillator_at(2.0))
     ));
+    for bad in [-1e-9, f64::NAN] {
+        assert!(invalid(
+            Study::new(Oscillator, 1.0, start).reference_with_error(oscillator_at(1.0), bad)
+        ));
+    }
 }

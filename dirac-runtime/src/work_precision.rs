@@ -59,7 +59,8 @@ pub struct Study<'a, S, const N: usize> {
     quadratures: Vec<Quadrature>,
     steps: Vec<f64>,
     repetitions: usize,
-    reference: Option<Sample<N>>,
+    /// The given reference and its error estimate.
+    reference: Option<(Sample<N>, f64)>,
 }
 
 impl<S, const N: usize> std::fmt::Debug for Study<'_, S, N> {
@@ -114,8 +115,8 @@ pub struct WorkPrecision<const N: usize> {
     pub reference: Sample<N>,
     /// How the reference was obtained (`given`, or the quadrature and step of the converged run).
     pub reference_method: String,
-    /// The reference's own error estimate (the difference of the two converged runs; 0 for a
-    /// given reference).
+    /// The reference's own error estimate (the difference of the two converged runs, or the
+    /// one given with the reference, 0 by default).
     pub reference_error: f64,
     /// One per run of the grid that could be measured, in grid order.
     pub measurements: Vec<Measurement>,
@@ -174,8 +175,37 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
     /// The solution at the horizon to measure errors against (a closed form, or a run of
     /// another integrator), instead of a converged run.
     pub fn reference(self, reference: Sample<N>) -> Self {
+        self.reference_with_error(reference, 0.0)
+    }
+
+    /// A reference of known accuracy, e.g. another integrator at a tight tolerance with `error`
+    /// its difference from a run at a looser one: error targets below ten times `error` are
+    /// refused, as for the converged reference.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Sample, Scalar, work_precision::Study};
+    /// # use nalgebra::{SVector, vector};
+    /// # #[derive(Clone)]
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// // A reference known to about 1e-7 only.
+    /// let rough = Sample { t: 1.0, q: vector![1f64.cos() + 1e-7], v: vector![-1f64.sin()], p: vector![-1f64.sin()] };
+    /// let study = Study::new(Oscillator, 1.0, |s| s.start_from_velocity(vector![1.0], vector![0.0]))
+    ///     .steps([0.1, 0.05])
+    ///     .reference_with_error(rough, 1e-7)
+    ///     .run()?;
+    /// assert_eq!(study.reference_error, 1e-7);
+    /// assert!(study.cheapest(1e-4).is_ok());
+    /// assert!(study.cheapest(1e-7).is_err()); // below what the reference resolves
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn reference_with_error(self, reference: Sample<N>, error: f64) -> Self {
         Self {
-            reference: Some(reference),
+            reference: Some((reference, error)),
             ..self
         }
     }
@@ -187,7 +217,7 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
     pub fn run(&self) -> Result<WorkPrecision<N>, DiracError> {
         self.check()?;
         let (reference, reference_method, reference_error) = match &self.reference {
-            Some(given) => (*given, "given".to_string(), 0.0),
+            Some((given, error)) => (*given, "given".to_string(), *error),
             None => self.converged_reference()?,
         };
         let mut measurements = Vec::new();
@@ -227,7 +257,12 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
         if let Some(h) = self.steps.iter().find(|h| !(h.is_finite() && **h > 0.0)) {
             return invalid(format!("steps must be positive and finite, got {h}"));
         }
-        if let Some(reference) = &self.reference {
+        if let Some((reference, error)) = &self.reference {
+            if !(error.is_finite() && *error >= 0.0) {
+                return invalid(format!(
+                    "the reference's error estimate must be finite and not negative, got {error}"
+                ));
+            }
             // The start function sets the time the horizon counts from.
             let t0 = self.stepper(&self.quadratures[0], self.steps[0])?.t();
             let t_end = t0 + self.horizon;

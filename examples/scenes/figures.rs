@@ -1,12 +1,13 @@
 //! The tour's pictures: orders of convergence, energy errors over time, the knife edge's paths
 //! under the three discrete constraints, the LC circuit against its closed form, and the
-//! cart-pole balanced by LQR on the step map's derivatives.
+//! cart-pole balanced by LQR on the step map's derivatives, and the pendulum's energy error against
+//! cost to T = 10⁴ beside the explicit Runge–Kutta and BDF peers.
 
 use std::error::Error;
 
 use dirac::prelude::*;
 
-use super::{cart_pole, circuit, double_pendulum, knife_edge, pendulum};
+use super::{cart_pole, circuit, double_pendulum, knife_edge, pendulum, study};
 use dirac::plot::{Series, line_chart};
 
 /// Writes every figure to `output/` and returns their paths.
@@ -17,7 +18,25 @@ pub fn draw_all() -> Result<Vec<&'static str>, Box<dyn Error>> {
         knife_edge_paths()?,
         lc_circuit()?,
         cart_pole_lqr()?,
+        long_horizon()?,
     ])
+}
+
+/// The pendulum to T = 10⁴: the largest energy error against the wall time per unit of simulated
+/// time, dirac's three quadratures beside Dop853 and Dopri5 (the `work_precision` example's
+/// measurement, for one scene).
+pub fn long_horizon() -> Result<&'static str, Box<dyn Error>> {
+    let path = "output/long_horizon_energy.png";
+    let (rows, _, _) = study::measure(&study::pendulum(), 1e4)?;
+    let rows: Vec<&study::Row> = rows.iter().collect();
+    study::draw(
+        path,
+        "Pendulum to T = 10⁴: largest energy error against cost",
+        "largest energy error",
+        &rows,
+        |r| r.energy_error,
+    )?;
+    Ok(path)
 }
 
 /// The cart-pole from a 0.3 rad tilt under LQR feedback (midpoint, h = 0.01, T = 10).

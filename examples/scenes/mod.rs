@@ -9,15 +9,18 @@ pub mod circuit;
 pub mod double_pendulum;
 pub mod ensemble;
 pub mod figures;
+pub mod first_order;
 pub mod hand_written;
 pub mod kepler;
 pub mod knife_edge;
 pub mod lotka_volterra;
 pub mod oscillator;
+pub mod peers;
 pub mod pendulum;
 pub mod port;
 pub mod progress;
 pub mod rolling_disk;
+pub mod study;
 
 use std::time::{Duration, Instant};
 

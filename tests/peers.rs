@@ -1,0 +1,159 @@
+//! The peers of the speed/accuracy study against dirac and against closed forms: the hand-derived
+//! first-order forms of the seven scenes and dirac's discrete Lagrangian are independent
+//! derivations of the same dynamics, so agreement at tight tolerance checks both.
+
+#[path = "../examples/scenes/mod.rs"]
+mod scenes;
+
+use dirac::prelude::*;
+use scenes::first_order::FirstOrder;
+use scenes::peers::{self, Peer};
+use scenes::study::{self, Scene, Visitor};
+use scenes::{circuit, knife_edge, pendulum};
+
+const HORIZON: f64 = 2.0;
+
+/// dirac's `galerkin(3)` at half the scene's smallest step against Dop853 at 1e-13, and every
+/// peer that takes the scene against the same reference.
+struct AgreeWithDirac;
+
+impl Visitor for AgreeWithDirac {
+    fn visit<S, F, G, const Y: usize, const Z: usize, const N: usize>(
+        &mut self,
+        scene: Scene<S, F, G, Y, Z, N>,
+    ) -> Result<(), String>
+    where
+        S: DiracSystem<N> + Clone,
+        F: FirstOrder<Y, N>,
+        G: FirstOrder<Z, N>,
+    {
+        let (reference, estimate) = peers::reference(&scene.ode, HORIZON)?;
+        assert!(
+            estimate < 1e-10,
+            "{}: reference estimate {estimate:e}",
+            scene.name
+        );
+        let h = scene.steps.iter().cloned().fold(f64::INFINITY, f64::min) / 2.0;
+        let start = scene.ode.sample(0.0, &scene.ode.initial());
+        let mut stepper = Stepper::new(scene.system, Quadrature::galerkin(3).unwrap(), h)
+            .map_err(|e| e.to_string())?;
+        stepper
+            .start_from_velocity(start.q, start.v)
+            .map_err(|e| e.to_string())?;
+        stepper.run_until(HORIZON).map_err(|e| e.to_string())?;
+        let end = stepper.interpolate(HORIZON).map_err(|e| e.to_string())?;
+        let gap = peers::distance(&end, &reference);
+        println!(
+            "{}: dirac galerkin(3) h = {h} vs Dop853: {gap:.1e}",
+            scene.name
+        );
+        assert!(
+            gap < 1e-8,
+            "{}: dirac and Dop853 differ by {gap:e}",
+            scene.name
+        );
+        for peer in [Peer::Dop853, Peer::Dopri5] {
+            let run = peers::measure(peer, &scene.ode, HORIZON, 1e-10, &reference, 1)?;
+            println!(
+                "  {} at 1e-10: error {:.1e}, |ΔE| {:.1e}",
+                peer.name(),
+                run.error,
+                run.energy_error
+            );
+            assert!(
+                run.error < 1e-7,
+                "{} {}: {:e}",
+                scene.name,
+                peer.name(),
+                run.error
+            );
+        }
+        if let Some(dae) = &scene.dae {
+            let run = peers::measure(Peer::Bdf, dae, HORIZON, 1e-10, &reference, 1)?;
+            println!(
+                "  BDF at 1e-10: error {:.1e}, violation {:.1e}",
+                run.error, run.violation
+            );
+            assert!(run.error < 1e-6, "{} BDF: {:e}", scene.name, run.error);
+            assert!(
+                run.violation < 1e-6,
+                "{} BDF violation: {:e}",
+                scene.name,
+                run.violation
+            );
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn every_scene_agrees_with_dirac_and_the_peers_with_each_other() {
+    study::visit_all(&mut AgreeWithDirac).unwrap();
+}
+
+/// The forms against the scenes' closed forms, with no dirac involved.
+#[test]
+fn the_first_order_forms_meet_the_closed_forms() {
+    use scenes::first_order::{KeplerOde, KnifeEdgeOde, LcDae, LcOde, PendulumOde};
+    let pendulum = PendulumOde {
+        pendulum: pendulum::SCENE,
+        theta0: 1.0,
+    };
+    let end = peers::solution(&pendulum, 5.0, 1e-13).unwrap();
+    assert!((end.q[0] - pendulum::Q5).abs() < 1e-11 && (end.p[0] - pendulum::P5).abs() < 1e-11);
+
+    let lc = LcOde {
+        circuit: circuit::LC,
+        q0: circuit::q0().into(),
+    };
+    let end = peers::solution(&lc, 10.0, 1e-13).unwrap();
+    assert!(
+        (end.q[2] - circuit::lc_q_c2(10.0)).abs() < 1e-11,
+        "{}",
+        end.q[2]
+    );
+    let dae = LcDae(lc);
+    let reference = peers::solution(&lc, 10.0, 1e-13).unwrap();
+    let run = peers::measure(Peer::Bdf, &dae, 10.0, 1e-10, &reference, 1).unwrap();
+    assert!(run.error < 1e-6, "BDF on the LC DAE: {:e}", run.error);
+
+    let knife = KnifeEdgeOde {
+        knife: knife_edge::SCENE,
+        omega: knife_edge::OMEGA,
+    };
+    let end = peers::solution(&knife, 10.0, 1e-13).unwrap();
+    assert!(
+        (end.q - knife_edge::exact(10.0)).amax() < 1e-10,
+        "{}",
+        end.q
+    );
+
+    // The closed forms the study measures against, against Dop853 at 1e-13.
+    fn agree<F: FirstOrder<Y, N>, const Y: usize, const N: usize>(ode: &F, name: &str) {
+        for t in [0.0, 3.7, 10.0] {
+            let exact = ode.sample(t, &ode.exact(t).unwrap());
+            let gap = if t == 0.0 {
+                peers::distance(&exact, &ode.sample(0.0, &ode.initial()))
+            } else {
+                peers::distance(&exact, &peers::solution(ode, t, 1e-13).unwrap())
+            };
+            assert!(gap < 1e-10, "{name} at t = {t}: {gap:e}");
+        }
+    }
+    agree(&knife, "knife edge");
+    agree(&lc, "LC circuit");
+    agree(&KeplerOde { e: 0.5 }, "Kepler e = 0.5");
+    agree(&KeplerOde { e: 0.9 }, "Kepler e = 0.9");
+}
+
+#[test]
+fn explicit_peers_refuse_algebraic_rows() {
+    use scenes::first_order::{LcDae, LcOde};
+    let dae = LcDae(LcOde {
+        circuit: circuit::LC,
+        q0: circuit::q0().into(),
+    });
+    let reference = peers::solution(&dae.0, 1.0, 1e-13).unwrap();
+    let refused = peers::measure(Peer::Dop853, &dae, 1.0, 1e-8, &reference, 1).unwrap_err();
+    assert!(refused.contains("algebraic"), "{refused}");
+}
