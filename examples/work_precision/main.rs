@@ -1,8 +1,8 @@
 //! The speed/accuracy study: dirac's quadratures against the integrators users would otherwise
 //! pick, on seven scenes, to T = 10 and T = 10⁴, measured in one run.
 //!
-//! Per scene and horizon: a reference by Dop853 at `rtol = atol = 1e-13` (its error estimated
-//! by the run at 1e-12); dirac's `midpoint`, `galerkin(2)` and `galerkin(3)` at the scene's
+//! Per scene and horizon: a reference, the closed form where the scene has one, else Dop853 at
+//! `rtol = atol = 1e-13` (its error estimated by the run at 1e-12); dirac's `midpoint`, `galerkin(2)` and `galerkin(3)` at the scene's
 //! steps, measured by `Study`; Dop853 and Dopri5 (ode_solvers) at tolerances 1e-4 … 1e-12 on the
 //! hand-derived first-order form; and BDF (diffsol) on the index-1 DAE of the circuit and of the
 //! knife edge. Every run's error at the horizon, largest energy error over every step and wall
@@ -10,7 +10,7 @@
 //! scene and horizon (error and energy error against cost); the summary prints, for each energy
 //! error target, the cheapest run of dirac and of the peers and their cost ratio.
 //!
-//! `cargo run --release --example work_precision` (about ten minutes; `-- 10` runs T = 10 only)
+//! `cargo run --release --example work_precision` (15 minutes here; `-- 10` runs T = 10 only)
 
 #[path = "../scenes/mod.rs"]
 mod scenes;
@@ -68,7 +68,11 @@ impl Runner {
     }
 
     fn print_and_draw(&self, scene: &str, horizon: f64, estimate: f64) -> Result<(), String> {
-        println!("  reference: Dop853 at 1e-13, estimated error {estimate:.1e}");
+        if estimate == 0.0 {
+            println!("  reference: the closed form");
+        } else {
+            println!("  reference: Dop853 at 1e-13, estimated error {estimate:.1e}");
+        }
         println!(
             "  {:<12} {:>12} {:>10} {:>10} {:>10} {:>10} {:>14}",
             "method", "setting", "steps", "error", "|ΔE|", "violation", "µs per unit t"
@@ -86,12 +90,12 @@ impl Runner {
                 r.seconds_per_unit_time * 1e6
             );
         }
+        // "Kepler e = 0.5" → kepler_e0.5, "chain (8 links)" → chain_8_links.
         let file = scene
-            .chars()
-            .filter(|c| c.is_alphanumeric() || *c == ' ')
-            .collect::<String>()
-            .replace(' ', "_")
-            .to_lowercase();
+            .to_lowercase()
+            .replace(" = ", "")
+            .replace(['(', ')'], "")
+            .replace(' ', "_");
         for (what, value, label) in [
             (
                 "error",
@@ -167,11 +171,13 @@ impl Runner {
                     at_most,
                 });
             }
-            if rows.iter().any(|r| r.violation > 0.0) {
+            // Where a peer's form lets the constraint drift (the knife edge): its first-order
+            // form of the circuit holds the constraints by construction.
+            if rows.iter().any(|r| !r.is_dirac() && r.violation > 1e-13) {
                 targets.push(Target {
                     what: "violation",
                     value: |r| r.violation,
-                    at_most: 1e-12,
+                    at_most: 1e-10,
                 });
             }
             for Target {
