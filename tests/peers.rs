@@ -9,7 +9,7 @@ use dirac::prelude::*;
 use scenes::first_order::FirstOrder;
 use scenes::peers::{self, Peer};
 use scenes::study::{self, Scene, Visitor};
-use scenes::{circuit, knife_edge, pendulum};
+use scenes::{circuit, kepler, knife_edge, pendulum};
 
 const HORIZON: f64 = 2.0;
 
@@ -40,6 +40,16 @@ impl Visitor for AgreeWithDirac {
         stepper
             .start_from_velocity(start.q, start.v)
             .map_err(|e| e.to_string())?;
+        // The form's energy is the model's.
+        let (form, model) = (
+            scene.ode.energy(&scene.ode.initial()),
+            stepper.energy().map_err(|e| e.to_string())?,
+        );
+        assert!(
+            (form - model).abs() <= 1e-12 * model.abs().max(1.0),
+            "{}: energy {form} in the form, {model} in the model",
+            scene.name
+        );
         stepper.run_until(HORIZON).map_err(|e| e.to_string())?;
         let end = stepper.interpolate(HORIZON).map_err(|e| e.to_string())?;
         let gap = peers::distance(&end, &reference);
@@ -66,6 +76,14 @@ impl Visitor for AgreeWithDirac {
                 scene.name,
                 peer.name(),
                 run.error
+            );
+            let tight = peers::measure(peer, &scene.ode, HORIZON, 1e-12, &reference, 1)?;
+            assert!(
+                tight.energy_error < 1e-8,
+                "{} {} at 1e-12: energy error {:e}",
+                scene.name,
+                peer.name(),
+                tight.energy_error
             );
         }
         if let Some(dae) = &scene.dae {
@@ -140,10 +158,35 @@ fn the_first_order_forms_meet_the_closed_forms() {
             assert!(gap < 1e-10, "{name} at t = {t}: {gap:e}");
         }
     }
+    // The violation vanishes on the closed forms and sees a state off the constraint.
+    for t in [1.0, 10.0] {
+        let on = knife.exact(t).unwrap();
+        assert!(knife.violation(&on) < 1e-12);
+        let mut off = on;
+        off[4] += 1e-3;
+        assert!(knife.violation(&off) > 1e-4);
+        let on = lc.exact(t).unwrap();
+        assert!(lc.violation(&on) < 1e-12);
+        let mut off = on;
+        off[1] += 1e-3;
+        assert!(lc.violation(&off) > 1e-4);
+    }
     agree(&knife, "knife edge");
     agree(&lc, "LC circuit");
-    agree(&KeplerOde { e: 0.5 }, "Kepler e = 0.5");
-    agree(&KeplerOde { e: 0.9 }, "Kepler e = 0.9");
+    agree(
+        &KeplerOde {
+            kepler: kepler::SCENE,
+            e: 0.5,
+        },
+        "Kepler e = 0.5",
+    );
+    agree(
+        &KeplerOde {
+            kepler: kepler::SCENE,
+            e: 0.9,
+        },
+        "Kepler e = 0.9",
+    );
 }
 
 #[test]

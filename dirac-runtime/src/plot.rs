@@ -30,6 +30,37 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
+impl Series {
+    /// One series per label, in order of first appearance, each series' points sorted by `x`.
+    ///
+    /// ```
+    /// use dirac_runtime::plot::Series;
+    /// let lines = Series::by_label([("a", (2.0, 1.0)), ("b", (0.0, 0.0)), ("a", (1.0, 3.0))]);
+    /// assert_eq!(lines[0].label, "a");
+    /// assert_eq!(lines[0].points, vec![(1.0, 3.0), (2.0, 1.0)]);
+    /// assert_eq!(lines[1].points, vec![(0.0, 0.0)]);
+    /// ```
+    pub fn by_label<L: AsRef<str>>(
+        points: impl IntoIterator<Item = (L, (f64, f64))>,
+    ) -> Vec<Series> {
+        let mut series: Vec<Series> = Vec::new();
+        for (label, point) in points {
+            let label = label.as_ref();
+            match series.iter_mut().find(|s| s.label == label) {
+                Some(line) => line.points.push(point),
+                None => series.push(Series {
+                    label: label.to_string(),
+                    points: vec![point],
+                }),
+            }
+        }
+        for line in &mut series {
+            line.points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
+        series
+    }
+}
+
 /// Makes the bundled font available as "sans-serif" (once per process).
 fn register_font() -> Result<(), DiracError> {
     static REGISTER: Once = Once::new();

@@ -411,20 +411,10 @@ impl<const N: usize> WorkPrecision<N> {
     #[cfg(feature = "plot")]
     pub fn save_png(&self, path: impl AsRef<Path>, title: &str) -> Result<(), DiracError> {
         use crate::plot::{Series, line_chart};
-        let mut series: Vec<Series> = Vec::new();
-        for m in &self.measurements {
+        let series = Series::by_label(self.measurements.iter().map(|m| {
             let point = (m.seconds_per_unit_time.log10(), m.error.log10());
-            match series.iter_mut().find(|s| s.label == m.quadrature) {
-                Some(line) => line.points.push(point),
-                None => series.push(Series {
-                    label: m.quadrature.clone(),
-                    points: vec![point],
-                }),
-            }
-        }
-        for line in &mut series {
-            line.points.sort_by(|a, b| a.0.total_cmp(&b.0));
-        }
+            (&m.quadrature, point)
+        }));
         let axes = (
             "log10 wall seconds per unit of simulated time",
             "log10 error at the horizon",

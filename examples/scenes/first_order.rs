@@ -12,6 +12,7 @@ use dirac::{Sample, Scalar};
 use super::chain::Chain;
 use super::circuit::LcCircuit;
 use super::double_pendulum::DoublePendulum;
+use super::kepler::Kepler;
 use super::knife_edge::KnifeEdge;
 use super::pendulum::Pendulum;
 
@@ -159,47 +160,46 @@ impl FirstOrder<4, 2> for DoublePendulumOde {
     }
 }
 
-/// Kepler's problem `q̈ = −q/|q|³` (μ = 1) from pericentre of an orbit of eccentricity `e` and
-/// semi-major axis 1: q0 = (1 − e, 0), q̇0 = (0, √((1 + e)/(1 − e))); y = (q, q̇).
+/// Kepler's problem `q̈ = −μ q/|q|³` from pericentre of an orbit of eccentricity `e` and
+/// semi-major axis 1: q0 = (1 − e, 0), q̇0 = (0, √(μ(1 + e)/(1 − e))); y = (q, q̇).
 #[derive(Debug, Clone, Copy)]
 pub struct KeplerOde {
+    pub kepler: Kepler,
     pub e: f64,
 }
 
 impl FirstOrder<4, 2> for KeplerOde {
     fn initial(&self) -> [f64; 4] {
-        [
-            1.0 - self.e,
-            0.0,
-            0.0,
-            ((1.0 + self.e) / (1.0 - self.e)).sqrt(),
-        ]
+        let speed = (self.kepler.mu * (1.0 + self.e) / (1.0 - self.e)).sqrt();
+        [1.0 - self.e, 0.0, 0.0, speed]
     }
     fn rhs<D: Scalar>(&self, y: &[D; 4]) -> [D; 4] {
         let r2 = y[0] * y[0] + y[1] * y[1];
-        let inverse_r3 = (r2 * r2.sqrt()).recip();
-        [y[2], y[3], -y[0] * inverse_r3, -y[1] * inverse_r3]
+        let mu_over_r3 = (r2 * r2.sqrt()).recip() * self.kepler.mu;
+        [y[2], y[3], -y[0] * mu_over_r3, -y[1] * mu_over_r3]
     }
     fn energy(&self, y: &[f64; 4]) -> f64 {
-        0.5 * (y[2] * y[2] + y[3] * y[3]) - (y[0] * y[0] + y[1] * y[1]).sqrt().recip()
+        0.5 * (y[2] * y[2] + y[3] * y[3]) - self.kepler.mu / (y[0] * y[0] + y[1] * y[1]).sqrt()
     }
     fn sample(&self, t: f64, y: &[f64; 4]) -> Sample<2> {
         sample(t, [y[0], y[1]], [y[2], y[3]], [y[2], y[3]])
     }
-    /// Kepler's equation `E − e sin E = t` (mean motion 1) solved by Newton from `E = t`:
-    /// `q = (cos E − e, √(1 − e²) sin E)`, `q̇ = (−sin E, √(1 − e²) cos E)/(1 − e cos E)`.
+    /// Kepler's equation `E − e sin E = n t` (mean motion `n = √μ`) solved by Newton from
+    /// `E = n t`: `q = (cos E − e, √(1 − e²) sin E)`,
+    /// `q̇ = n (−sin E, √(1 − e²) cos E)/(1 − e cos E)`.
     fn exact(&self, t: f64) -> Option<[f64; 4]> {
-        let e = self.e;
-        let mut anomaly = t;
+        let (e, n) = (self.e, self.kepler.mu.sqrt());
+        let mean = n * t;
+        let mut anomaly = mean;
         for _ in 0..100 {
-            let update = (anomaly - e * anomaly.sin() - t) / (1.0 - e * anomaly.cos());
+            let update = (anomaly - e * anomaly.sin() - mean) / (1.0 - e * anomaly.cos());
             anomaly -= update;
             if update.abs() < 1e-15 * anomaly.abs().max(1.0) {
                 break;
             }
         }
         let (sin, cos) = anomaly.sin_cos();
-        let (b, rate) = ((1.0 - e * e).sqrt(), 1.0 / (1.0 - e * cos));
+        let (b, rate) = ((1.0 - e * e).sqrt(), n / (1.0 - e * cos));
         Some([cos - e, b * sin, -sin * rate, b * cos * rate])
     }
 }
@@ -290,7 +290,12 @@ fn lc_energy(circuit: &LcCircuit, q: [f64; 4], i: f64) -> f64 {
 impl FirstOrder<5, 4> for LcOde {
     fn initial(&self) -> [f64; 5] {
         let [a, b, c, d] = self.q0;
-        [a, b, c, d, 0.0]
+        let y = [a, b, c, d, 0.0];
+        debug_assert!(
+            self.violation(&y) < 1e-12,
+            "C1 and C3 must start at one voltage"
+        );
+        y
     }
     fn rhs<D: Scalar>(&self, y: &[D; 5]) -> [D; 5] {
         let LcCircuit { l, c1, c2, c3 } = self.circuit;

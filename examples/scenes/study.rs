@@ -89,7 +89,10 @@ pub fn visit_all(visitor: &mut impl Visitor) -> Result<(), String> {
         visitor.visit(Scene::<_, _, KeplerOde, 4, 4, 2> {
             name,
             system: kepler::SCENE,
-            ode: KeplerOde { e },
+            ode: KeplerOde {
+                kepler: kepler::SCENE,
+                e,
+            },
             dae: None,
             long: (every_quadrature(), steps.clone()),
             steps,
@@ -281,20 +284,10 @@ pub fn draw(
     rows: &[&Row],
     value: fn(&Row) -> f64,
 ) -> Result<(), String> {
-    let mut series: Vec<Series> = Vec::new();
-    for r in rows {
+    let series = Series::by_label(rows.iter().map(|r| {
         let point = (r.seconds_per_unit_time.log10(), value(r).log10());
-        match series.iter_mut().find(|s| s.label == r.method) {
-            Some(line) => line.points.push(point),
-            None => series.push(Series {
-                label: r.method.clone(),
-                points: vec![point],
-            }),
-        }
-    }
-    for line in &mut series {
-        line.points.sort_by(|a, b| a.0.total_cmp(&b.0));
-    }
+        (&r.method, point)
+    }));
     let axes = (
         "log10 wall seconds per unit of simulated time",
         &*format!("log10 {label}"),
