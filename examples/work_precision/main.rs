@@ -12,7 +12,7 @@
 //! Constraint violations are printed but not compared: dirac records its discrete constraint
 //! `A(q_c)(q_{k+1} − q_k)`, the peers' forms the velocity constraint at each state.
 //!
-//! `cargo run --release --example work_precision` (15 minutes here; `-- 10` runs T = 10 only)
+//! `cargo run --release --example work_precision` (16 minutes here; `-- 10` runs T = 10 only)
 
 #[path = "../scenes/mod.rs"]
 mod scenes;
