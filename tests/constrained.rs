@@ -700,7 +700,15 @@ fn one_forms_at_the_nodes_of_galerkin_steps_keep_the_orders() {
         let knife: Vec<f64> = hs
             .iter()
             .map(|&h| {
-                let mut stepper = Stepper::new(knife_edge::SCENE, quadrature.clone(), h).unwrap();
+                // Newton's method (no Jacobian kept across steps), to see its convergence.
+                let newton = NewtonOptions {
+                    jacobian_reuse: Some(0.0),
+                    ..Default::default()
+                };
+                let mut stepper = Stepper::new(knife_edge::SCENE, quadrature.clone(), h)
+                    .unwrap()
+                    .with_newton_options(newton)
+                    .unwrap();
                 stepper
                     .start_from_velocity(SVector::zeros(), vector![0.0, 0.0, knife_edge::OMEGA])
                     .unwrap();

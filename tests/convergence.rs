@@ -85,22 +85,36 @@ fn double_pendulum_orders_match_theory() {
     }
 }
 
-/// The predictor extrapolates the last two steps' solutions: on the double pendulum at h = 0.01
-/// Newton takes 3.22 evaluations per step on average over 1 000 steps (78 % of the steps take 3;
-/// predicted from the last step alone it took 4.00), for the midpoint rule and `galerkin(2)`.
-/// The answer does not change: the same tolerances end every solve.
+/// The predictor extrapolates the last four steps' solutions (a cubic), and Newton's method
+/// evaluates the point after an update below the step tolerance without its Jacobian: on the
+/// double pendulum at h = 0.01 a step takes 2.97 evaluations on average over 1 000 steps, 1.97
+/// of them with the Jacobian (measured for the midpoint rule and `galerkin(2)`): two Newton
+/// iterations and a check. With the line through two steps and a Jacobian at every evaluation
+/// it took 3.22, all with the Jacobian, and from the last step alone 4.00. The answer does not change: the same tolerances end every solve.
 #[test]
 fn the_extrapolating_predictor_saves_a_newton_iteration() {
+    let newton = NewtonOptions {
+        jacobian_reuse: Some(0.0),
+        ..Default::default()
+    };
     for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
         let name = quadrature.name();
-        let mut stepper = double_pendulum::stepper(quadrature, 0.01).unwrap();
-        let mut total = 0;
+        let mut stepper = double_pendulum::stepper(quadrature, 0.01)
+            .unwrap()
+            .with_newton_options(newton)
+            .unwrap();
+        let (mut evaluations, mut jacobians) = (0, 0);
         for _ in 0..1000 {
             stepper.step().unwrap();
-            total += stepper.last_report().unwrap().iterations;
+            let report = stepper.last_report().unwrap();
+            evaluations += report.iterations;
+            jacobians += report.jacobians;
         }
-        let mean = total as f64 / 1000.0;
-        println!("{name}: {mean} Newton evaluations per step");
-        assert!(mean < 3.5, "{name}: {mean}");
+        let (mean, with_jacobian) = (evaluations as f64 / 1e3, jacobians as f64 / 1e3);
+        println!("{name}: {mean} Newton evaluations per step, {with_jacobian} with the Jacobian");
+        assert!(
+            mean <= 3.0 && with_jacobian <= 2.0,
+            "{name}: {mean}, {with_jacobian}"
+        );
     }
 }

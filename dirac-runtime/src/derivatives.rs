@@ -176,6 +176,32 @@ pub(crate) fn seeded_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const
     }
 }
 
+/// `(∂L/∂q, ∂L/∂v)` at `(q, v)`: two passes of first-order duals, no second derivatives.
+pub(crate) fn gradients<F: PhaseFunction<N>, const N: usize>(
+    lagrangian: &F,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+) -> (SVector<f64, N>, SVector<f64, N>) {
+    let constant = |x: &SVector<f64, N>| x.map(Dual::<N>::from);
+    let lq = lagrangian.value(&lift(q, 1.0), &constant(v));
+    let lv = lagrangian.value(&constant(q), &lift(v, 1.0));
+    (gradient(&lq), gradient(&lv))
+}
+
+/// [`gradients`] of `ℓ(ξ, ξ̇)`: for a translation chart, of `L` at `q_k + ξ` directly.
+#[inline]
+pub(crate) fn gradients_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
+    chart: &InChart<'_, S, C, N>,
+    xi: &SVector<f64, N>,
+    xi_dot: &SVector<f64, N>,
+) -> (SVector<f64, N>, SVector<f64, N>) {
+    if C::TRANSLATION {
+        gradients(chart.system, &(chart.base + xi), xi_dot)
+    } else {
+        gradients(chart, xi, xi_dot)
+    }
+}
+
 /// First-order dual numbers with `N` directions.
 pub(crate) type Dual<const N: usize> = DualSVec64<N>;
 

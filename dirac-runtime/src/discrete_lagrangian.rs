@@ -16,7 +16,9 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
-use crate::derivatives::{InChart, PhaseFunction, Seed, seeded_in_chart, third_derivative};
+use crate::derivatives::{
+    InChart, PhaseFunction, Seed, gradients_in_chart, seeded_in_chart, third_derivative,
+};
 use crate::error::DiracError;
 use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
@@ -153,15 +155,16 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
     /// The points are `Q_0 = base` and `Q_j = R_base(ξ_j)`; the unknowns are `ξ_1, …, ξ_s`
     /// (`Q_s = q_{k+1}`), blocks of `N`. Writes the residual
     /// `[π_k + ∂L_d/∂ξ_0; ∂L_d/∂ξ_1; …; ∂L_d/∂ξ_{s−1}]` (`π_k` the momentum in the chart) into
-    /// the first `N s` rows and adds its Jacobian into `jacobian` (which the caller zeroes).
-    /// Returns the slot covectors and the size of the terms summed into the residual.
+    /// the first `N s` rows and, when asked for, adds its Jacobian into `jacobian` (which the
+    /// caller zeroes). Without a Jacobian only first derivatives of `L` are taken. Returns the
+    /// slot covectors and the size of the terms summed into the residual.
     pub(crate) fn euler_lagrange(
         &self,
         base: &SVector<f64, N>,
         increments: &[SVector<f64, N>],
         momentum: &SVector<f64, N>,
         residual: &mut DVector<f64>,
-        jacobian: &mut DMatrix<f64>,
+        mut jacobian: Option<&mut DMatrix<f64>>,
     ) -> (StepCovectors<N>, f64) {
         let s = self.quadrature.degree();
         let h = self.h;
@@ -177,53 +180,68 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
             let (xi, xi_dot) = self.node(i, increments);
             let a = |j: usize| quad.ell(i, j);
             let d = |j: usize| quad.ell_prime(i, j) / h;
-            if s == 1 {
-                // One pair of slots: seed the directions of ξ_0 and ξ_1 themselves.
-                let l = seeded_in_chart(
-                    &chart,
-                    &xi,
-                    &xi_dot,
-                    Seed {
-                        position: a(0),
-                        velocity: d(0),
-                    },
-                    Seed {
-                        position: a(1),
-                        velocity: d(1),
-                    },
-                );
-                let mut r = residual.rows_mut(0, N);
-                r += l.first * w;
-                impulse += (l.first + l.second) * w;
-                end += l.second * w;
-                magnitude += (l.first.abs() + l.second.abs()) * w;
-                let mut block = jacobian.fixed_view_mut::<N, N>(0, 0);
-                block += l.mixed * w;
-            } else {
-                // Many pairs: the Hessian of ℓ at the node, then the chain rule.
-                let qv = seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::VELOCITY);
-                let qq =
-                    seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::POSITION).mixed;
-                let vv =
-                    seeded_in_chart(&chart, &xi, &xi_dot, Seed::VELOCITY, Seed::VELOCITY).mixed;
-                let (lq, lv, qv) = (qv.first, qv.second, qv.mixed);
-                impulse += lq * w;
-                end += (lq * a(s) + lv * d(s)) * w;
-                magnitude += (lq.abs() + lv.abs() * s as f64 / h) * w;
-                for j in 0..s {
-                    let mut r = residual.rows_mut(j * N, N);
-                    r += (lq * a(j) + lv * d(j)) * w;
+            let (lq, lv) = match jacobian.as_deref_mut() {
+                None => gradients_in_chart(&chart, &xi, &xi_dot),
+                Some(jacobian) if s == 1 => {
+                    // One pair of slots: seed the directions of ξ_0 and ξ_1 themselves.
+                    let l = seeded_in_chart(
+                        &chart,
+                        &xi,
+                        &xi_dot,
+                        Seed {
+                            position: a(0),
+                            velocity: d(0),
+                        },
+                        Seed {
+                            position: a(1),
+                            velocity: d(1),
+                        },
+                    );
+                    let mut block = jacobian.fixed_view_mut::<N, N>(0, 0);
+                    block += l.mixed * w;
+                    let mut r = residual.rows_mut(0, N);
+                    r += l.first * w;
+                    impulse += (l.first + l.second) * w;
+                    end += l.second * w;
+                    magnitude += (l.first.abs() + l.second.abs()) * w;
+                    continue;
                 }
-                for j in 0..s {
-                    for k in 1..=s {
-                        let mut block = jacobian.fixed_view_mut::<N, N>(j * N, (k - 1) * N);
-                        block += (qq * (a(j) * a(k))
-                            + qv * (a(j) * d(k))
-                            + qv.transpose() * (d(j) * a(k))
-                            + vv * (d(j) * d(k)))
-                            * w;
+                Some(jacobian) => {
+                    // Many pairs: the Hessian of ℓ at the node, then the chain rule.
+                    let qv = seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::VELOCITY);
+                    let qq =
+                        seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::POSITION).mixed;
+                    let vv =
+                        seeded_in_chart(&chart, &xi, &xi_dot, Seed::VELOCITY, Seed::VELOCITY).mixed;
+                    for j in 0..s {
+                        for k in 1..=s {
+                            let mut block = jacobian.fixed_view_mut::<N, N>(j * N, (k - 1) * N);
+                            block += (qq * (a(j) * a(k))
+                                + qv.mixed * (a(j) * d(k))
+                                + qv.mixed.transpose() * (d(j) * a(k))
+                                + vv * (d(j) * d(k)))
+                                * w;
+                        }
                     }
+                    (qv.first, qv.second)
                 }
+            };
+            if s == 1 {
+                let first = lq * a(0) + lv * d(0);
+                let second = lq * a(1) + lv * d(1);
+                let mut r = residual.rows_mut(0, N);
+                r += first * w;
+                impulse += (first + second) * w;
+                end += second * w;
+                magnitude += (first.abs() + second.abs()) * w;
+                continue;
+            }
+            impulse += lq * w;
+            end += (lq * a(s) + lv * d(s)) * w;
+            magnitude += (lq.abs() + lv.abs() * s as f64 / h) * w;
+            for j in 0..s {
+                let mut r = residual.rows_mut(j * N, N);
+                r += (lq * a(j) + lv * d(j)) * w;
             }
         }
         (StepCovectors { impulse, end }, magnitude.amax())
@@ -350,7 +368,16 @@ mod tests {
         let p = vector![0.7, -0.4];
         let mut r = DVector::zeros(2 * s);
         let mut jac = DMatrix::zeros(2 * s, 2 * s);
-        let (covectors, _) = ld.euler_lagrange(&base, &xis[1..], &p, &mut r, &mut jac);
+        let (covectors, _) = ld.euler_lagrange(&base, &xis[1..], &p, &mut r, Some(&mut jac));
+        // Without a Jacobian (first derivatives only) the same rows and covectors.
+        let mut alone = DVector::zeros(2 * s);
+        let (gradient_only, _) = ld.euler_lagrange(&base, &xis[1..], &p, &mut alone, None);
+        assert!((&alone - &r).amax() < 1e-14, "{name}: {alone} vs {r}");
+        assert!(
+            (gradient_only.impulse - covectors.impulse).amax() < 1e-14,
+            "{name}"
+        );
+        assert!((gradient_only.end - covectors.end).amax() < 1e-14, "{name}");
         for c in 0..2 {
             assert!((r[c] - p[c] - fd(&f, &xis, 0, c)).abs() < 1e-8, "{name}");
             for j in 1..s {
@@ -379,8 +406,8 @@ mod tests {
                 minus[k][c] -= eps;
                 let (mut rp, mut rm) = (DVector::zeros(2 * s), DVector::zeros(2 * s));
                 let mut scratch = DMatrix::zeros(2 * s, 2 * s);
-                ld.euler_lagrange(&base, &plus[1..], &p, &mut rp, &mut scratch);
-                ld.euler_lagrange(&base, &minus[1..], &p, &mut rm, &mut scratch);
+                ld.euler_lagrange(&base, &plus[1..], &p, &mut rp, Some(&mut scratch));
+                ld.euler_lagrange(&base, &minus[1..], &p, &mut rm, Some(&mut scratch));
                 let column = (rp - rm) / (2.0 * eps);
                 let exact = jac.column((k - 1) * 2 + c);
                 assert!((column - exact).amax() < 1e-6, "{name}: column {k},{c}");

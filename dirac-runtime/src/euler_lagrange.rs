@@ -84,6 +84,9 @@ pub struct EulerLagrange<S, const N: usize, C> {
     increments: Vec<SVector<f64, N>>,
     /// The step's covectors at the point assembled last.
     covectors: StepCovectors<N>,
+    /// Where the rows other than the discrete Euler–Lagrange ones put their Jacobian when Newton
+    /// asks for the residual alone (their derivatives are first-order and cheap).
+    scratch: DMatrix<f64>,
 }
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<S, N, C> {
@@ -157,6 +160,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
                 impulse: SVector::zeros(),
                 end: SVector::zeros(),
             },
+            scratch: DMatrix::zeros(0, 0),
             discrete,
         })
     }
@@ -660,6 +664,103 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     }
 }
 
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<S, N, C> {
+    /// [`StepEquations::assemble`] with `scratch` (`n × n`) taking the Jacobian of the rows
+    /// beyond the discrete Euler–Lagrange ones when none is asked for.
+    fn assemble_into(
+        &mut self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        residual: &mut DVector<f64>,
+        mut jacobian: Option<&mut DMatrix<f64>>,
+        scratch: &mut DMatrix<f64>,
+    ) -> f64 {
+        let discrete = &self.discrete;
+        if self.projected() || self.first_order() {
+            // First-order (collocated) steps take their rows' derivatives together.
+            let jacobian = jacobian.unwrap_or(scratch);
+            if self.projected() {
+                let shift = x.fixed_rows::<N>(self.layout.projection()).into_owned();
+                return first_order::symmetric_projection(
+                    discrete,
+                    &state.q,
+                    &state.p,
+                    &self.increments,
+                    &shift,
+                    residual,
+                    jacobian,
+                );
+            }
+            return first_order::collocation(
+                discrete,
+                &state.q,
+                &self.increments,
+                &self.collocated,
+                residual,
+                jacobian,
+            );
+        }
+        let (mut covectors, mut scale) = discrete.euler_lagrange(
+            &state.q,
+            &self.increments,
+            &self.momentum,
+            residual,
+            jacobian.as_deref_mut(),
+        );
+        let jacobian = match jacobian {
+            Some(jacobian) => jacobian,
+            None => {
+                scratch.fill(0.0);
+                scratch
+            }
+        };
+        if !self.collocated.is_empty() {
+            // A mixed Lagrangian: the rows of the coordinates linear in their velocities are
+            // collocated, the others stay variational.
+            let size = first_order::collocation(
+                discrete,
+                &state.q,
+                &self.increments,
+                &self.collocated,
+                residual,
+                jacobian,
+            );
+            scale = scale.max(size);
+        }
+        if S::FORCES {
+            let (forces, size) = discrete.add_forces(
+                &state.q,
+                &self.increments,
+                state.t,
+                &self.lifted_inputs,
+                residual,
+                jacobian,
+            );
+            covectors.impulse += forces.impulse;
+            covectors.end += forces.end;
+            scale = scale.max(size);
+        }
+        if Self::constrained() {
+            let constraints = StepConstraints {
+                system: discrete.system(),
+                space: discrete.space(),
+                point: self.point,
+                base: &state.q,
+                layout: &self.layout,
+                holonomic_forms: &self.holonomic_forms,
+                quadrature: discrete.quadrature(),
+                h: discrete.h(),
+            };
+            let (impulses, size) = constraints.add(x, residual, jacobian);
+            covectors.impulse += impulses.impulse;
+            covectors.end += impulses.end;
+            scale = scale.max(size);
+        }
+        self.covectors = covectors;
+        scale
+    }
+}
+
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<N>
     for EulerLagrange<S, N, C>
 {
@@ -950,85 +1051,30 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         state: &State<N>,
         x: &DVector<f64>,
         residual: &mut DVector<f64>,
-        jacobian: &mut DMatrix<f64>,
+        jacobian: Option<&mut DMatrix<f64>>,
     ) -> f64 {
         for (j, z) in self.increments.iter_mut().enumerate() {
             z.copy_from(&x.fixed_rows::<N>(self.layout.point(j + 1)));
         }
-        let discrete = &self.discrete;
-        if self.projected() {
-            let shift = x.fixed_rows::<N>(self.layout.projection()).into_owned();
-            return first_order::symmetric_projection(
-                discrete,
-                &state.q,
-                &state.p,
-                &self.increments,
-                &shift,
-                residual,
-                jacobian,
-            );
+        let n = x.len();
+        if self.scratch.shape() != (n, n) {
+            self.scratch = DMatrix::zeros(n, n);
         }
-        if self.first_order() {
-            return first_order::collocation(
-                discrete,
-                &state.q,
-                &self.increments,
-                &self.collocated,
-                residual,
-                jacobian,
-            );
-        }
-        let (mut covectors, mut scale) = discrete.euler_lagrange(
-            &state.q,
-            &self.increments,
-            &self.momentum,
-            residual,
-            jacobian,
-        );
-        if !self.collocated.is_empty() {
-            // A mixed Lagrangian: the rows of the coordinates linear in their velocities are
-            // collocated, the others stay variational.
-            let size = first_order::collocation(
-                discrete,
-                &state.q,
-                &self.increments,
-                &self.collocated,
-                residual,
-                jacobian,
-            );
-            scale = scale.max(size);
-        }
-        if S::FORCES {
-            let (forces, size) = discrete.add_forces(
-                &state.q,
-                &self.increments,
-                state.t,
-                &self.lifted_inputs,
-                residual,
-                jacobian,
-            );
-            covectors.impulse += forces.impulse;
-            covectors.end += forces.end;
-            scale = scale.max(size);
-        }
-        if Self::constrained() {
-            let constraints = StepConstraints {
-                system: discrete.system(),
-                space: discrete.space(),
-                point: self.point,
-                base: &state.q,
-                layout: &self.layout,
-                holonomic_forms: &self.holonomic_forms,
-                quadrature: discrete.quadrature(),
-                h: discrete.h(),
-            };
-            let (impulses, size) = constraints.add(x, residual, jacobian);
-            covectors.impulse += impulses.impulse;
-            covectors.end += impulses.end;
-            scale = scale.max(size);
-        }
-        self.covectors = covectors;
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let scale = self.assemble_into(state, x, residual, jacobian, &mut scratch);
+        self.scratch = scratch;
         scale
+    }
+
+    /// A Jacobian takes the hyper-dual Hessian of `L` (about `(N + 1)²` numbers per operation
+    /// of `L`; three such passes per node beyond the midpoint rule) where the residual takes two
+    /// first-order passes (`N + 1` each); first-order steps assemble both together.
+    fn jacobian_cost(&self) -> f64 {
+        if self.projected() || self.first_order() {
+            return 1.0;
+        }
+        let passes = if self.layout.points() == 1 { 1.0 } else { 3.0 };
+        passes * (N + 1) as f64 / 2.0
     }
 
     fn advance(

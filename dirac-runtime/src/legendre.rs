@@ -65,13 +65,23 @@ pub(crate) fn velocity<S: DiracSystem<N>, const N: usize>(
     let mut x = DVector::from_column_slice(guess.as_slice());
     newton.solve(&mut x, |x, r, j| {
         let v = SVector::<f64, N>::from_column_slice(x.as_slice());
-        let l = seeded(system, q, &v, Seed::VELOCITY, Seed::VELOCITY);
+        // The Hessian only when Newton asks for a Jacobian.
+        let second = if j.is_some() {
+            Seed::VELOCITY
+        } else {
+            Seed::NONE
+        };
+        let l = seeded(system, q, &v, Seed::VELOCITY, second);
         r.copy_from(&(l.first - p));
-        j.copy_from(&l.mixed);
         for &i in dead {
             r[i] = x[i] - guess[i];
-            j.row_mut(i).fill(0.0);
-            j[(i, i)] = 1.0;
+        }
+        if let Some(j) = j {
+            j.copy_from(&l.mixed);
+            for &i in dead {
+                j.row_mut(i).fill(0.0);
+                j[(i, i)] = 1.0;
+            }
         }
         l.first.abs().sup(&p.abs()).amax()
     })?;
@@ -131,6 +141,12 @@ pub(crate) fn constrained_velocity<S: DiracSystem<N>, const N: usize>(
         }
         let rate = forms * v;
         r.rows_mut(N, m).copy_from(&rate);
+        // Line-searched solves always ask for the Jacobian; any other gets a local one.
+        let mut local = None;
+        let j = match j {
+            Some(j) => j,
+            None => local.insert(DMatrix::zeros(N + m, N + m)),
+        };
         j.view_mut((0, 0), (N, N)).copy_from(&l.mixed);
         j.view_mut((0, N), (N, m)).copy_from(&(-forms.transpose()));
         j.view_mut((N, 0), (m, N)).copy_from(forms);
@@ -207,7 +223,9 @@ pub(crate) fn first_order_velocity<S: DiracSystem<N>, const N: usize>(
         let l = seeded(system, q, &v, Seed::POSITION, Seed::VELOCITY);
         let transport = l.mixed.transpose() * v;
         r.copy_from(&(l.first - transport));
-        j.copy_from(&(l.mixed - l.mixed.transpose()));
+        if let Some(j) = j {
+            j.copy_from(&(l.mixed - l.mixed.transpose()));
+        }
         l.first.abs().sup(&transport.abs()).amax()
     })?;
     Ok(SVector::from_column_slice(x.as_slice()))

@@ -33,6 +33,7 @@ mod lu;
 pub mod newton;
 #[cfg(feature = "plot")]
 pub mod plot;
+mod predictor;
 pub mod quadrature;
 pub mod run;
 pub mod scalar;

@@ -9,9 +9,10 @@ use crate::lu::{self, SingularPivot};
 ///
 /// A solve has converged when the residual's infinity norm is at most
 /// `residual_tolerance · scale`, where `scale` is the size of the terms summed into the residual
-/// (so the tolerance sits a fixed distance above its round-off floor), and the last update was at
-/// most `step_tolerance · (1 + |x|∞)`. The tolerance never asks for less than the round-off floor
-/// `64 ε ‖J‖∞ ‖x‖∞`. The returned point is always one whose residual was checked.
+/// (so the tolerance sits a fixed distance above its round-off floor), and the correction at the
+/// point (the update the factorised Jacobian gives there) is at round-off, `64 ε (1 + |x|∞)`,
+/// or has stopped shrinking below `step_tolerance · (1 + |x|∞)`. The tolerance never asks for
+/// less than the round-off floor `64 ε ‖J‖∞ ‖x‖∞`. The returned point is always one whose residual was checked.
 ///
 /// **Root acceptance.** A root is accepted only if the iteration reached it while contracting:
 /// as long as the residual is above tolerance, every full update above the step tolerance is at
@@ -45,17 +46,24 @@ pub struct NewtonOptions {
     pub residual_tolerance: f64,
     /// Relative tolerance on the last update, in `[0, 1)`.
     pub step_tolerance: f64,
-    /// Most iterations (evaluations of the residual and Jacobian) before giving up, at least 1.
-    /// A point is accepted after an update below the step tolerance, so a nonlinear solve takes
-    /// three or more.
+    /// Most iterations (evaluations of the residual, with or without its Jacobian) before giving
+    /// up, at least 1. A point is accepted where its correction is at round-off, so a nonlinear
+    /// solve takes three or more (Newton's method: two with the Jacobian, the last without).
     pub max_iterations: usize,
     /// A pivot below this fraction of the largest Jacobian entry counts as zero, in `[0, 1)`.
     pub singular_tolerance: f64,
     /// Largest accepted ratio of successive updates: positive; `f64::INFINITY` turns the
     /// root-acceptance check off.
     pub max_contraction: f64,
-    /// Backtrack each update until the residual decreases (globalised Newton).
+    /// Backtrack each update until the residual decreases (globalised Newton; every
+    /// evaluation then brings its Jacobian).
     pub line_search: bool,
+    /// Largest contraction ratio at which a Jacobian evaluated at an earlier iterate, or in an
+    /// earlier solve, is kept (simplified Newton), in `[0, 1]` (above `max_contraction` it acts
+    /// as `max_contraction`); `Some(0.0)` evaluates it at every iteration (Newton's method).
+    /// `None` (the default) decides from what a Jacobian costs against a residual alone (see
+    /// [`Newton::solve`]).
+    pub jacobian_reuse: Option<f64>,
 }
 
 impl Default for NewtonOptions {
@@ -67,6 +75,7 @@ impl Default for NewtonOptions {
             singular_tolerance: 1e-13,
             max_contraction: 0.25,
             line_search: false,
+            jacobian_reuse: None,
         }
     }
 }
@@ -92,6 +101,13 @@ impl NewtonOptions {
                 self.max_contraction
             )));
         }
+        if let Some(reuse) = self.jacobian_reuse
+            && !(0.0..=1.0).contains(&reuse)
+        {
+            return Err(DiracError::InvalidOptions(format!(
+                "jacobian_reuse must be in [0, 1], got {reuse}"
+            )));
+        }
         if self.max_iterations == 0 {
             return Err(DiracError::InvalidOptions(
                 "max_iterations must be at least 1".into(),
@@ -104,8 +120,10 @@ impl NewtonOptions {
 /// How a successful solve went.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonReport {
-    /// Residual evaluations (each with its Jacobian) performed.
+    /// Residual evaluations performed.
     pub iterations: usize,
+    /// Jacobians evaluated (and factorised) among them: 0 when an earlier solve's served.
+    pub jacobians: usize,
     /// Infinity norm of the residual at the returned point.
     pub residual: f64,
     /// Largest ratio of successive updates above the step tolerance (0 when there was only one):
@@ -148,9 +166,9 @@ pub enum NewtonFailure {
 
 /// Newton's method for `F(x) = 0` on `R^n`, reusing its buffers across solves.
 ///
-/// The caller's closure fills the residual and adds the Jacobian at `x` (into a zeroed matrix)
-/// and returns the residual's scale: the size of the terms it sums, against which the tolerance
-/// is relative. Nothing is allocated per iteration.
+/// The caller's closure fills the residual at `x`, adds the Jacobian into the zeroed matrix
+/// when one is asked for (`Some`), and returns the residual's scale: the size of the terms it
+/// sums, against which the tolerance is relative. Nothing is allocated per iteration.
 ///
 /// ```
 /// use dirac_runtime::{Newton, NewtonOptions};
@@ -160,7 +178,9 @@ pub enum NewtonFailure {
 /// let mut x = DVector::from_element(1, 1.0);
 /// newton.solve(&mut x, |x, r, j| {
 ///     r[0] = x[0] * x[0] - 2.0;
-///     j[(0, 0)] = 2.0 * x[0];
+///     if let Some(j) = j {
+///         j[(0, 0)] = 2.0 * x[0]; // asked for only when a Jacobian is due
+///     }
 ///     2.0 // the size of the terms of the residual
 /// }).unwrap();
 /// assert!((x[0] - 2f64.sqrt()).abs() < 1e-15);
@@ -178,6 +198,31 @@ pub struct Newton {
     trial: DVector<f64>,
     /// The root of the last successful solve, where `jacobian` holds the factorisation.
     root: Option<DVector<f64>>,
+    /// `jacobian` holds a factorisation (of an earlier iterate's Jacobian) that may be reused.
+    factorised: bool,
+    /// `‖J‖∞` of the last Jacobian evaluated: the residual's round-off floor scales with it.
+    jacobian_norm: f64,
+    /// What an evaluation with the Jacobian costs, in evaluations of the residual alone.
+    jacobian_cost: f64,
+    /// The factorisation a solve began with, kept aside while it evaluates its own: a failed
+    /// solve puts it back, so that a failure changes nothing a later solve would see.
+    kept: Kept,
+    /// `(‖J‖∞, factorised)` of the factorisation parked in `kept` while `jacobian` holds the
+    /// one at the last root (see [`Newton::factorise_at`]).
+    parked: Option<(f64, bool)>,
+}
+
+/// A factorised Jacobian set aside (see [`Newton::solve`]).
+#[derive(Debug, Clone)]
+struct Kept {
+    jacobian: DMatrix<f64>,
+    pivots: Vec<usize>,
+    norm: f64,
+    /// The solve in progress began with a reusable factorisation that is still in `jacobian`
+    /// of the solver (not yet set aside).
+    pending: bool,
+    /// The solve in progress set one aside here.
+    holding: bool,
 }
 
 /// The residual's norm at a point and the tolerance it is held to there.
@@ -199,6 +244,17 @@ impl Newton {
             update: DVector::zeros(n),
             trial: DVector::zeros(n),
             root: None,
+            factorised: false,
+            jacobian_norm: 0.0,
+            jacobian_cost: 1.0,
+            kept: Kept {
+                jacobian: DMatrix::zeros(n, n),
+                pivots: vec![0; n],
+                norm: 0.0,
+                pending: false,
+                holding: false,
+            },
+            parked: None,
         })
     }
 
@@ -229,32 +285,63 @@ impl Newton {
         &self.options
     }
 
-    /// Residual and Jacobian at `x` into the buffers: the residual's norm and the tolerance it is
-    /// held to there. Fails when an entry of the residual is not finite, or when the closure
-    /// resized a buffer (the buffers are then restored for the next solve).
+    /// The residual at `x` into its buffer, with the Jacobian when `with_jacobian` (then
+    /// factorised in place): the residual's norm and the tolerance it is held to there. Fails
+    /// when an entry of the residual or the Jacobian is not finite, when the Jacobian is singular,
+    /// or when the closure resized a buffer (the buffers are then restored for the next solve).
     fn evaluate<F>(
         &mut self,
         x: &DVector<f64>,
         evaluate: &mut F,
+        with_jacobian: bool,
     ) -> Result<Evaluation, NewtonFailure>
     where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, &mut DMatrix<f64>) -> f64,
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
     {
         let n = x.len();
-        self.jacobian.fill(0.0);
-        let scale = evaluate(x, &mut self.residual, &mut self.jacobian);
+        let scale = if with_jacobian {
+            if std::mem::take(&mut self.kept.pending) {
+                // Set the factorisation the solve began with aside (buffers swap, no copy).
+                std::mem::swap(&mut self.jacobian, &mut self.kept.jacobian);
+                std::mem::swap(&mut self.pivots, &mut self.kept.pivots);
+                self.kept.norm = self.jacobian_norm;
+                self.kept.holding = true;
+            }
+            // The buffer no longer holds a factorisation, whatever happens next.
+            self.factorised = false;
+            self.jacobian.fill(0.0);
+            evaluate(x, &mut self.residual, Some(&mut self.jacobian))
+        } else {
+            evaluate(x, &mut self.residual, None)
+        };
         if self.residual.len() != n || self.jacobian.shape() != (n, n) {
             let got = self.residual.len();
             self.residual = DVector::zeros(n);
             self.jacobian = DMatrix::zeros(n, n);
+            self.factorised = false;
+            self.kept.holding = false;
             return Err(NewtonFailure::Dimension { expected: n, got });
         }
         // `amax` skips a NaN that a later entry follows: test every entry.
         if !self.residual.iter().all(|r| r.is_finite()) {
             return Err(NewtonFailure::NonFinite);
         }
-        // Round-off floor: what perturbing x by a few ulps does to the residual.
-        let floor = 64.0 * f64::EPSILON * row_sum_norm(&self.jacobian) * x.amax();
+        if with_jacobian {
+            if !self.jacobian.iter().all(|v| v.is_finite()) {
+                return Err(NewtonFailure::NonFinite);
+            }
+            self.jacobian_norm = row_sum_norm(&self.jacobian);
+            lu::factorise(
+                &mut self.jacobian,
+                &mut self.pivots,
+                self.options.singular_tolerance,
+            )
+            .map_err(NewtonFailure::Singular)?;
+            self.factorised = true;
+        }
+        // Round-off floor: what perturbing x by a few ulps does to the residual (measured with
+        // the last Jacobian evaluated).
+        let floor = 64.0 * f64::EPSILON * self.jacobian_norm * x.amax();
         Ok(Evaluation {
             residual: self.residual.amax(),
             tolerance: self.options.residual_tolerance * scale + floor,
@@ -264,6 +351,7 @@ impl Newton {
     /// Armijo backtracking along the update: halves the step from `x` until the residual is
     /// finite and its norm decreases sufficiently (or is within tolerance, where round-off admits
     /// no decrease). Leaves the accepted point in `trial`; `None` when the step became negligible.
+    /// The trial points' Jacobians are evaluated: the accepted one is the next iteration's.
     fn backtrack<F>(
         &mut self,
         x: &DVector<f64>,
@@ -271,14 +359,14 @@ impl Newton {
         evaluate: &mut F,
     ) -> Result<Option<(Evaluation, f64)>, NewtonFailure>
     where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, &mut DMatrix<f64>) -> f64,
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
     {
         let mut length = 1.0;
         while length >= 1e-10 {
             self.trial.copy_from(x);
             self.trial.axpy(-length, &self.update, 1.0);
             let trial = std::mem::take(&mut self.trial);
-            let at_trial = self.evaluate(&trial, evaluate);
+            let at_trial = self.evaluate(&trial, evaluate, true);
             self.trial = trial;
             match at_trial {
                 Ok(e)
@@ -294,20 +382,124 @@ impl Newton {
         Ok(None)
     }
 
+    /// Tells the solver what an evaluation with the Jacobian costs, in evaluations of the
+    /// residual alone (1 until told: Newton's method unless the options say otherwise).
+    pub(crate) fn set_jacobian_cost(&mut self, cost: f64) {
+        self.jacobian_cost = cost;
+    }
+
+    /// The largest contraction ratio at which an earlier solve's Jacobian is kept: the option,
+    /// or, by default, none (Newton's method) where a Jacobian costs `c < 2` residuals and
+    /// `exp(−20 / (c + 2))` otherwise (up to `max_contraction`). A solve that starts with a
+    /// Jacobian of its own takes about `c + 2` residuals; one that keeps an older Jacobian
+    /// contracting by `θ` takes about `ln(e₀/tol) / ln(1/θ)`, with `ln(e₀/tol) ≈ 20` from a
+    /// predictor `1e-5` off to a tolerance `1e-14`: the limit equates the two.
+    fn reuse_limit(&self) -> f64 {
+        let options = &self.options;
+        if options.line_search {
+            return 0.0;
+        }
+        let limit = match options.jacobian_reuse {
+            Some(limit) => limit,
+            None if self.jacobian_cost < 2.0 => 0.0,
+            None => (-20.0 / (self.jacobian_cost + 2.0)).exp(),
+        };
+        limit.min(options.max_contraction)
+    }
+
+    /// Drops the factorised Jacobian: the next solve evaluates its own.
+    pub(crate) fn forget_jacobian(&mut self) {
+        self.unpark();
+        self.factorised = false;
+        self.root = None;
+    }
+
+    /// Evaluates the Jacobian at `x` and factorises it, so that the implicit function theorem's
+    /// solves ([`StepEquations::linearise`](crate::StepEquations::linearise)) can use it at `x`,
+    /// the root of the last successful solve (a solve that ended without a Jacobian at its root leaves none).
+    /// The factorisation the solver keeps for its next solve is parked meanwhile and taken up
+    /// again by it: differentiating a step does not change the steps that follow.
+    ///
+    /// ```
+    /// use dirac_runtime::{Newton, NewtonOptions};
+    /// use nalgebra::{DMatrix, DVector};
+    /// let f = |x: &DVector<f64>, r: &mut DVector<f64>, j: Option<&mut DMatrix<f64>>| {
+    ///     r[0] = x[0] * x[0] - 2.0;
+    ///     if let Some(j) = j {
+    ///         j[(0, 0)] = 2.0 * x[0];
+    ///     }
+    ///     2.0
+    /// };
+    /// let mut newton = Newton::new(1, NewtonOptions::default())?;
+    /// let mut x = DVector::from_element(1, 1.0);
+    /// newton.solve(&mut x, f).unwrap();
+    /// newton.factorise_at(&x, f).unwrap(); // J(√2) = 2√2, ready for implicit derivatives
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn factorise_at<F>(
+        &mut self,
+        x: &DVector<f64>,
+        mut evaluate: F,
+    ) -> Result<(), NewtonFailure>
+    where
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
+    {
+        if self.root.as_ref() == Some(x) {
+            return Ok(());
+        }
+        self.unpark();
+        std::mem::swap(&mut self.jacobian, &mut self.kept.jacobian);
+        std::mem::swap(&mut self.pivots, &mut self.kept.pivots);
+        self.parked = Some((self.jacobian_norm, self.factorised));
+        if let Err(failure) = self.evaluate(x, &mut evaluate, true) {
+            self.unpark();
+            return Err(failure);
+        }
+        self.root = Some(x.clone());
+        Ok(())
+    }
+
+    /// Takes the factorisation parked by [`factorise_at`](Self::factorise_at) up again.
+    fn unpark(&mut self) {
+        if let Some((norm, factorised)) = self.parked.take() {
+            std::mem::swap(&mut self.jacobian, &mut self.kept.jacobian);
+            std::mem::swap(&mut self.pivots, &mut self.kept.pivots);
+            self.jacobian_norm = norm;
+            self.factorised = factorised;
+            self.root = None;
+        }
+    }
+
     /// Solves `F(x) = 0` from the initial guess in `x`; `x` holds the solution on success and an
     /// unspecified iterate on failure.
     ///
-    /// A point is accepted when its residual is within tolerance, the full Newton update that
-    /// led to it was below the step tolerance, and its Jacobian factorises (the root is
-    /// isolated). The returned point is the one whose residual and Jacobian were evaluated last,
-    /// so whatever the closure computed alongside belongs to it. Each iteration evaluates once.
+    /// A point is accepted when its residual is within tolerance and the correction at it (the
+    /// update the factorised Jacobian gives there, the estimate of its distance from the root)
+    /// is at round-off or has stopped shrinking below the step tolerance. Accepting needs no
+    /// Jacobian at the point itself: after an update below the step tolerance the next point is
+    /// evaluated without one. The returned point is the one whose residual was
+    /// evaluated last, so whatever the closure computed alongside belongs to it.
+    ///
+    /// **Jacobians.** The closure is asked for the Jacobian (`Some`) only when one is due; with
+    /// `None` it fills the residual alone. Where the reuse limit is 0
+    /// ([`jacobian_reuse`](NewtonOptions::jacobian_reuse), or by default a Jacobian that costs
+    /// less than two residuals) every evaluation brings its Jacobian: Newton's method. Otherwise
+    /// the factorised Jacobian is kept across iterations and across solves (simplified Newton:
+    /// the solves of successive steps are nearby problems). A solve evaluates its own at its
+    /// start when the last solve found the kept one contracting by more than the limit (or there
+    /// is none), and in the middle where an update leads out of the residual's domain or
+    /// successive updates fail the contraction test. The measured ratio estimates the chord
+    /// map's Lipschitz constant `‖I − J₀⁻¹ J(x)‖`; below 1, `J(x)` is invertible near the root,
+    /// which is therefore isolated. The contraction test judges the Jacobian of the iterate
+    /// before the update or of the iterate itself; an older one that fails it is refreshed
+    /// instead.
     pub fn solve<F>(
         &mut self,
         x: &mut DVector<f64>,
         mut evaluate: F,
     ) -> Result<NewtonReport, NewtonFailure>
     where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, &mut DMatrix<f64>) -> f64,
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
     {
         if x.len() != self.residual.len() {
             return Err(NewtonFailure::Dimension {
@@ -315,81 +507,181 @@ impl Newton {
                 got: x.len(),
             });
         }
+        self.unpark();
         self.root = None;
         let options = self.options;
-        let mut at_x = self.evaluate(x, &mut evaluate)?;
+        let reuse_limit = self.reuse_limit();
+        let newton = reuse_limit == 0.0;
+        // How many updates had been taken when the factorised Jacobian was evaluated in this
+        // solve (`None`: an earlier solve's).
+        let mut jacobian_at: Option<usize> = None;
+        let mut jacobians = 0;
+        let reused = !newton && self.factorised;
+        self.kept.pending = reused;
+        self.kept.holding = false;
+        let mut at_x = match self.evaluate(x, &mut evaluate, !reused) {
+            Ok(e) => e,
+            Err(failure) => return Err(self.failed(failure)),
+        };
+        if !reused {
+            jacobian_at = Some(0);
+            jacobians += 1;
+        }
+        let mut evaluations = 1;
+        let mut updates = 0;
         // The last full (undamped) update's size: convergence and the contraction ratio use it.
         let mut previous: Option<f64> = None;
         let mut contraction: f64 = 0.0;
-        for iteration in 1..=options.max_iterations {
+        // The largest ratio of successive updates with an earlier solve's Jacobian.
+        let mut kept_ratio: f64 = 0.0;
+        loop {
+            // The correction at x, with the factorised Jacobian: x's distance from the root.
+            self.update.copy_from(&self.residual);
+            lu::solve(&self.jacobian, &self.pivots, &mut self.update);
+            if !self.update.iter().all(|u| u.is_finite()) {
+                return Err(self.failed(NewtonFailure::NonFinite));
+            }
+            let update = self.update.amax();
             // Below this an update is round-off: never asked for, never measured.
             let noise = options.step_tolerance.max(64.0 * f64::EPSILON) * (1.0 + x.amax());
             let within = at_x.residual <= at_x.tolerance;
-            let settled = previous.is_some_and(|u| u <= noise) || at_x.residual == 0.0;
-            if !self.jacobian.iter().all(|v| v.is_finite()) {
-                return Err(NewtonFailure::NonFinite);
-            }
-            // Factorised even when the point is accepted: a solution is only accepted where the
-            // Jacobian shows it is isolated.
-            lu::factorise(
-                &mut self.jacobian,
-                &mut self.pivots,
-                options.singular_tolerance,
-            )
-            .map_err(NewtonFailure::Singular)?;
+            // The Jacobian of the iterate before the last update, or of this one.
+            let current = jacobian_at.is_some_and(|at| at + 1 >= updates);
+            // x is the root to round-off: a Newton step (with the Jacobian of the iterate it
+            // started from) below the step tolerance led to it, which leaves x about the square
+            // of that step off; or, with an older Jacobian (a linear rate), its own correction
+            // is at round-off.
+            let round_off = 4.0 * f64::EPSILON * (1.0 + x.amax());
+            let settled = at_x.residual == 0.0
+                || if current {
+                    previous.is_some_and(|before| before <= noise)
+                } else {
+                    update <= round_off
+                };
             if within && settled {
-                match &mut self.root {
-                    Some(root) => root.copy_from(x),
-                    None => self.root = Some(x.clone()),
+                self.kept.pending = false;
+                self.kept.holding = false;
+                // An earlier solve's Jacobian that contracted slowly is not kept for the next:
+                // it evaluates its own at its predictor.
+                if jacobian_at.is_none() && kept_ratio > reuse_limit {
+                    self.factorised = false;
+                }
+                if jacobian_at == Some(updates) {
+                    match &mut self.root {
+                        Some(root) => root.copy_from(x),
+                        None => self.root = Some(x.clone()),
+                    }
                 }
                 return Ok(NewtonReport {
-                    iterations: iteration,
+                    iterations: evaluations,
+                    jacobians,
                     residual: at_x.residual,
                     contraction,
                 });
             }
-            if iteration == options.max_iterations {
+            if evaluations >= options.max_iterations {
                 break;
             }
-            self.update.copy_from(&self.residual);
-            lu::solve(&self.jacobian, &self.pivots, &mut self.update);
-            if !self.update.iter().all(|u| u.is_finite()) {
-                return Err(NewtonFailure::NonFinite);
-            }
-            let update = self.update.amax();
-            // The contraction of full steps, while the iteration is still converging.
-            if let (Some(previous), false, true) = (previous, within, update > noise) {
-                contraction = contraction.max(update / previous);
-                if contraction > options.max_contraction {
-                    return Err(NewtonFailure::NotContracting {
-                        contraction,
-                        iterations: iteration,
-                    });
+            if let Some(before) = previous {
+                let ratio = update / before;
+                if !current && ratio > options.max_contraction && update > round_off {
+                    // An older Jacobian does not contract: evaluate it here and start the
+                    // measurement again.
+                    at_x = match self.evaluate(x, &mut evaluate, true) {
+                        Ok(e) => e,
+                        Err(failure) => return Err(self.failed(failure)),
+                    };
+                    jacobian_at = Some(updates);
+                    jacobians += 1;
+                    evaluations += 1;
+                    previous = None;
+                    continue;
+                }
+                // The contraction of full steps, while the iteration is still converging.
+                if !within && update > noise {
+                    if ratio > options.max_contraction {
+                        return Err(self.failed(NewtonFailure::NotContracting {
+                            contraction: ratio,
+                            iterations: evaluations,
+                        }));
+                    }
+                    contraction = contraction.max(ratio);
+                }
+                if jacobian_at.is_none() && update > round_off {
+                    kept_ratio = kept_ratio.max(ratio);
                 }
             }
             let length = if options.line_search {
-                let Some((at_trial, length)) = self.backtrack(x, at_x, &mut evaluate)? else {
-                    return Err(NewtonFailure::NoConvergence {
+                let Some((at_trial, length)) = self
+                    .backtrack(x, at_x, &mut evaluate)
+                    .map_err(|f| self.failed(f))?
+                else {
+                    return Err(self.failed(NewtonFailure::NoConvergence {
                         residual: at_x.residual,
                         update,
-                        iterations: iteration,
-                    });
+                        iterations: evaluations,
+                    }));
                 };
                 at_x = at_trial;
                 x.copy_from(&self.trial);
+                evaluations += 1;
+                jacobians += 1;
+                jacobian_at = Some(updates + 1);
                 length
             } else {
                 x.axpy(-1.0, &self.update, 1.0);
-                at_x = self.evaluate(x, &mut evaluate)?;
+                evaluations += 1;
+                // After an update below the step tolerance the next point is the root to
+                // round-off: its correction needs no Jacobian of its own.
+                let with_jacobian = newton && update > noise;
+                match self.evaluate(x, &mut evaluate, with_jacobian) {
+                    Ok(e) => at_x = e,
+                    Err(NewtonFailure::NonFinite)
+                        if !with_jacobian && jacobian_at != Some(updates) =>
+                    {
+                        // An update of an older Jacobian left the residual's domain: back to
+                        // the iterate it came from, with its own Jacobian.
+                        x.axpy(1.0, &self.update, 1.0);
+                        at_x = match self.evaluate(x, &mut evaluate, true) {
+                            Ok(e) => e,
+                            Err(failure) => return Err(self.failed(failure)),
+                        };
+                        jacobian_at = Some(updates);
+                        jacobians += 1;
+                        evaluations += 1;
+                        previous = None;
+                        continue;
+                    }
+                    Err(failure) => return Err(self.failed(failure)),
+                }
+                if with_jacobian {
+                    jacobians += 1;
+                    jacobian_at = Some(updates + 1);
+                }
                 1.0
             };
+            updates += 1;
             previous = (length == 1.0).then_some(update);
         }
-        Err(NewtonFailure::NoConvergence {
+        Err(self.failed(NewtonFailure::NoConvergence {
             residual: at_x.residual,
             update: previous.unwrap_or(f64::INFINITY),
             iterations: options.max_iterations,
-        })
+        }))
+    }
+
+    /// A failed solve leaves the factorisation it began with, as if it had not run.
+    fn failed(&mut self, failure: NewtonFailure) -> NewtonFailure {
+        if std::mem::take(&mut self.kept.holding) {
+            std::mem::swap(&mut self.jacobian, &mut self.kept.jacobian);
+            std::mem::swap(&mut self.pivots, &mut self.kept.pivots);
+            self.jacobian_norm = self.kept.norm;
+            self.factorised = true;
+        } else if !std::mem::take(&mut self.kept.pending) {
+            // It began without one, or evaluated its own over it.
+            self.factorised = false;
+        }
+        failure
     }
 }
 
@@ -413,7 +705,9 @@ mod tests {
             .solve(&mut x, |x, r, j| {
                 r[0] = x[0] + x[1] - 3.0;
                 r[1] = x[0] * x[1] - 2.0;
-                j.copy_from_slice(&[1.0, x[1], 1.0, x[0]]);
+                if let Some(j) = j {
+                    j.copy_from_slice(&[1.0, x[1], 1.0, x[0]]);
+                }
                 3.0
             })
             .unwrap();
@@ -436,7 +730,9 @@ mod tests {
         // x² + 1 = 0 has no real root.
         let err = newton.solve(&mut x, |x, r, j| {
             r[0] = x[0] * x[0] + 1.0;
-            j[(0, 0)] = 2.0 * x[0];
+            if let Some(j) = j {
+                j[(0, 0)] = 2.0 * x[0];
+            }
             1.0
         });
         assert!(matches!(
@@ -446,7 +742,9 @@ mod tests {
         let mut x = DVector::from_element(1, 0.0);
         let err = newton.solve(&mut x, |x, r, j| {
             r[0] = x[0] * x[0] + 1.0;
-            j[(0, 0)] = 2.0 * x[0];
+            if let Some(j) = j {
+                j[(0, 0)] = 2.0 * x[0];
+            }
             1.0
         });
         assert_eq!(
@@ -466,7 +764,9 @@ mod tests {
         let err = newton.solve(&mut x, |_, r, j| {
             r[0] = f64::NAN;
             r[1] = 1.0;
-            j.fill_with_identity();
+            if let Some(j) = j {
+                j.fill_with_identity();
+            }
             1.0
         });
         assert_eq!(err, Err(NewtonFailure::NonFinite));
@@ -477,9 +777,11 @@ mod tests {
     /// is above 1; from x0 = 0.5 it converges with ratios far below ¼.
     #[test]
     fn a_non_contracting_iteration_is_refused() {
-        let atan = |x: &DVector<f64>, r: &mut DVector<f64>, j: &mut DMatrix<f64>| {
+        let atan = |x: &DVector<f64>, r: &mut DVector<f64>, j: Option<&mut DMatrix<f64>>| {
             r[0] = x[0].atan();
-            j[(0, 0)] = 1.0 / (1.0 + x[0] * x[0]);
+            if let Some(j) = j {
+                j[(0, 0)] = 1.0 / (1.0 + x[0] * x[0]);
+            }
             1.0
         };
         let mut newton = Newton::new(1, NewtonOptions::default()).unwrap();
@@ -532,7 +834,9 @@ mod tests {
             .solve(&mut x, |x, r, j| {
                 r[0] = 1e8 * x[0] + x[1] - 1.0;
                 r[1] = x[0] - 2.0 * x[1];
-                j.copy_from_slice(&[1e8, 1.0, 1.0, -2.0]);
+                if let Some(j) = j {
+                    j.copy_from_slice(&[1e8, 1.0, 1.0, -2.0]);
+                }
                 1e8 * x[0].abs() + x[1].abs() + 1.0
             })
             .unwrap();
@@ -559,7 +863,9 @@ mod tests {
         newton
             .solve(&mut x, |x, r, j| {
                 r.copy_from(x);
-                j.fill_with_identity();
+                if let Some(j) = j {
+                    j.fill_with_identity();
+                }
                 1.0
             })
             .unwrap();

@@ -140,20 +140,29 @@ pub trait StepEquations<const N: usize> {
 
     /// Prepares the step from `state` and writes the predictor into `x`. `previous` holds the
     /// stepper's prediction from the accepted steps, when there is one: the last solution, or
-    /// the last two extrapolated linearly (`2 x_k − x_{k−1}`; not across a start or a change of
-    /// inputs).
+    /// the last two or three extrapolated (the line `2 x_k − x_{k−1}`, the parabola
+    /// `3 x_k − 3 x_{k−1} + x_{k−2}`; not across a start or a change of inputs).
     fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>);
 
-    /// Writes the residual `F(x)` and adds its Jacobian into `jacobian` (zeroed by the caller);
-    /// returns the size of the terms summed into the residual (its round-off floor is a few ulps
-    /// of this).
+    /// Writes the residual `F(x)` and, when one is asked for, adds its Jacobian into
+    /// `jacobian` (zeroed by the caller; Newton asks only when a Jacobian is due, see
+    /// [`Newton::solve`]); returns the size of the terms summed into the residual (its round-off
+    /// floor is a few ulps of this). What [`advance`](Self::advance) needs must not depend on
+    /// whether the Jacobian was asked for.
     fn assemble(
         &mut self,
         state: &State<N>,
         x: &DVector<f64>,
         residual: &mut DVector<f64>,
-        jacobian: &mut DMatrix<f64>,
+        jacobian: Option<&mut DMatrix<f64>>,
     ) -> f64;
+
+    /// What assembling with the Jacobian costs against assembling the residual alone: Newton
+    /// keeps a Jacobian across iterations and steps the longer, the more it costs (see
+    /// [`Newton::solve`]). By default 1 (Newton's method).
+    fn jacobian_cost(&self) -> f64 {
+        1.0
+    }
 
     /// The state after the step from `state` solved by `x` (the point assembled last), without
     /// its time, and the step's constraint violation. `step` counts the steps before this one,
@@ -217,8 +226,8 @@ pub trait StepEquations<const N: usize> {
 
     /// The derivatives of the step from `state` solved by `x` (the point assembled last) with
     /// respect to `(q_k, p_k)` and the inputs `u`; `newton` must hold the Jacobian factorised at
-    /// `x` by the solve that produced it (otherwise an error). The default refuses: equations
-    /// that can differentiate their step override it.
+    /// `x`, the root of its last solve ([`Newton::factorise_at`]; otherwise an error). The
+    /// default refuses: equations that can differentiate their step override it.
     fn linearise(
         &self,
         state: &State<N>,

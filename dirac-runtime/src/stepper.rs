@@ -26,6 +26,7 @@ use crate::holonomic_scheme::HolonomicScheme;
 use crate::input::Input;
 use crate::legendre;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
+use crate::predictor::Predictor;
 use crate::quadrature::Quadrature;
 use crate::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step_equations::{State, StepEquations};
@@ -100,12 +101,8 @@ pub struct Stepper<S, const N: usize, E = EulerLagrange<S, N, Euclidean>> {
     steps: u64,
     /// Newton unknowns (the iterate), laid out by the equations.
     unknowns: DVector<f64>,
-    /// The unknowns of the last accepted step: the next predictor.
-    previous: Option<DVector<f64>>,
-    /// The unknowns of the step before it (none after a start or a change of inputs).
-    earlier: Option<DVector<f64>>,
-    /// The predictor extrapolated from the last two steps (scratch).
-    extrapolated: DVector<f64>,
+    /// The unknowns of the last accepted steps, extrapolated into the next step's predictor.
+    predictor: Predictor,
     report: Option<NewtonReport>,
     /// Constraint violation of the last step.
     violation: f64,
@@ -374,7 +371,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         &mut self,
     ) -> Result<(StepDerivatives<N>, StepHessians<N>), DiracError> {
         let proposal = self.solve_step()?;
-        let state = self.state.ok_or(DiracError::NotStarted)?;
+        let state = self.factorise_at_root()?;
         let first = self
             .equations
             .linearise(&state, &self.unknowns, &self.newton)?;
@@ -590,7 +587,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         }
         if self.equations.inputs()[index] != value {
             // A step after a change of inputs is predicted from the last one alone.
-            self.earlier = None;
+            self.predictor.restart();
         }
         self.equations.inputs_mut()[index] = value;
         Ok(())
@@ -628,7 +625,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         self.equations.set_inputs(values)?;
         if changed {
             // A step after a change of inputs is predicted from the last one alone.
-            self.earlier = None;
+            self.predictor.restart();
         }
         Ok(())
     }
@@ -767,9 +764,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             origin: None,
             steps: 0,
             unknowns: DVector::zeros(unknowns),
-            previous: None,
-            earlier: None,
-            extrapolated: DVector::zeros(unknowns),
+            predictor: Predictor::new(unknowns),
             report: None,
             violation: 0.0,
             system: PhantomData,
@@ -922,6 +917,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         // singular) is refused here, before the first step, naming the undetermined unknowns.
         let equations = &mut self.equations;
         equations.predict(&state, None, &mut self.unknowns);
+        // The start's own Jacobian decides, not one reused from another run.
+        self.newton.forget_jacobian();
         let trial = self.newton.solve(&mut self.unknowns, |x, r, j| {
             equations.assemble(&state, x, r, j)
         });
@@ -947,7 +944,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         if unknowns != self.unknowns.len() {
             self.newton = Newton::new(unknowns, *self.newton.options())?;
             self.unknowns = DVector::zeros(unknowns);
-            self.extrapolated = DVector::zeros(unknowns);
+            self.predictor.clear(unknowns);
         }
         Ok(())
     }
@@ -960,8 +957,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         self.state = Some(state);
         self.before = None;
         self.steps = 0;
-        self.previous = None;
-        self.earlier = None;
+        self.predictor.clear(self.unknowns.len());
         self.report = None;
     }
 
@@ -1013,7 +1009,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// ```
     pub fn step_linearised(&mut self) -> Result<StepDerivatives<N>, DiracError> {
         let proposal = self.solve_step()?;
-        let state = self.state.ok_or(DiracError::NotStarted)?;
+        let state = self.factorise_at_root()?;
         let derivatives = self
             .equations
             .linearise(&state, &self.unknowns, &self.newton)?;
@@ -1021,21 +1017,28 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         Ok(derivatives)
     }
 
+    /// Factorises the Jacobian at the root of the step just solved (the implicit function
+    /// theorem needs it there; the solve may have ended with an earlier one) and returns the
+    /// state the step started from.
+    fn factorise_at_root(&mut self) -> Result<State<N>, DiracError> {
+        let state = self.state.ok_or(DiracError::NotStarted)?;
+        let equations = &mut self.equations;
+        self.newton
+            .factorise_at(&self.unknowns, |x, r, j| {
+                equations.assemble(&state, x, r, j)
+            })
+            .map_err(|f| self.failure(Problem::Step, f))?;
+        Ok(state)
+    }
+
     /// Solves the next step without making it current: the state is unchanged whatever happens.
     fn solve_step(&mut self) -> Result<Proposal<N>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
-        // The last two solutions extrapolated linearly (the path's points and the multipliers
-        // change smoothly from step to step: O(h³) off where the last one alone is O(h²)).
-        let predictor = match (&self.previous, &self.earlier) {
-            (Some(previous), Some(earlier)) if previous.len() == self.extrapolated.len() => {
-                self.extrapolated.copy_from(previous);
-                self.extrapolated.axpy(-1.0, earlier, 2.0);
-                Some(&self.extrapolated)
-            }
-            (previous, _) => previous.as_ref(),
-        };
+        // The last solutions extrapolated (see `predictor`).
+        let predictor = self.predictor.predict();
         let equations = &mut self.equations;
         equations.predict(&state, predictor, &mut self.unknowns);
+        self.newton.set_jacobian_cost(equations.jacobian_cost());
         let result = self.newton.solve(&mut self.unknowns, |x, r, j| {
             equations.assemble(&state, x, r, j)
         });
@@ -1055,13 +1058,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let count = self.multipliers.len();
         self.multipliers
             .copy_from_slice(&self.unknowns.as_slice()[first..first + count]);
-        std::mem::swap(&mut self.previous, &mut self.earlier);
-        match &mut self.previous {
-            Some(previous) if previous.len() == self.unknowns.len() => {
-                previous.copy_from(&self.unknowns)
-            }
-            _ => self.previous = Some(self.unknowns.clone()),
-        }
+        self.predictor.record(&self.unknowns);
         self.violation = proposal.violation;
         self.steps += 1;
         self.before = self.state.replace(proposal.next);

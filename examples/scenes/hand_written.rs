@@ -84,7 +84,9 @@ impl HandMidpoint {
             let q1 = SVector::<f64, 2>::new(x[0], x[1]);
             let (lq, lv, lqq, lqv, lvv) = derivatives(system, &((q0 + q1) * 0.5), &((q1 - q0) / h));
             r.copy_from(&(p0 + lq * (0.5 * h) - lv));
-            j.copy_from(&(lqq * (0.25 * h) + lqv * 0.5 - lqv.transpose() * 0.5 - lvv / h));
+            if let Some(j) = j {
+                j.copy_from(&(lqq * (0.25 * h) + lqv * 0.5 - lqv.transpose() * 0.5 - lvv / h));
+            }
             p1 = lq * (0.5 * h) + lv;
             p0.abs().sup(&lv.abs()).amax()
         })?;

@@ -164,7 +164,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         b: &Sample<N>,
         theta: f64,
     ) -> Result<Sample<N>, DiracError> {
-        let x = self.previous.as_ref().ok_or(DiracError::NotStarted)?;
+        let x = self.predictor.last().ok_or(DiracError::NotStarted)?;
         self.equations
             .dense([a, b], x, theta)
             .ok_or_else(|| DiracError::Unsupported(format!("dense output of {}", E::NAME)))
