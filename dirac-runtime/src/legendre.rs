@@ -62,8 +62,7 @@ pub(crate) fn velocity<S: DiracSystem<N>, const N: usize>(
     guess: &SVector<f64, N>,
     dead: &[usize],
 ) -> Result<SVector<f64, N>, NewtonFailure> {
-    let mut x = DVector::from_column_slice(guess.as_slice());
-    newton.solve(&mut x, |x, r, j| {
+    let x = newton.solve_from(guess.as_slice(), |x, r, j| {
         let v = SVector::<f64, N>::from_column_slice(x.as_slice());
         // The Hessian only when Newton asks for a Jacobian.
         let second = if j.is_some() {

@@ -197,7 +197,9 @@ pub struct Newton {
     /// The trial point of the line search.
     trial: DVector<f64>,
     /// The root of the last successful solve, where `jacobian` holds the factorisation.
-    root: Option<DVector<f64>>,
+    root: DVector<f64>,
+    /// `jacobian` holds the factorisation at `root`.
+    at_root: bool,
     /// `jacobian` holds a factorisation (of an earlier iterate's Jacobian) that may be reused.
     factorised: bool,
     /// `‖J‖∞` of the last Jacobian evaluated: the residual's round-off floor scales with it.
@@ -210,6 +212,8 @@ pub struct Newton {
     /// `(‖J‖∞, factorised)` of the factorisation parked in `kept` while `jacobian` holds the
     /// one at the last root (see [`Newton::factorise_at`]).
     parked: Option<(f64, bool)>,
+    /// The iterate of [`solve_from`](Newton::solve_from) (reused: no allocation per solve).
+    iterate: DVector<f64>,
 }
 
 /// A factorised Jacobian set aside (see [`Newton::solve`]).
@@ -243,7 +247,8 @@ impl Newton {
             pivots: vec![0; n],
             update: DVector::zeros(n),
             trial: DVector::zeros(n),
-            root: None,
+            root: DVector::zeros(n),
+            at_root: false,
             factorised: false,
             jacobian_norm: 0.0,
             jacobian_cost: 1.0,
@@ -255,6 +260,7 @@ impl Newton {
                 holding: false,
             },
             parked: None,
+            iterate: DVector::zeros(n),
         })
     }
 
@@ -262,13 +268,13 @@ impl Newton {
     /// of the last successful [`solve`](Self::solve) (the implicit function theorem's solves
     /// reuse it); `None` otherwise (no solve yet, a failed one since, or another point).
     pub(crate) fn solve_factorised(&self, root: &DVector<f64>, b: &mut DVector<f64>) -> Option<()> {
-        (self.root.as_ref() == Some(root)).then(|| lu::solve(&self.jacobian, &self.pivots, b))
+        (self.at_root && &self.root == root).then(|| lu::solve(&self.jacobian, &self.pivots, b))
     }
 
     /// `max |u_ii| / min |u_ii|` over the pivots of the Jacobian factorised at the last
     /// successful solve's root: a lower bound of its condition number (infinite before any).
     pub(crate) fn pivot_ratio(&self) -> f64 {
-        if self.root.is_none() {
+        if !self.at_root {
             return f64::INFINITY;
         }
         let pivots = self.jacobian.diagonal().map(f64::abs);
@@ -407,11 +413,31 @@ impl Newton {
         limit.min(options.max_contraction)
     }
 
+    /// [`solve`](Self::solve) from `start` in the solver's own iterate buffer (no allocation):
+    /// the solution on success.
+    pub(crate) fn solve_from<F>(
+        &mut self,
+        start: &[f64],
+        evaluate: F,
+    ) -> Result<&DVector<f64>, NewtonFailure>
+    where
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
+    {
+        let mut x = std::mem::take(&mut self.iterate);
+        if x.len() != start.len() {
+            x = DVector::zeros(start.len());
+        }
+        x.copy_from_slice(start);
+        let solved = self.solve(&mut x, evaluate);
+        self.iterate = x;
+        solved.map(|_| &self.iterate)
+    }
+
     /// Drops the factorised Jacobian: the next solve evaluates its own.
     pub(crate) fn forget_jacobian(&mut self) {
         self.unpark();
         self.factorised = false;
-        self.root = None;
+        self.at_root = false;
     }
 
     /// Evaluates the Jacobian at `x` and factorises it, so that the implicit function theorem's
@@ -444,7 +470,13 @@ impl Newton {
     where
         F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
     {
-        if self.root.as_ref() == Some(x) {
+        if x.len() != self.root.len() {
+            return Err(NewtonFailure::Dimension {
+                expected: self.root.len(),
+                got: x.len(),
+            });
+        }
+        if self.at_root && &self.root == x {
             return Ok(());
         }
         self.unpark();
@@ -455,7 +487,8 @@ impl Newton {
             self.unpark();
             return Err(failure);
         }
-        self.root = Some(x.clone());
+        self.root.copy_from(x);
+        self.at_root = true;
         Ok(())
     }
 
@@ -466,7 +499,7 @@ impl Newton {
             std::mem::swap(&mut self.pivots, &mut self.kept.pivots);
             self.jacobian_norm = norm;
             self.factorised = factorised;
-            self.root = None;
+            self.at_root = false;
         }
     }
 
@@ -508,7 +541,7 @@ impl Newton {
             });
         }
         self.unpark();
-        self.root = None;
+        self.at_root = false;
         let options = self.options;
         let reuse_limit = self.reuse_limit();
         let newton = reuse_limit == 0.0;
@@ -549,8 +582,9 @@ impl Newton {
             let current = jacobian_at.is_some_and(|at| at + 1 >= updates);
             // x is the root to round-off: a Newton step (with the Jacobian of the iterate it
             // started from) below the step tolerance led to it, which leaves x about the square
-            // of that step off; or, with an older Jacobian (a linear rate), its own correction
-            // is at round-off.
+            // of that step off (and that last step refines x: the midpoint rule keeps a stiff
+            // spring's energy to round-off over 10⁶ steps only with it); or, with an older
+            // Jacobian (a linear rate), its own correction is at round-off.
             let round_off = 4.0 * f64::EPSILON * (1.0 + x.amax());
             let settled = at_x.residual == 0.0
                 || if current {
@@ -567,10 +601,8 @@ impl Newton {
                     self.factorised = false;
                 }
                 if jacobian_at == Some(updates) {
-                    match &mut self.root {
-                        Some(root) => root.copy_from(x),
-                        None => self.root = Some(x.clone()),
-                    }
+                    self.root.copy_from(x);
+                    self.at_root = true;
                 }
                 return Ok(NewtonReport {
                     iterations: evaluations,

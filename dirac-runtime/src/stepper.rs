@@ -86,9 +86,9 @@ struct Proposal<const N: usize> {
 pub struct Stepper<S, const N: usize, E = EulerLagrange<S, N, Euclidean>> {
     equations: E,
     newton: Newton,
-    /// The workspace of the velocity solves of recorded samples (reused: no allocation per
+    /// The workspaces of the velocity solves of recorded samples (reused: no allocation per
     /// sample).
-    velocity_newton: Newton,
+    velocity: VelocitySolver,
     state: Option<State<N>>,
     /// The state the last step started from (none before the first step of a run).
     before: Option<State<N>>,
@@ -748,12 +748,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             )));
         }
         let newton = Newton::new(unknowns, NewtonOptions::default())?;
-        let velocity_newton = Newton::new(
-            equations.velocity_unknowns(),
-            velocity_options(newton.options()),
-        )?;
+        let velocity = VelocitySolver::new(equations.velocity_unknowns(), newton.options())?;
         Ok(Self {
-            velocity_newton,
+            velocity,
             multipliers: vec![0.0; equations.multipliers()],
             equations,
             newton,
@@ -816,10 +813,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// ```
     pub fn with_newton_options(mut self, options: NewtonOptions) -> Result<Self, DiracError> {
         self.newton = Newton::new(self.unknowns.len(), options)?;
-        self.velocity_newton = Newton::new(
-            self.equations.velocity_unknowns(),
-            velocity_options(self.newton.options()),
-        )?;
+        self.velocity = VelocitySolver::new(self.equations.velocity_unknowns(), &options)?;
         Ok(self)
     }
 
@@ -843,7 +837,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         &self.equations
     }
 
-    /// The velocity at `(q, p)` by the globalised Legendre inversion from `guess`; `in_run`
+    /// The velocity at `(q, p)` by the Legendre inversion from `guess`; `in_run`
     /// when the state is the running one (see [`StepEquations::velocity_in_run`]).
     fn velocity_at(
         &self,
@@ -853,14 +847,17 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         guess: &SVector<f64, N>,
         in_run: bool,
     ) -> Result<SVector<f64, N>, DiracError> {
-        let options = velocity_options(self.newton.options());
-        let mut newton = Newton::new(self.equations.velocity_unknowns(), options)?;
-        let solved = if in_run {
-            self.equations.velocity_in_run(&mut newton, t, q, p, guess)
-        } else {
-            self.equations.velocity(&mut newton, t, q, p, guess)
+        // As a recorded sample's velocity is solved, in a workspace of its own.
+        let mut solver =
+            VelocitySolver::new(self.equations.velocity_unknowns(), self.newton.options())?;
+        let mut solve = |newton: &mut Newton| match in_run {
+            true => self.equations.velocity_in_run(newton, t, q, p, guess),
+            false => self.equations.velocity(newton, t, q, p, guess),
         };
-        solved.map_err(|f| self.failure(Problem::Velocity, f))
+        if let Ok(v) = solve(&mut solver.fast) {
+            return Ok(v);
+        }
+        solve(&mut solver.globalised).map_err(|f| self.failure(Problem::Velocity, f))
     }
 
     /// The velocity of a recorded `state`, reached after `steps` steps, solved from `guess` in
@@ -871,13 +868,19 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         guess: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, DiracError> {
         let unknowns = self.equations.velocity_unknowns();
-        if self.velocity_newton.unknowns() != unknowns {
-            self.velocity_newton = Newton::new(unknowns, velocity_options(self.newton.options()))?;
+        if self.velocity.fast.unknowns() != unknowns {
+            self.velocity = VelocitySolver::new(unknowns, self.newton.options())?;
         }
         let (t, q, p) = (state.t, &state.q, &state.p);
-        let solved = self
-            .equations
-            .velocity_in_run(&mut self.velocity_newton, t, q, p, guess);
+        // From a guess near the velocity one Hessian, evaluated there, serves the whole solve;
+        // where that does not converge, the globalised solve from the same guess.
+        let fast = &mut self.velocity.fast;
+        fast.forget_jacobian();
+        if let Ok(v) = self.equations.velocity_in_run(fast, t, q, p, guess) {
+            return Ok(v);
+        }
+        let globalised = &mut self.velocity.globalised;
+        let solved = self.equations.velocity_in_run(globalised, t, q, p, guess);
         solved.map_err(|f| self.failure(Problem::Velocity, f))
     }
 
@@ -1465,8 +1468,32 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 }
 
-/// The Newton options of a velocity solve: the stepper's, globalised (line search, no contraction
-/// test, at least 50 iterations).
+/// The velocity solves of recorded samples: a simplified Newton solve with the Hessian at the
+/// guess (one Hessian per sample: exact for a Lagrangian quadratic in the velocities), and,
+/// where it fails, a globalised one (line search, no contraction test, at least 50 iterations), both
+/// with the stepper's tolerances.
+#[derive(Debug, Clone)]
+struct VelocitySolver {
+    fast: Newton,
+    globalised: Newton,
+}
+
+impl VelocitySolver {
+    fn new(unknowns: usize, options: &NewtonOptions) -> Result<Self, DiracError> {
+        let fast = NewtonOptions {
+            line_search: false,
+            jacobian_reuse: Some(options.max_contraction.min(1.0)),
+            ..*options
+        };
+        Ok(Self {
+            fast: Newton::new(unknowns, fast)?,
+            globalised: Newton::new(unknowns, velocity_options(options))?,
+        })
+    }
+}
+
+/// The Newton options of a globalised velocity solve: the stepper's, with a line search, no
+/// contraction test and at least 50 iterations.
 fn velocity_options(options: &NewtonOptions) -> NewtonOptions {
     NewtonOptions {
         line_search: true,

@@ -59,7 +59,9 @@ pub struct Trajectory<const N: usize> {
     energy: Vec<f64>,
     /// Names of the multipliers (empty for an unconstrained system).
     multiplier_names: Vec<String>,
-    multipliers: Vec<Vec<f64>>,
+    /// The multipliers of every sample in one buffer, `multiplier_names.len()` per sample (one
+    /// allocation for the run, not one per sample).
+    multipliers: Vec<f64>,
     violation: Vec<f64>,
 }
 
@@ -125,8 +127,29 @@ impl<const N: usize> Trajectory<N> {
         }
         self.append(sample, energy);
         self.violation.push(violation);
-        self.multipliers.push(multipliers.to_vec());
+        self.multipliers.extend_from_slice(multipliers);
         Ok(())
+    }
+
+    /// Makes room for `additional` more samples, so that recording them allocates nothing.
+    ///
+    /// ```
+    /// use dirac_runtime::Trajectory;
+    /// let mut trajectory = Trajectory::<1>::new(vec!["x".into()])?;
+    /// trajectory.reserve(1000);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn reserve(&mut self, additional: usize) {
+        self.t.reserve(additional);
+        self.q.reserve(additional);
+        self.v.reserve(additional);
+        self.p.reserve(additional);
+        self.energy.reserve(additional);
+        if !self.multiplier_names.is_empty() {
+            self.violation.reserve(additional);
+            self.multipliers
+                .reserve(additional * self.multiplier_names.len());
+        }
     }
 
     /// Names of the recorded multipliers (empty for an unconstrained system).
@@ -139,9 +162,18 @@ impl<const N: usize> Trajectory<N> {
         &self.violation
     }
 
-    /// Multipliers of the step that ended at each sample (empty when unconstrained).
-    pub fn multipliers(&self) -> &[Vec<f64>] {
-        &self.multipliers
+    /// Multipliers of the step that ended at each sample, one slice per sample (none when
+    /// unconstrained).
+    pub fn multipliers(&self) -> std::slice::ChunksExact<'_, f64> {
+        self.multipliers
+            .chunks_exact(self.multiplier_names.len().max(1))
+    }
+
+    /// Multipliers of the step that ended at sample `k` (`None` when unconstrained or past the
+    /// end).
+    pub fn multipliers_at(&self, k: usize) -> Option<&[f64]> {
+        let m = self.multiplier_names.len();
+        (m > 0 && k < self.len()).then(|| &self.multipliers[k * m..(k + 1) * m])
     }
 
     /// The largest constraint violation over the trajectory.
@@ -258,7 +290,7 @@ impl<const N: usize> Trajectory<N> {
         row.extend(self.v[k].iter());
         row.extend(self.p[k].iter());
         row.push(self.energy[k]);
-        if let (Some(v), Some(m)) = (self.violation.get(k), self.multipliers.get(k)) {
+        if let (Some(v), Some(m)) = (self.violation.get(k), self.multipliers_at(k)) {
             row.push(*v);
             row.extend(m.iter());
         }

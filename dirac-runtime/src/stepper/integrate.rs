@@ -182,6 +182,16 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let saveat = saveat.map(<[f64]>::to_vec);
         let (dense, every) = (run.dense(), run.stride() as u64);
         let trajectory = &mut solution.trajectory;
+        // Room for the samples the run will save, up to 2²⁰ (a run that an event or observer
+        // may stop early should not claim memory it might never use): recording allocates
+        // nothing per sample, and past that size the buffers double a few times.
+        let samples = match &saveat {
+            Some(times) => times.len(),
+            None => usize::try_from(total / every)
+                .unwrap_or(usize::MAX)
+                .saturating_add(2),
+        };
+        trajectory.reserve(samples.min(1 << 20));
         let v = self.sample_velocity(&start, &start.velocity)?;
         let mut current = sample(&start, v);
         let mut saved = 0;

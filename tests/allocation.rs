@@ -1,0 +1,69 @@
+//! Recording a run allocates nothing per sample: the allocations of `run(n)` on the double
+//! pendulum do not grow with `n` (counted by a global allocator that counts).
+
+#[path = "../examples/scenes/mod.rs"]
+#[allow(dead_code)]
+mod scenes;
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use dirac::prelude::*;
+use scenes::double_pendulum;
+
+/// The system allocator, counting allocations.
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Allocations made by `f`.
+fn allocations(f: impl FnOnce()) -> usize {
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    f();
+    ALLOCATIONS.load(Ordering::Relaxed) - before
+}
+
+#[test]
+fn recording_allocates_nothing_per_sample() {
+    let count = |n: u64| {
+        let mut stepper = double_pendulum::stepper(Quadrature::midpoint(), 0.01).unwrap();
+        stepper.step().unwrap();
+        allocations(|| {
+            let trajectory = stepper.run(n).unwrap();
+            assert_eq!(trajectory.len() as u64, n + 1);
+        })
+    };
+    let (short, long) = (count(10), count(10_000));
+    println!("run(10): {short} allocations, run(10 000): {long}");
+    assert_eq!(short, long, "allocations grow with the number of samples");
+    // The bare steps allocate nothing at all.
+    let mut stepper = double_pendulum::stepper(Quadrature::galerkin(2).unwrap(), 0.01).unwrap();
+    stepper.step().unwrap();
+    assert_eq!(
+        allocations(|| {
+            for _ in 0..1000 {
+                stepper.step().unwrap();
+            }
+        }),
+        0
+    );
+}
