@@ -850,7 +850,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         // As a recorded sample's velocity is solved, in a workspace of its own.
         let mut solver =
             VelocitySolver::new(self.equations.velocity_unknowns(), self.newton.options())?;
-        let mut solve = |newton: &mut Newton| match in_run {
+        let solve = |newton: &mut Newton| match in_run {
             true => self.equations.velocity_in_run(newton, t, q, p, guess),
             false => self.equations.velocity(newton, t, q, p, guess),
         };
