@@ -2,7 +2,6 @@
 //! pendulum do not grow with `n` (counted by a global allocator that counts).
 
 #[path = "../examples/scenes/mod.rs"]
-#[allow(dead_code)]
 mod scenes;
 
 use std::alloc::{GlobalAlloc, Layout, System};
