@@ -188,6 +188,36 @@ pub(crate) fn gradients<F: PhaseFunction<N>, const N: usize>(
     (gradient(&lq), gradient(&lv))
 }
 
+/// The gradient of `L` along `seed` at `(q, v)`: `∂L/∂x_i` where moving `x_i` moves `q_i` by
+/// `seed.position` and `v_i` by `seed.velocity` (one pass of first-order duals).
+pub(crate) fn directional_gradient<F: PhaseFunction<N>, const N: usize>(
+    lagrangian: &F,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+    seed: Seed,
+) -> SVector<f64, N> {
+    gradient(&lagrangian.value(&lift(q, seed.position), &lift(v, seed.velocity)))
+}
+
+/// [`directional_gradient`] of `ℓ(ξ, ξ̇)`: for a translation chart, of `L` at `q_k + ξ`.
+#[inline]
+pub(crate) fn directional_gradient_in_chart<
+    S: DiracSystem<N>,
+    C: ConfigurationSpace<N>,
+    const N: usize,
+>(
+    chart: &InChart<'_, S, C, N>,
+    xi: &SVector<f64, N>,
+    xi_dot: &SVector<f64, N>,
+    seed: Seed,
+) -> SVector<f64, N> {
+    if C::TRANSLATION {
+        directional_gradient(chart.system, &(chart.base + xi), xi_dot, seed)
+    } else {
+        directional_gradient(chart, xi, xi_dot, seed)
+    }
+}
+
 /// [`gradients`] of `ℓ(ξ, ξ̇)`: for a translation chart, of `L` at `q_k + ξ` directly.
 #[inline]
 pub(crate) fn gradients_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(

@@ -17,7 +17,8 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
 use crate::derivatives::{
-    InChart, PhaseFunction, Seed, gradients_in_chart, seeded_in_chart, third_derivative,
+    InChart, PhaseFunction, Seed, directional_gradient_in_chart, gradients_in_chart,
+    seeded_in_chart, third_derivative,
 };
 use crate::error::DiracError;
 use crate::quadrature::Quadrature;
@@ -156,8 +157,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
     /// (`Q_s = q_{k+1}`), blocks of `N`. Writes the residual
     /// `[π_k + ∂L_d/∂ξ_0; ∂L_d/∂ξ_1; …; ∂L_d/∂ξ_{s−1}]` (`π_k` the momentum in the chart) into
     /// the first `N s` rows and, when asked for, adds its Jacobian into `jacobian` (which the
-    /// caller zeroes). Without a Jacobian only first derivatives of `L` are taken. Returns the
-    /// slot covectors and the size of the terms summed into the residual.
+    /// caller zeroes). Without a Jacobian only first derivatives of `L` are taken, and with one
+    /// pair of slots only those the residual needs: the slot covectors are then left to
+    /// [`slot_covectors`](Self::slot_covectors) (`None`). Returns the slot covectors and the size
+    /// of the terms summed into the residual.
     pub(crate) fn euler_lagrange(
         &self,
         base: &SVector<f64, N>,
@@ -165,7 +168,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         momentum: &SVector<f64, N>,
         residual: &mut DVector<f64>,
         mut jacobian: Option<&mut DMatrix<f64>>,
-    ) -> (StepCovectors<N>, f64) {
+    ) -> (Option<StepCovectors<N>>, f64) {
         let s = self.quadrature.degree();
         let h = self.h;
         residual.fill(0.0);
@@ -181,6 +184,18 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
             let a = |j: usize| quad.ell(i, j);
             let d = |j: usize| quad.ell_prime(i, j) / h;
             let (lq, lv) = match jacobian.as_deref_mut() {
+                None if s == 1 => {
+                    // The residual's slot alone: one pass along the direction of ξ_0.
+                    let seed = Seed {
+                        position: a(0),
+                        velocity: d(0),
+                    };
+                    let first = directional_gradient_in_chart(&chart, &xi, &xi_dot, seed);
+                    let mut r = residual.rows_mut(0, N);
+                    r += first * w;
+                    magnitude += first.abs() * w;
+                    continue;
+                }
                 None => gradients_in_chart(&chart, &xi, &xi_dot),
                 Some(jacobian) if s == 1 => {
                     // One pair of slots: seed the directions of ξ_0 and ξ_1 themselves.
@@ -203,7 +218,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
                     r += l.first * w;
                     impulse += (l.first + l.second) * w;
                     end += l.second * w;
-                    magnitude += (l.first.abs() + l.second.abs()) * w;
+                    magnitude += l.first.abs() * w;
                     continue;
                 }
                 Some(jacobian) => {
@@ -226,16 +241,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
                     (qv.first, qv.second)
                 }
             };
-            if s == 1 {
-                let first = lq * a(0) + lv * d(0);
-                let second = lq * a(1) + lv * d(1);
-                let mut r = residual.rows_mut(0, N);
-                r += first * w;
-                impulse += (first + second) * w;
-                end += second * w;
-                magnitude += (first.abs() + second.abs()) * w;
-                continue;
-            }
             impulse += lq * w;
             end += (lq * a(s) + lv * d(s)) * w;
             magnitude += (lq.abs() + lv.abs() * s as f64 / h) * w;
@@ -244,7 +249,33 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
                 r += (lq * a(j) + lv * d(j)) * w;
             }
         }
-        (StepCovectors { impulse, end }, magnitude.amax())
+        let complete = s > 1 || jacobian.is_some();
+        (
+            complete.then_some(StepCovectors { impulse, end }),
+            magnitude.amax(),
+        )
+    }
+
+    /// The slot covectors of the step with points `ξ_1..ξ_s` in the chart at `base`:
+    /// `Σ_j ∂L_d/∂ξ_j` and `∂L_d/∂ξ_s` (first derivatives only).
+    pub(crate) fn slot_covectors(
+        &self,
+        base: &SVector<f64, N>,
+        increments: &[SVector<f64, N>],
+    ) -> StepCovectors<N> {
+        let (quad, h, s) = (&self.quadrature, self.h, self.quadrature.degree());
+        let chart = self.in_chart(base);
+        let mut covectors = StepCovectors {
+            impulse: SVector::zeros(),
+            end: SVector::zeros(),
+        };
+        for (i, &b) in quad.weights().iter().enumerate() {
+            let (xi, xi_dot) = self.node(i, increments);
+            let (lq, lv) = gradients_in_chart(&chart, &xi, &xi_dot);
+            covectors.impulse += lq * (h * b);
+            covectors.end += (lq * quad.ell(i, s) + lv * (quad.ell_prime(i, s) / h)) * (h * b);
+        }
+        covectors
     }
 }
 
@@ -369,15 +400,18 @@ mod tests {
         let mut r = DVector::zeros(2 * s);
         let mut jac = DMatrix::zeros(2 * s, 2 * s);
         let (covectors, _) = ld.euler_lagrange(&base, &xis[1..], &p, &mut r, Some(&mut jac));
-        // Without a Jacobian (first derivatives only) the same rows and covectors.
+        let covectors = covectors.expect("complete with a Jacobian");
+        // Without a Jacobian (first derivatives only) the same rows, and the same covectors
+        // (from `slot_covectors` where the residual did not need them).
         let mut alone = DVector::zeros(2 * s);
         let (gradient_only, _) = ld.euler_lagrange(&base, &xis[1..], &p, &mut alone, None);
         assert!((&alone - &r).amax() < 1e-14, "{name}: {alone} vs {r}");
-        assert!(
-            (gradient_only.impulse - covectors.impulse).amax() < 1e-14,
-            "{name}"
-        );
-        assert!((gradient_only.end - covectors.end).amax() < 1e-14, "{name}");
+        assert_eq!(gradient_only.is_some(), s > 1, "{name}");
+        let separate = ld.slot_covectors(&base, &xis[1..]);
+        for found in [gradient_only, Some(separate)].into_iter().flatten() {
+            assert!((found.impulse - covectors.impulse).amax() < 1e-14, "{name}");
+            assert!((found.end - covectors.end).amax() < 1e-14, "{name}");
+        }
         for c in 0..2 {
             assert!((r[c] - p[c] - fd(&f, &xis, 0, c)).abs() < 1e-8, "{name}");
             for j in 1..s {

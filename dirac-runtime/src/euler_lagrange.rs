@@ -84,6 +84,9 @@ pub struct EulerLagrange<S, const N: usize, C> {
     increments: Vec<SVector<f64, N>>,
     /// The step's covectors at the point assembled last.
     covectors: StepCovectors<N>,
+    /// `covectors` lacks the discrete Lagrangian's part, which `advance` then computes (an
+    /// assembly without a Jacobian leaves it out where the residual does not need it).
+    covectors_pending: bool,
     /// Where the rows other than the discrete Euler–Lagrange ones put their Jacobian when Newton
     /// asks for the residual alone (their derivatives are first-order and cheap).
     scratch: DMatrix<f64>,
@@ -160,6 +163,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
                 impulse: SVector::zeros(),
                 end: SVector::zeros(),
             },
+            covectors_pending: false,
             scratch: DMatrix::zeros(0, 0),
             discrete,
         })
@@ -700,13 +704,19 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
                 jacobian,
             );
         }
-        let (mut covectors, mut scale) = discrete.euler_lagrange(
+        let (lagrangian, mut scale) = discrete.euler_lagrange(
             &state.q,
             &self.increments,
             &self.momentum,
             residual,
             jacobian.as_deref_mut(),
         );
+        // Left to `advance` where the residual did not need them.
+        self.covectors_pending = lagrangian.is_none();
+        let mut covectors = lagrangian.unwrap_or(StepCovectors {
+            impulse: SVector::zeros(),
+            end: SVector::zeros(),
+        });
         let jacobian = match jacobian {
             Some(jacobian) => jacobian,
             None => {
@@ -1090,6 +1100,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             let shift = x.fixed_rows::<N>(self.layout.projection()).into_owned();
             xi = first_order::projected_increment(self.discrete.quadrature(), &xi, &shift);
         }
+        let mut covectors = self.covectors;
+        if self.covectors_pending {
+            let lagrangian = self.discrete.slot_covectors(&state.q, &self.increments);
+            covectors.impulse += lagrangian.impulse;
+            covectors.end += lagrangian.end;
+        }
         let mut next = *state;
         space.advance(&mut next.q, &mut next.q_carry, &xi);
         space
@@ -1098,7 +1114,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 &xi,
                 &mut next.p,
                 &mut next.p_carry,
-                &self.covectors,
+                &covectors,
             )
             .ok_or_else(|| {
                 DiracError::OutsideChart(format!(
