@@ -1109,13 +1109,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         let mut next = *state;
         space.advance(&mut next.q, &mut next.q_carry, &xi);
         space
-            .advance_momentum(
-                &state.q,
-                &xi,
-                &mut next.p,
-                &mut next.p_carry,
-                &covectors,
-            )
+            .advance_momentum(&state.q, &xi, &mut next.p, &mut next.p_carry, &covectors)
             .ok_or_else(|| {
                 DiracError::OutsideChart(format!(
                     "step {step} reaches a point where the retraction's tangent map is singular"
