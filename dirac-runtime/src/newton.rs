@@ -212,6 +212,9 @@ pub struct Newton {
     /// `(‖J‖∞, factorised)` of the factorisation parked in `kept` while `jacobian` holds the
     /// one at the last root (see [`Newton::factorise_at`]).
     parked: Option<(f64, bool)>,
+    /// Newton's method evaluates the Jacobian at the point it accepts (for the implicit
+    /// function theorem's solves that follow) instead of checking it with the residual alone.
+    jacobian_at_root: bool,
     /// The iterate of [`solve_from`](Newton::solve_from) (reused: no allocation per solve).
     iterate: DVector<f64>,
 }
@@ -260,6 +263,7 @@ impl Newton {
                 holding: false,
             },
             parked: None,
+            jacobian_at_root: false,
             iterate: DVector::zeros(n),
         })
     }
@@ -411,6 +415,12 @@ impl Newton {
             None => (-20.0 / (self.jacobian_cost + 2.0)).exp(),
         };
         limit.min(options.max_contraction)
+    }
+
+    /// Whether Newton's method (where the Jacobian is not kept) also evaluates the Jacobian at
+    /// the point it accepts, as [`factorise_at`](Self::factorise_at) would after the solve.
+    pub(crate) fn set_jacobian_at_root(&mut self, on: bool) {
+        self.jacobian_at_root = on;
     }
 
     /// [`solve`](Self::solve) from `start` in the solver's own iterate buffer (no allocation):
@@ -665,7 +675,7 @@ impl Newton {
                 evaluations += 1;
                 // After an update below the step tolerance the next point is the root to
                 // round-off: its correction needs no Jacobian of its own.
-                let with_jacobian = newton && update > noise;
+                let with_jacobian = newton && (update > noise || self.jacobian_at_root);
                 match self.evaluate(x, &mut evaluate, with_jacobian) {
                     Ok(e) => at_x = e,
                     Err(NewtonFailure::NonFinite)

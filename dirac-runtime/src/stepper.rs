@@ -370,7 +370,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     pub fn step_second_order(
         &mut self,
     ) -> Result<(StepDerivatives<N>, StepHessians<N>), DiracError> {
-        let proposal = self.solve_step()?;
+        let proposal = self.solve_step_at_root()?;
         let state = self.factorise_at_root()?;
         let first = self
             .equations
@@ -1011,13 +1011,22 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn step_linearised(&mut self) -> Result<StepDerivatives<N>, DiracError> {
-        let proposal = self.solve_step()?;
+        let proposal = self.solve_step_at_root()?;
         let state = self.factorise_at_root()?;
         let derivatives = self
             .equations
             .linearise(&state, &self.unknowns, &self.newton)?;
         self.accept(proposal);
         Ok(derivatives)
+    }
+
+    /// [`solve_step`](Self::solve_step) ending, where Newton's method runs, with the Jacobian
+    /// at the root (the derivatives that follow need it).
+    fn solve_step_at_root(&mut self) -> Result<Proposal<N>, DiracError> {
+        self.newton.set_jacobian_at_root(true);
+        let proposal = self.solve_step();
+        self.newton.set_jacobian_at_root(false);
+        proposal
     }
 
     /// Factorises the Jacobian at the root of the step just solved (the implicit function
