@@ -669,6 +669,25 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
 }
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<S, N, C> {
+    /// The collocated rows of the coordinates linear in their velocities (see
+    /// [`first_order`]), with their Jacobian.
+    fn collocate(
+        &self,
+        state: &State<N>,
+        residual: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> f64 {
+        let (q, increments) = (&state.q, &self.increments);
+        first_order::collocation(
+            &self.discrete,
+            q,
+            increments,
+            &self.collocated,
+            residual,
+            jacobian,
+        )
+    }
+
     /// [`StepEquations::assemble`] with `scratch` (`n × n`) taking the Jacobian of the rows
     /// beyond the discrete Euler–Lagrange ones when none is asked for.
     fn assemble_into(
@@ -695,14 +714,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
                     jacobian,
                 );
             }
-            return first_order::collocation(
-                discrete,
-                &state.q,
-                &self.increments,
-                &self.collocated,
-                residual,
-                jacobian,
-            );
+            return self.collocate(state, residual, jacobian);
         }
         let (lagrangian, mut scale) = discrete.euler_lagrange(
             &state.q,
@@ -727,15 +739,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         if !self.collocated.is_empty() {
             // A mixed Lagrangian: the rows of the coordinates linear in their velocities are
             // collocated, the others stay variational.
-            let size = first_order::collocation(
-                discrete,
-                &state.q,
-                &self.increments,
-                &self.collocated,
-                residual,
-                jacobian,
-            );
-            scale = scale.max(size);
+            scale = scale.max(self.collocate(state, residual, jacobian));
         }
         if S::FORCES {
             let (forces, size) = discrete.add_forces(

@@ -629,14 +629,9 @@ impl Newton {
                 if !current && ratio > options.max_contraction && update > round_off {
                     // An older Jacobian does not contract: evaluate it here and start the
                     // measurement again.
-                    at_x = match self.evaluate(x, &mut evaluate, true) {
-                        Ok(e) => e,
-                        Err(failure) => return Err(self.failed(failure)),
-                    };
-                    jacobian_at = Some(updates);
-                    jacobians += 1;
-                    evaluations += 1;
-                    previous = None;
+                    at_x = self.refresh(x, &mut evaluate)?;
+                    (jacobian_at, previous) = (Some(updates), None);
+                    (jacobians, evaluations) = (jacobians + 1, evaluations + 1);
                     continue;
                 }
                 // The contraction of full steps, while the iteration is still converging.
@@ -684,14 +679,9 @@ impl Newton {
                         // An update of an older Jacobian left the residual's domain: back to
                         // the iterate it came from, with its own Jacobian.
                         x.axpy(1.0, &self.update, 1.0);
-                        at_x = match self.evaluate(x, &mut evaluate, true) {
-                            Ok(e) => e,
-                            Err(failure) => return Err(self.failed(failure)),
-                        };
-                        jacobian_at = Some(updates);
-                        jacobians += 1;
-                        evaluations += 1;
-                        previous = None;
+                        at_x = self.refresh(x, &mut evaluate)?;
+                        (jacobian_at, previous) = (Some(updates), None);
+                        (jacobians, evaluations) = (jacobians + 1, evaluations + 1);
                         continue;
                     }
                     Err(failure) => return Err(self.failed(failure)),
@@ -710,6 +700,18 @@ impl Newton {
             update: previous.unwrap_or(f64::INFINITY),
             iterations: options.max_iterations,
         }))
+    }
+
+    /// The residual and a new Jacobian at `x` in the middle of a solve (a failure ends it).
+    fn refresh<F>(
+        &mut self,
+        x: &DVector<f64>,
+        evaluate: &mut F,
+    ) -> Result<Evaluation, NewtonFailure>
+    where
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
+    {
+        self.evaluate(x, evaluate, true).map_err(|f| self.failed(f))
     }
 
     /// A failed solve leaves the factorisation it began with, as if it had not run.
