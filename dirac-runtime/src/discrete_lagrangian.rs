@@ -159,8 +159,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
     /// the first `N s` rows and, when asked for, adds its Jacobian into `jacobian` (which the
     /// caller zeroes). Without a Jacobian only first derivatives of `L` are taken, and with one
     /// pair of slots and more than two coordinates only those the residual needs: the slot
-    /// covectors are then left to [`slot_covectors`](Self::slot_covectors) (`None`). Returns the slot covectors and the size
-    /// of the terms summed into the residual.
+    /// covectors are then left to [`slot_covectors`](Self::slot_covectors) (`None`). Returns
+    /// the slot covectors and the size of the terms summed into the residual.
     pub(crate) fn euler_lagrange(
         &self,
         base: &SVector<f64, N>,

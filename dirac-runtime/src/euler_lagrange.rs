@@ -1081,10 +1081,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
     }
 
     /// A Jacobian takes the hyper-dual Hessian of `L` (about `(N + 1)²` numbers per operation
-    /// of `L`; three such passes per node beyond the midpoint rule) where the residual takes two
-    /// first-order passes (`N + 1` each); first-order steps assemble both together.
+    /// of `L`; three such passes per node beyond the midpoint rule) where the residual takes one
+    /// or two first-order passes (`N + 1` numbers each): `(N + 1)/2` per pass is the cautious
+    /// count. Collocated rows (first-order and mixed Lagrangians) take their Jacobian with their
+    /// residual, so there a Jacobian costs about a residual.
     fn jacobian_cost(&self) -> f64 {
-        if self.projected() || self.first_order() {
+        if self.projected() || self.first_order() || !self.collocated.is_empty() {
             return 1.0;
         }
         let passes = if self.layout.points() == 1 { 1.0 } else { 3.0 };

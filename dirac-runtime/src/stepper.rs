@@ -850,14 +850,11 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         // As a recorded sample's velocity is solved, in a workspace of its own.
         let mut solver =
             VelocitySolver::new(self.equations.velocity_unknowns(), self.newton.options())?;
-        let solve = |newton: &mut Newton| match in_run {
+        let solved = solver.solve(|newton| match in_run {
             true => self.equations.velocity_in_run(newton, t, q, p, guess),
             false => self.equations.velocity(newton, t, q, p, guess),
-        };
-        if let Ok(v) = solve(&mut solver.fast) {
-            return Ok(v);
-        }
-        solve(&mut solver.globalised).map_err(|f| self.failure(Problem::Velocity, f))
+        });
+        solved.map_err(|f| self.failure(Problem::Velocity, f))
     }
 
     /// The velocity of a recorded `state`, reached after `steps` steps, solved from `guess` in
@@ -872,15 +869,10 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             self.velocity = VelocitySolver::new(unknowns, self.newton.options())?;
         }
         let (t, q, p) = (state.t, &state.q, &state.p);
-        // From a guess near the velocity one Hessian, evaluated there, serves the whole solve;
-        // where that does not converge, the globalised solve from the same guess.
-        let fast = &mut self.velocity.fast;
-        fast.forget_jacobian();
-        if let Ok(v) = self.equations.velocity_in_run(fast, t, q, p, guess) {
-            return Ok(v);
-        }
-        let globalised = &mut self.velocity.globalised;
-        let solved = self.equations.velocity_in_run(globalised, t, q, p, guess);
+        let equations = &self.equations;
+        let solved = self
+            .velocity
+            .solve(|newton| equations.velocity_in_run(newton, t, q, p, guess));
         solved.map_err(|f| self.failure(Problem::Velocity, f))
     }
 
@@ -1498,6 +1490,16 @@ impl VelocitySolver {
             fast: Newton::new(unknowns, fast)?,
             globalised: Newton::new(unknowns, velocity_options(options))?,
         })
+    }
+
+    /// `solve` run by the fast solver, with the Hessian at its guess (none kept from an earlier
+    /// sample), and where that fails by the globalised one, from the same guess.
+    fn solve<T>(
+        &mut self,
+        solve: impl Fn(&mut Newton) -> Result<T, NewtonFailure>,
+    ) -> Result<T, NewtonFailure> {
+        self.fast.forget_jacobian();
+        solve(&mut self.fast).or_else(|_| solve(&mut self.globalised))
     }
 }
 
