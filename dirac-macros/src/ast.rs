@@ -116,6 +116,8 @@ pub struct Model {
     pub inputs: Vec<Ident>,
     /// `__dirac::ConstraintPoint::...` when `constraint_at` is given.
     pub constraint_point: Option<TokenStream>,
+    /// The Lagrangian's derivatives in closed form, where the expression has them.
+    pub closed_form: Option<crate::symbolic::ClosedForm>,
     /// Continuations of long chains, each emitted as a method of its own.
     pub parts: Vec<crate::expression::Part>,
     /// The path of the runtime crate (`crate = ...`, `::dirac` by default), bound to `__dirac`

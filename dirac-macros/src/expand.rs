@@ -91,6 +91,7 @@ fn expand(model: &Model) -> TokenStream {
         }
     };
     let dirac = dirac_items(model, &n, &bindings);
+    let closed_form = closed_form(model, &n);
     let parts = parts(model, &n, &bindings);
     let names = model.coordinates.iter().zip(&offsets).map(|(c, offset)| {
         let name = c.name.to_string();
@@ -152,10 +153,54 @@ fn expand(model: &Model) -> TokenStream {
             }
 
             #dirac
+            #closed_form
         }
     };
     let implementation = in_scope(&model.krate, implementation);
     quote!(#item #implementation)
+}
+
+/// `lagrangian_gradient` and `lagrangian_hessian` where the Lagrangian has closed forms: the
+/// parameters bound by name, then straight-line `f64` code.
+fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
+    let Some(closed) = &model.closed_form else {
+        return TokenStream::new();
+    };
+    let parameters = model.parameters.iter().map(|p| {
+        let name = &p.name;
+        quote!(let #name = self.#name;)
+    });
+    let parameters = quote!(#(#parameters)*);
+    let vector = quote!(&__dirac::nalgebra::SVector<f64, #n>);
+    let gradient = &closed.gradient;
+    let hessian = closed.hessian.as_ref().map(|hessian| {
+        quote! {
+            #[inline]
+            #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
+            fn lagrangian_hessian(
+                &self,
+                __q: #vector,
+                __v: #vector,
+            ) -> ::core::option::Option<__dirac::LagrangianHessian<#n>> {
+                #parameters
+                #hessian
+            }
+        }
+    });
+    quote! {
+        #[inline]
+        #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
+        fn lagrangian_gradient(
+            &self,
+            __q: #vector,
+            __v: #vector,
+        ) -> ::core::option::Option<__dirac::LagrangianGradient<#n>> {
+            #parameters
+            #gradient
+        }
+
+        #hessian
+    }
 }
 
 /// The inputs bound by name for the forces.

@@ -1,7 +1,8 @@
 //! The `#[dirac_system(...)]` attribute. It parses the model (`ast`), checks it and collects
 //! every error with its span (`validate`), rewrites the Lagrangian and the one-forms into generic
-//! scalar code (`expression`, `one_form`) and implements `dirac::DiracSystem` (`expand`). It never
-//! panics on input.
+//! scalar code (`expression`, `one_form`), derives the Lagrangian's gradient and Hessian in
+//! closed form where the expression allows (`symbolic`) and implements `dirac::DiracSystem`
+//! (`expand`). It never panics on input.
 
 use proc_macro::TokenStream;
 
@@ -10,6 +11,7 @@ mod expand;
 mod expression;
 mod one_form;
 mod quadrature;
+mod symbolic;
 mod validate;
 
 /// Turns a struct of parameters into a `dirac::DiracSystem`.

@@ -11,6 +11,7 @@ use syn::{Expr, Fields, GenericParam, Ident, Meta, Token, Type};
 
 use crate::ast::{Arguments, Coordinate, Lagrangian, Length, Model, Parameter};
 use crate::expression::{Context, Part, Rewriter, Scope, bounds, is_reserved, reserved_message};
+use crate::symbolic;
 use crate::{expression, one_form, quadrature};
 
 const KEYS: &str = "`coordinates(...)`, `lagrangian = ...`, `quadrature = ...`, \
@@ -208,13 +209,21 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         &parameters,
         &mut errors,
     );
+    let mut closed_form = None;
     let lagrangian = match (e.lagrangian, &coordinates) {
         (None, _) => {
             errors.push(Span::call_site(), "missing `lagrangian = ...`: an expression in the coordinates, dot(coordinate) and the parameters, or the path of a generic function");
             None
         }
         (Some(expr), Some(coordinates)) => {
-            lagrangian_of(expr, coordinates, &parameters, &parts, &mut errors)
+            let n = literal_dimension(coordinates);
+            let closed = n.and_then(|n| symbolic::closed_form(&expr, coordinates, n));
+            let lagrangian = lagrangian_of(expr, coordinates, &parameters, &parts, &mut errors);
+            // A function path has no expression to differentiate.
+            if matches!(lagrangian, Some(Lagrangian::Expression(_))) {
+                closed_form = closed;
+            }
+            lagrangian
         }
         (Some(_), None) => None,
     };
@@ -302,6 +311,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 forces,
                 inputs,
                 constraint_point,
+                closed_form,
                 parts: parts.into_inner(),
                 krate,
             }))
@@ -370,6 +380,17 @@ fn check_inputs(
             );
         }
     }
+}
+
+/// The number of coordinates when every array length is a literal.
+fn literal_dimension(coordinates: &[Coordinate]) -> Option<usize> {
+    coordinates
+        .iter()
+        .try_fold(0usize, |sum, c| match &c.length {
+            None => sum.checked_add(1),
+            Some(Length::Literal(n, _)) => sum.checked_add(*n),
+            Some(Length::Named(_)) => None,
+        })
 }
 
 /// A bare path naming no coordinate or parameter is a function; anything else an expression.

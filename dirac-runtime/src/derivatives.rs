@@ -9,6 +9,7 @@
 use nalgebra::{Const, SMatrix, SVector, U1};
 use num_dual::{Derivative, DualSVec64, HyperDualSVec64, HyperHyperDual64};
 
+use crate::closed_form::{LagrangianGradient, LagrangianHessian};
 use crate::configuration_space::ConfigurationSpace;
 use crate::scalar::Scalar;
 use crate::system::DiracSystem;
@@ -16,12 +17,48 @@ use crate::system::DiracSystem;
 /// A function of `(q, v)` over any scalar: the model's Lagrangian, or the Lagrangian in a chart.
 pub(crate) trait PhaseFunction<const N: usize> {
     fn value<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D;
+
+    /// The value and gradient in closed form, where known.
+    fn closed_gradient(
+        &self,
+        _q: &SVector<f64, N>,
+        _v: &SVector<f64, N>,
+    ) -> Option<LagrangianGradient<N>> {
+        None
+    }
+
+    /// The value, gradient and Hessian in closed form, where known.
+    fn closed_hessian(
+        &self,
+        _q: &SVector<f64, N>,
+        _v: &SVector<f64, N>,
+    ) -> Option<LagrangianHessian<N>> {
+        None
+    }
 }
 
 impl<S: DiracSystem<N>, const N: usize> PhaseFunction<N> for S {
     #[inline]
     fn value<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D {
         self.lagrangian(q, v)
+    }
+
+    #[inline]
+    fn closed_gradient(
+        &self,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Option<LagrangianGradient<N>> {
+        self.lagrangian_gradient(q, v)
+    }
+
+    #[inline]
+    fn closed_hessian(
+        &self,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Option<LagrangianHessian<N>> {
+        self.lagrangian_hessian(q, v)
     }
 }
 
@@ -77,8 +114,91 @@ pub(crate) struct Seeded<const N: usize> {
     pub mixed: SMatrix<f64, N, N>,
 }
 
-/// Evaluates `L(q, v)` over hyper-dual numbers seeded along `x` and `y`.
+/// `L(q, v)` seeded along `x` and `y`: from the closed forms where the function has them (the
+/// gradient alone when `y` is [`Seed::NONE`]), else by hyper-dual numbers.
+#[inline]
 pub(crate) fn seeded<F: PhaseFunction<N>, const N: usize>(
+    lagrangian: &F,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+    x: Seed,
+    y: Seed,
+) -> Seeded<N> {
+    // Terms of weight zero are left out, not multiplied by zero: a derivative that is not
+    // finite (outside the Lagrangian's domain) must not reach a direction that does not see it.
+    let along = |g: &LagrangianGradient<N>, s: Seed| {
+        weighted(&g.q, s.position) + weighted(&g.v, s.velocity)
+    };
+    if y == Seed::NONE
+        && let Some(g) = lagrangian.closed_gradient(q, v)
+    {
+        return Seeded {
+            value: g.value,
+            first: along(&g, x),
+            second: SVector::zeros(),
+            mixed: SMatrix::zeros(),
+        };
+    }
+    match lagrangian.closed_hessian(q, v) {
+        Some(h) => Seeded {
+            value: h.gradient.value,
+            first: along(&h.gradient, x),
+            second: along(&h.gradient, y),
+            mixed: weighted(&h.qq, x.position * y.position)
+                + weighted(&h.qv, x.position * y.velocity)
+                + weighted(&h.qv.transpose(), x.velocity * y.position)
+                + weighted(&h.vv, x.velocity * y.velocity),
+        },
+        None => seeded_by_duals(lagrangian, q, v, x, y),
+    }
+}
+
+/// `w · m`, or zeros when `w` is zero (whatever `m` holds).
+#[inline]
+fn weighted<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>, w: f64) -> SMatrix<f64, R, C> {
+    if w == 0.0 { SMatrix::zeros() } else { m * w }
+}
+
+/// `L(q, v)`, its gradient and its three Hessian blocks `(∂²L/∂q², ∂²L/∂q∂v, ∂²L/∂v²)`: in
+/// closed form where known, else by three hyper-dual passes.
+#[inline]
+pub(crate) fn hessian<F: PhaseFunction<N>, const N: usize>(
+    lagrangian: &F,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+) -> LagrangianHessian<N> {
+    if let Some(h) = lagrangian.closed_hessian(q, v) {
+        return h;
+    }
+    let qv = seeded_by_duals(lagrangian, q, v, Seed::POSITION, Seed::VELOCITY);
+    LagrangianHessian {
+        gradient: LagrangianGradient {
+            value: qv.value,
+            q: qv.first,
+            v: qv.second,
+        },
+        qq: seeded_by_duals(lagrangian, q, v, Seed::POSITION, Seed::POSITION).mixed,
+        qv: qv.mixed,
+        vv: seeded_by_duals(lagrangian, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed,
+    }
+}
+
+/// [`hessian`] of `ℓ(ξ, ξ̇)`: for a translation chart, of `L` at `q_k + ξ`.
+#[inline]
+pub(crate) fn hessian_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
+    chart: &InChart<'_, S, C, N>,
+    xi: &SVector<f64, N>,
+    xi_dot: &SVector<f64, N>,
+) -> LagrangianHessian<N> {
+    if C::TRANSLATION {
+        hessian(chart.system, &(chart.base + xi), xi_dot)
+    } else {
+        hessian(chart, xi, xi_dot)
+    }
+}
+
+/// Evaluates `L(q, v)` over hyper-dual numbers seeded along `x` and `y`.
+pub(crate) fn seeded_by_duals<F: PhaseFunction<N>, const N: usize>(
     lagrangian: &F,
     q: &SVector<f64, N>,
     v: &SVector<f64, N>,
@@ -182,6 +302,9 @@ pub(crate) fn gradients<F: PhaseFunction<N>, const N: usize>(
     q: &SVector<f64, N>,
     v: &SVector<f64, N>,
 ) -> (SVector<f64, N>, SVector<f64, N>) {
+    if let Some(g) = lagrangian.closed_gradient(q, v) {
+        return (g.q, g.v);
+    }
     let constant = |x: &SVector<f64, N>| x.map(Dual::<N>::from);
     let lq = lagrangian.value(&lift(q, 1.0), &constant(v));
     let lv = lagrangian.value(&constant(q), &lift(v, 1.0));
@@ -196,6 +319,9 @@ pub(crate) fn directional_gradient<F: PhaseFunction<N>, const N: usize>(
     v: &SVector<f64, N>,
     seed: Seed,
 ) -> SVector<f64, N> {
+    if let Some(g) = lagrangian.closed_gradient(q, v) {
+        return weighted(&g.q, seed.position) + weighted(&g.v, seed.velocity);
+    }
     gradient(&lagrangian.value(&lift(q, seed.position), &lift(v, seed.velocity)))
 }
 
@@ -255,7 +381,8 @@ pub(crate) fn degenerate_at<S: DiracSystem<N>, const N: usize>(
     q: &SVector<f64, N>,
     v: &SVector<f64, N>,
 ) -> Vec<usize> {
-    let vv = seeded(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed;
+    // Dual numbers, whose zeros are structural, as they are for any model.
+    let vv = seeded_by_duals(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed;
     (0..N)
         .filter(|&i| vv.row(i).iter().all(|x| *x == 0.0))
         .collect()
@@ -278,7 +405,7 @@ pub(crate) fn degenerate<S: DiracSystem<N>, const N: usize>(
     let probes = [(*q, *v), (moved(q, 0.0137), moved(v, 0.291))];
     let hessians: Vec<_> = probes
         .iter()
-        .map(|(q, v)| seeded(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed)
+        .map(|(q, v)| seeded_by_duals(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed)
         .filter(|vv| vv.iter().all(|x| x.is_finite()))
         .collect();
     if hessians.is_empty() {

@@ -15,10 +15,11 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+use crate::closed_form::LagrangianHessian;
 use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
 use crate::derivatives::{
     InChart, PhaseFunction, Seed, directional_gradient_in_chart, gradients_in_chart,
-    seeded_in_chart, third_derivative,
+    hessian_in_chart, seeded_in_chart, third_derivative,
 };
 use crate::error::DiracError;
 use crate::quadrature::Quadrature;
@@ -178,12 +179,22 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         let mut magnitude = momentum.abs();
         let quad = &self.quadrature;
         let chart = self.in_chart(base);
+        let mut closed_gradient = false;
         for (i, &b) in quad.weights().iter().enumerate() {
             let w = h * b;
             let (xi, xi_dot) = self.node(i, increments);
             let a = |j: usize| quad.ell(i, j);
             let d = |j: usize| quad.ell_prime(i, j) / h;
+            // A gradient in closed form brings every slot at the cost of the residual's alone.
+            let closed = match jacobian {
+                None if C::TRANSLATION => self.system.lagrangian_gradient(&(base + xi), &xi_dot),
+                _ => None,
+            };
             let (lq, lv) = match jacobian.as_deref_mut() {
+                None if let Some(g) = closed => {
+                    closed_gradient = true;
+                    (g.q, g.v)
+                }
                 // Up to two coordinates the hyper-dual pass costs about one first-order pass,
                 // and brings both slots: the covectors come with the residual.
                 None if s == 1 && N > 2 => {
@@ -227,33 +238,34 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
                 }
                 Some(jacobian) => {
                     // Many pairs: the Hessian of ℓ at the node, then the chain rule.
-                    let qv = seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::VELOCITY);
-                    let qq =
-                        seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::POSITION).mixed;
-                    let vv =
-                        seeded_in_chart(&chart, &xi, &xi_dot, Seed::VELOCITY, Seed::VELOCITY).mixed;
+                    let l = hessian_in_chart(&chart, &xi, &xi_dot);
                     for j in 0..s {
                         for k in 1..=s {
                             let mut block = jacobian.fixed_view_mut::<N, N>(j * N, (k - 1) * N);
-                            block += (qq * (a(j) * a(k))
-                                + qv.mixed * (a(j) * d(k))
-                                + qv.mixed.transpose() * (d(j) * a(k))
-                                + vv * (d(j) * d(k)))
+                            block += (l.qq * (a(j) * a(k))
+                                + l.qv * (a(j) * d(k))
+                                + l.qv.transpose() * (d(j) * a(k))
+                                + l.vv * (d(j) * d(k)))
                                 * w;
                         }
                     }
-                    (qv.first, qv.second)
+                    (l.gradient.q, l.gradient.v)
                 }
             };
             impulse += lq * w;
             end += (lq * a(s) + lv * d(s)) * w;
-            magnitude += (lq.abs() + lv.abs() * s as f64 / h) * w;
+            magnitude += if s == 1 {
+                // The terms summed into the residual, as the dual-number passes count them.
+                (lq * a(0) + lv * d(0)).abs() * w
+            } else {
+                (lq.abs() + lv.abs() * s as f64 / h) * w
+            };
             for j in 0..s {
                 let mut r = residual.rows_mut(j * N, N);
                 r += (lq * a(j) + lv * d(j)) * w;
             }
         }
-        let complete = s > 1 || N <= 2 || jacobian.is_some();
+        let complete = s > 1 || N <= 2 || jacobian.is_some() || closed_gradient;
         (
             complete.then_some(StepCovectors { impulse, end }),
             magnitude.amax(),
@@ -317,9 +329,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         for (i, &b) in quad.weights().iter().enumerate() {
             let w = h * b;
             let (xi, xi_dot) = self.node(i, increments);
-            let qv = seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::VELOCITY).mixed;
-            let qq = seeded_in_chart(&chart, &xi, &xi_dot, Seed::POSITION, Seed::POSITION).mixed;
-            let vv = seeded_in_chart(&chart, &xi, &xi_dot, Seed::VELOCITY, Seed::VELOCITY).mixed;
+            let LagrangianHessian { qq, qv, vv, .. } = hessian_in_chart(&chart, &xi, &xi_dot);
             let a = |j: usize| quad.ell(i, j);
             let d = |j: usize| quad.ell_prime(i, j) / h;
             for (j, row) in blocks.iter_mut().enumerate() {

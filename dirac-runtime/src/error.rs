@@ -114,6 +114,10 @@ pub enum DiracError {
     /// A run's time span, save times or events do not fit the stepper (the message says how).
     #[error("invalid run: {0}")]
     InvalidRun(String),
+    /// A model's closed-form derivatives of its Lagrangian disagree with its Lagrangian (the
+    /// message names the derivative and the point).
+    #[error("{0}")]
+    InconsistentDerivatives(String),
     /// Writing a trajectory failed.
     #[error("could not write the trajectory: {0}")]
     Io(String),

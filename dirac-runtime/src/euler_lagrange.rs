@@ -898,6 +898,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
                 value: energy,
             });
         }
+        crate::closed_form::check(system, q, v)?;
         initial_state::check(system, state.t, q, v, &self.inputs, tolerance)
             .map_err(DiracError::InconsistentInitialState)?;
         let hidden = HiddenConstraints::find(system, q, v, state.t, &self.inputs);

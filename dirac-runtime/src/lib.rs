@@ -7,10 +7,12 @@
 //! Lagrange–d'Alembert forces) and [`constraint`] (multiplier rows) → [`euler_lagrange`] (the
 //! step's residual, unknowns and update, behind the [`step_equations`] seam) → [`newton`] →
 //! [`stepper`] (over a [`run`], with [`dense_output`] and [`event`]s) → [`trajectory`], with
-//! [`step_derivatives`] (the step map's derivatives by the implicit function theorem). Every derivative of the model's functions is taken by dual
-//! numbers in one private module, `derivatives`.
+//! [`step_derivatives`] (the step map's derivatives by the implicit function theorem). Every derivative of the model's functions is taken in one
+//! private module, `derivatives`: from the Lagrangian's [`closed_form`] derivatives where the
+//! model has them (`#[dirac_system]` derives them at compile time), else by dual numbers.
 #![warn(missing_docs)]
 
+pub mod closed_form;
 pub mod configuration_space;
 pub mod constraint;
 mod constraint_point;
@@ -44,6 +46,7 @@ pub mod system;
 pub mod trajectory;
 pub mod work_precision;
 
+pub use closed_form::{LagrangianGradient, LagrangianHessian};
 pub use configuration_space::{ConfigurationSpace, Euclidean, Positive};
 pub use constraint::ConstraintPoint;
 pub use dense_output::Sample;

@@ -2,6 +2,7 @@
 
 use nalgebra::SVector;
 
+use crate::closed_form::{LagrangianGradient, LagrangianHessian};
 use crate::constraint_point::ConstraintPoint;
 use crate::error::DiracError;
 use crate::quadrature::Quadrature;
@@ -48,6 +49,31 @@ pub trait DiracSystem<const N: usize> {
 
     /// The continuous Lagrangian `L(q, v)` at position `q` and velocity `v`.
     fn lagrangian<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D;
+
+    /// `L` and its gradient at `(q, v)` in closed form, where the model has them:
+    /// `#[dirac_system]` derives them at compile time from a Lagrangian written as an
+    /// expression. `None` (the default) lets the runtime take them by dual numbers. They must
+    /// be the derivatives of [`lagrangian`](Self::lagrangian): a stepper compares the two at the
+    /// start of every run ([`closed_form::check`](crate::closed_form::check)).
+    fn lagrangian_gradient(
+        &self,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Option<LagrangianGradient<N>> {
+        let _ = (q, v);
+        None
+    }
+
+    /// `L` with its first and second derivatives at `(q, v)` in closed form, where the model
+    /// has them (as [`lagrangian_gradient`](Self::lagrangian_gradient)).
+    fn lagrangian_hessian(
+        &self,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Option<LagrangianHessian<N>> {
+        let _ = (q, v);
+        None
+    }
 
     /// Constraint one-form `a` (`0 <= a < ONE_FORMS`) at `q`: the row `A_a(q)` of `A(q) v = 0`.
     fn one_form<D: Scalar>(&self, q: &SVector<D, N>, a: usize) -> SVector<D, N> {

@@ -1,0 +1,170 @@
+//! The Lagrangian's first and second derivatives in closed form, where a model has them.
+//!
+//! `#[dirac_system]` derives them at compile time from a Lagrangian written as an expression
+//! (a graph of its operations differentiated by the chain rule, emitted as straight-line `f64`
+//! code), and [`DiracSystem::lagrangian_gradient`] and [`DiracSystem::lagrangian_hessian`]
+//! return them. The runtime then takes them instead of evaluating `L` over dual numbers; third
+//! derivatives and Lagrangians read in a curved chart still use dual numbers. A model written by
+//! hand may implement them too: a stepper compares them with dual numbers at the start of every
+//! run and refuses a model whose closed forms disagree (see [`check`]).
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::derivatives::{Seed, seeded_by_duals};
+use crate::error::DiracError;
+use crate::system::DiracSystem;
+
+/// `L` and its first derivatives at one `(q, v)`.
+///
+/// A model written by hand supplies them like this (and a stepper checks them at its start):
+///
+/// ```
+/// use dirac_runtime::{DiracSystem, LagrangianGradient, Scalar, closed_form};
+/// use nalgebra::{SVector, vector};
+///
+/// /// L = (v² − q²)/2.
+/// struct Oscillator;
+///
+/// impl DiracSystem<1> for Oscillator {
+///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+///     }
+///     fn lagrangian_gradient(
+///         &self,
+///         q: &SVector<f64, 1>,
+///         v: &SVector<f64, 1>,
+///     ) -> Option<LagrangianGradient<1>> {
+///         Some(LagrangianGradient { value: (v[0] * v[0] - q[0] * q[0]) * 0.5, q: -q, v: *v })
+///     }
+/// }
+///
+/// assert!(closed_form::check(&Oscillator, &vector![0.3], &vector![0.7]).is_ok());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LagrangianGradient<const N: usize> {
+    /// `L(q, v)`.
+    pub value: f64,
+    /// `∂L/∂q`.
+    pub q: SVector<f64, N>,
+    /// `∂L/∂v`.
+    pub v: SVector<f64, N>,
+}
+
+/// `L` with its first and second derivatives at one `(q, v)`.
+///
+/// ```
+/// use dirac_runtime::{DiracError, DiracSystem, LagrangianGradient, LagrangianHessian, Scalar};
+/// use dirac_runtime::closed_form;
+/// use nalgebra::{SMatrix, SVector, vector};
+///
+/// /// L = (v² − q²)/2, with a sign slip in its hand-written ∂²L/∂q².
+/// struct Slip;
+///
+/// impl DiracSystem<1> for Slip {
+///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+///     }
+///     fn lagrangian_hessian(
+///         &self,
+///         q: &SVector<f64, 1>,
+///         v: &SVector<f64, 1>,
+///     ) -> Option<LagrangianHessian<1>> {
+///         Some(LagrangianHessian {
+///             gradient: LagrangianGradient {
+///                 value: (v[0] * v[0] - q[0] * q[0]) * 0.5,
+///                 q: -q,
+///                 v: *v,
+///             },
+///             qq: SMatrix::identity(), // should be −1
+///             qv: SMatrix::zeros(),
+///             vv: SMatrix::identity(),
+///         })
+///     }
+/// }
+///
+/// let refused = closed_form::check(&Slip, &vector![0.3], &vector![0.7]);
+/// assert!(matches!(refused, Err(DiracError::InconsistentDerivatives(_))));
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LagrangianHessian<const N: usize> {
+    /// `L`, `∂L/∂q`, `∂L/∂v`.
+    pub gradient: LagrangianGradient<N>,
+    /// `∂²L/∂q²`.
+    pub qq: SMatrix<f64, N, N>,
+    /// `∂²L/∂q∂v`: entry `(i, j)` is `∂²L/∂q_i∂v_j`.
+    pub qv: SMatrix<f64, N, N>,
+    /// `∂²L/∂v²`.
+    pub vv: SMatrix<f64, N, N>,
+}
+
+/// Relative disagreement with dual numbers beyond which closed forms are refused.
+const TOLERANCE: f64 = 1e-8;
+
+/// Compares the model's closed forms, where it has them, with dual numbers at `(q, v)`: an
+/// `Err(InconsistentDerivatives)` naming the first derivative that differs by more than `1e-8`
+/// of the largest of its kind. Points where the Lagrangian is not finite are not judged.
+pub fn check<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+) -> Result<(), DiracError> {
+    let gradient = system.lagrangian_gradient(q, v);
+    let hessian = system.lagrangian_hessian(q, v);
+    if gradient.is_none() && hessian.is_none() {
+        return Ok(());
+    }
+    let qv = seeded_by_duals(system, q, v, Seed::POSITION, Seed::VELOCITY);
+    let qq = seeded_by_duals(system, q, v, Seed::POSITION, Seed::POSITION).mixed;
+    let vv = seeded_by_duals(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed;
+    let reference = LagrangianHessian {
+        gradient: LagrangianGradient {
+            value: qv.value,
+            q: qv.first,
+            v: qv.second,
+        },
+        qq,
+        qv: qv.mixed,
+        vv,
+    };
+    let finite = |x: &[f64]| x.iter().all(|x| x.is_finite());
+    let first = |g: &LagrangianGradient<N>| {
+        let mut all = vec![g.value];
+        all.extend(g.q.iter().chain(g.v.iter()));
+        all
+    };
+    let second = |h: &LagrangianHessian<N>| {
+        h.qq.iter()
+            .chain(h.qv.iter())
+            .chain(h.vv.iter())
+            .copied()
+            .collect::<Vec<_>>()
+    };
+    let compare = |what: &str, closed: Vec<f64>, duals: Vec<f64>| {
+        if !finite(&duals) {
+            return Ok(());
+        }
+        let scale = duals.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        // A difference that is NaN (a closed form NaN where the duals are finite) disagrees.
+        let bound = TOLERANCE * scale.max(f64::MIN_POSITIVE);
+        let agrees = |a: f64, b: f64| (a - b).abs() <= bound;
+        match closed.iter().zip(&duals).position(|(a, b)| !agrees(*a, *b)) {
+            None => Ok(()),
+            Some(k) => Err(DiracError::InconsistentDerivatives(format!(
+                "the closed-form {what} of the Lagrangian differs from dual numbers at \
+                 q = {:?}, v = {:?}: entry {k} is {} against {}",
+                q.as_slice(),
+                v.as_slice(),
+                closed[k],
+                duals[k]
+            ))),
+        }
+    };
+    if let Some(g) = gradient {
+        compare("gradient", first(&g), first(&reference.gradient))?;
+    }
+    if let Some(h) = hessian {
+        compare("gradient", first(&h.gradient), first(&reference.gradient))?;
+        compare("Hessian", second(&h), second(&reference))?;
+    }
+    Ok(())
+}
