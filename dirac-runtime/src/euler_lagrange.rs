@@ -642,14 +642,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
                 .copy_from(&form.transpose());
         }
         // ∂x/∂z = −J⁻¹ ∂R/∂z.
-        let mut dx = DMatrix::zeros(n, parameters);
-        let mut column = DVector::zeros(n);
-        for c in 0..parameters {
-            column.copy_from(&dr.column(c));
+        let mut dx = dr;
+        for column in dx.as_mut_slice().chunks_exact_mut(n) {
             newton
-                .solve_factorised(x, &mut column)
+                .solve_factorised_in(x, column)
                 .ok_or_else(stale_factorisation)?;
-            dx.set_column(c, &(-&column));
+            column.iter_mut().for_each(|v| *v = -*v);
         }
         Ok(Sensitivity {
             g,
@@ -1307,7 +1305,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
         }
         // p_{k+1} = ∂L_d/∂ξ_s + f_s + (1 − σ) A(q_c)ᵀμ.
         let mut dp = DMatrix::zeros(N, parameters);
-        let to_dynamic = |m: &SMatrix<f64, N, N>| DMatrix::from_column_slice(N, N, m.as_slice());
         dp.view_mut((0, 0), (N, N))
             .copy_from(&(moving_all[s] + end_turning));
         if let Some(force) = force_u.get(s) {
@@ -1320,7 +1317,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
             } else {
                 *g_sm
             };
-            dp += to_dynamic(&block) * dx.rows(layout.point(m), N);
+            // Column by column: fixed-size products, no allocation.
+            let row = layout.point(m);
+            for c in 0..parameters {
+                let moved = block * dx.fixed_view::<N, 1>(row, c);
+                let mut target = dp.fixed_view_mut::<N, 1>(0, c);
+                target += moved;
+            }
         }
         for (a, row) in end_rows.iter().enumerate() {
             dp += row * dx.row(layout.one_form(a));

@@ -1,7 +1,7 @@
 //! LU factorisation with partial pivoting, in place, without allocation: the linear solve inside
 //! every Newton iteration.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 /// Why a factorisation failed: the column whose pivot vanished, and the unknowns that a null
 /// vector of the matrix moves (the directions the equations do not determine).
@@ -66,10 +66,10 @@ fn null_vector_support(lu: &DMatrix<f64>, k: usize) -> Vec<usize> {
 }
 
 /// Solves `A x = b` in place of `b` with the factors from [`factorise`].
-pub(crate) fn solve(lu: &DMatrix<f64>, pivots: &[usize], b: &mut DVector<f64>) {
+pub(crate) fn solve(lu: &DMatrix<f64>, pivots: &[usize], b: &mut [f64]) {
     let n = lu.nrows();
     for (k, &p) in pivots.iter().enumerate().take(n) {
-        b.swap_rows(k, p);
+        b.swap(k, p);
     }
     for i in 0..n {
         let mut s = b[i];
@@ -90,6 +90,7 @@ pub(crate) fn solve(lu: &DMatrix<f64>, pivots: &[usize], b: &mut DVector<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::DVector;
 
     #[test]
     fn solves_a_system_that_needs_pivoting() {
@@ -99,7 +100,7 @@ mod tests {
         let mut lu = a.clone();
         let mut pivots = [0; 3];
         factorise(&mut lu, &mut pivots, 1e-14).unwrap();
-        solve(&lu, &pivots, &mut b);
+        solve(&lu, &pivots, b.as_mut_slice());
         assert!((b - x).amax() < 1e-14);
     }
 

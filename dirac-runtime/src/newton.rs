@@ -272,6 +272,11 @@ impl Newton {
     /// of the last successful [`solve`](Self::solve) (the implicit function theorem's solves
     /// reuse it); `None` otherwise (no solve yet, a failed one since, or another point).
     pub(crate) fn solve_factorised(&self, root: &DVector<f64>, b: &mut DVector<f64>) -> Option<()> {
+        self.solve_factorised_in(root, b.as_mut_slice())
+    }
+
+    /// [`solve_factorised`](Self::solve_factorised) on a slice (a column of a matrix).
+    pub(crate) fn solve_factorised_in(&self, root: &DVector<f64>, b: &mut [f64]) -> Option<()> {
         (self.at_root && &self.root == root).then(|| lu::solve(&self.jacobian, &self.pivots, b))
     }
 
@@ -580,7 +585,7 @@ impl Newton {
         loop {
             // The correction at x, with the factorised Jacobian: x's distance from the root.
             self.update.copy_from(&self.residual);
-            lu::solve(&self.jacobian, &self.pivots, &mut self.update);
+            lu::solve(&self.jacobian, &self.pivots, self.update.as_mut_slice());
             if !self.update.iter().all(|u| u.is_finite()) {
                 return Err(self.failed(NewtonFailure::NonFinite));
             }
