@@ -364,3 +364,51 @@ fn huge_steps_are_finite_or_refused() {
         }
     }
 }
+
+/// A double pendulum that has turned 10⁵ times (angles near ±6·10⁵ rad, whose ulp is 1.2e-10)
+/// against one at the same angles modulo 2π. The residual is evaluated at points rounded to
+/// those ulps, which can leave it above Newton's tolerance: each step is then refused with
+/// `NoConvergence`, never accepted wrong; a step that is accepted matches the fresh pendulum.
+#[test]
+fn a_pendulum_that_has_turned_many_times_steps_like_a_fresh_one_or_refuses() {
+    let model = DoublePendulum {
+        m1: 1.0,
+        m2: 1.0,
+        l1: 1.0,
+        l2: 1.0,
+        g: 9.81,
+    };
+    let turns = 2.0 * std::f64::consts::PI * 1e5;
+    let start = vector![std::f64::consts::FRAC_PI_2, 0.3];
+    let mut fresh = Stepper::new(model, Quadrature::galerkin(2).unwrap(), 0.01).unwrap();
+    fresh
+        .start_from_velocity(start, vector![1.0, -2.0])
+        .unwrap();
+    let mut turned = Stepper::new(model, Quadrature::galerkin(2).unwrap(), 0.01).unwrap();
+    let offset = vector![turns, -turns];
+    turned
+        .start_from_velocity(start + offset, vector![1.0, -2.0])
+        .unwrap();
+    let mut refused = 0;
+    for step in 0..200 {
+        fresh.step().unwrap();
+        let before = (turned.q(), turned.p(), turned.steps());
+        match turned.step() {
+            Ok(()) => {}
+            Err(DiracError::NoConvergence { .. }) => {
+                refused += 1;
+                assert_eq!(before, (turned.q(), turned.p(), turned.steps()));
+                break;
+            }
+            Err(e) => panic!("step {step}: {e}"),
+        }
+        let apart = (turned.q() - offset - fresh.q()).amax();
+        // The turned start is rounded by 6e-11; differences grow from there.
+        assert!(apart < 1e-8, "step {step}: {apart:e} apart");
+        assert!((turned.p() - fresh.p()).amax() < 1e-7);
+    }
+    println!(
+        "turned pendulum: {} steps, refused {refused}",
+        turned.steps()
+    );
+}

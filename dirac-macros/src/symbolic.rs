@@ -682,8 +682,41 @@ impl Graph {
                 | Node::Atan2(a, b) => stack.extend([*a, *b]),
             }
         }
+        // `sin x` and `cos x` both needed: one `sin_cos` call gives the pair (libm computes
+        // them together for about the price of one).
+        let partner = |id: Id| match self.nodes[id] {
+            Node::Call(f @ (Function::Sin | Function::Cos), a) => {
+                let other = if f == Function::Sin {
+                    Function::Cos
+                } else {
+                    Function::Sin
+                };
+                self.index
+                    .get(&Node::Call(other, a))
+                    .copied()
+                    .filter(|&o| needed[o])
+                    .map(|o| (f, a, o))
+            }
+            _ => None,
+        };
         let mut statements = TokenStream::new();
         for (id, node) in self.nodes.iter().enumerate().filter(|(id, _)| needed[*id]) {
+            if let Some((f, a, other)) = partner(id) {
+                if other < id {
+                    continue; // emitted with its partner
+                }
+                let (sin, cos) = match f {
+                    Function::Sin => (id, other),
+                    _ => (other, id),
+                };
+                let (sin, cos) = (
+                    quote::format_ident!("__s{}", sin),
+                    quote::format_ident!("__s{}", cos),
+                );
+                let a = self.operand(a);
+                statements.extend(quote!(let (#sin, #cos): (f64, f64) = #a.sin_cos();));
+                continue;
+            }
             let value = match node {
                 Node::Number(_) | Node::Constant(_) | Node::Variable(_) => continue,
                 Node::Add(a, b) => binary(self.operand(*a), quote!(+), self.operand(*b)),
