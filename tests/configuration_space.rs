@@ -50,7 +50,7 @@ fn wall_exact(t: f64) -> (f64, f64) {
 }
 
 /// `(q, p)` at `t_end` from `(Q0, V0)` with step `h` on `space`.
-fn wall_run<C: ConfigurationSpace<1>>(
+fn wall_run<C: ConfigurationSpace<1, Manifold = dirac::Vectors>>(
     space: C,
     c: f64,
     quadrature: Quadrature,
@@ -166,7 +166,7 @@ impl DiracSystem<2> for HyperbolaOneForm {
 }
 
 /// `q` at `t = 1` from `(1, 1)` with the tangent velocity `(1, −1)`.
-fn hyperbola_run<S: DiracSystem<2>, C: ConfigurationSpace<2>>(
+fn hyperbola_run<S: DiracSystem<2>, C: ConfigurationSpace<2, Manifold = dirac::Vectors>>(
     system: S,
     space: C,
     h: f64,

@@ -30,6 +30,7 @@ struct ImplicitMidpoint {
 
 impl StepEquations<1> for ImplicitMidpoint {
     type System = Oscillator;
+    type Manifold = dirac::Vectors;
     const NAME: &'static str = "the implicit midpoint rule";
     const VELOCITY: &'static str = "v = ∂H/∂p";
 
@@ -108,6 +109,10 @@ impl StepEquations<1> for ImplicitMidpoint {
 
     fn first_multiplier(&self) -> usize {
         2
+    }
+
+    fn momentum(&self, _q: &SVector<f64, 1>, v: &SVector<f64, 1>) -> Result<SVector<f64, 1>, DiracError> {
+        Ok(*v)
     }
 
     fn unknown_name(&self, column: usize) -> String {

@@ -16,15 +16,16 @@
 //!
 //! [`Euclidean`] (`Q = Rⁿ`, `R_q(ξ) = q + ξ`) is the default: every map is the identity, the
 //! momentum advances by the step's total impulse, and both sums are compensated. [`Positive`]
-//! (`R₊ⁿ`, `R_q(ξ) = q ⊙ exp ξ`) defines only [`retract`](ConfigurationSpace::retract),
-//! [`push_forward`](ConfigurationSpace::push_forward) and [`local`](ConfigurationSpace::local);
-//! the other maps have defaults derived from those three. The trait is sealed: this scheme is
-//! symplectic only for retractions with affine chart transitions (see [`ConfigurationSpace`]).
+//! (`R₊ⁿ`, `R_q(ξ) = q ⊙ exp ξ`) keeps every point positive. Both have affine chart transitions.
+//! The [`Product`](crate::product::Product) spaces of vectors, rotations and unit vectors do
+//! not: their steps differentiate the discrete Lagrangian through the moving chart (see
+//! [`ConfigurationSpace`]). The trait is sealed.
 
 use std::fmt::Debug;
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+use crate::manifold::{Manifold, Vectors};
 use crate::scalar::Scalar;
 
 /// The covectors a solved step hands to the configuration space to advance the momentum.
@@ -39,21 +40,31 @@ pub struct StepCovectors<const N: usize> {
     pub end: SVector<f64, N>,
 }
 
-/// A configuration space with `N` coordinates and a retraction `R_q(ξ)` whose charts a step works in.
+/// The point of a configuration space `C` over the scalar `D`.
+pub type Point<C, const N: usize, D> =
+    <<C as ConfigurationSpace<N>>::Manifold as Manifold<N>>::Point<D>;
+
+/// A tangent vector (or covector) of a configuration space `C` over the scalar `D`.
+pub type Tangent<C, const N: usize, D> =
+    <<C as ConfigurationSpace<N>>::Manifold as Manifold<N>>::Tangent<D>;
+
+/// A configuration space of dimension `N` on a [`Manifold`], with a retraction `R_q(ξ)` whose
+/// charts a step works in.
 ///
 /// The maps are generic over the [`Scalar`] so that the runtime differentiates through them
 /// exactly. A retraction must satisfy `R_q(0) = q` and have an invertible tangent map near
 /// `ξ = 0`.
 ///
-/// **Sealed: the spaces are the library's.** A step holds its chart at `q_k` fixed and takes
-/// `p_k + ∂L_d/∂ξ_0 = 0` in it. That is the discrete Euler–Lagrange equation of one discrete
-/// Lagrangian on `Q × Q` only when the chart transitions `R_{q'}⁻¹ ∘ R_q` are affine in `ξ`
-/// (then `L_d` does not depend on where its chart is centred). `Euclidean` and `Positive` (an
-/// abelian group with `exp`) have affine transitions. For other retractions (e.g.
-/// `R_q(ξ) = q + sinh ξ`, or a non-abelian Lie group) the same equations give a step that is
-/// consistent but not symplectic: measured `det A − 1 = O(h³)` per step, and a drifting energy.
-/// Those spaces need the derivative of `L_d` through the moving chart; until the runtime has it,
-/// no other space can be written.
+/// **Sealed: the spaces are the library's.** A step from `q_k` solves for chart coordinates in
+/// the chart centred at `q_k`, and the discrete Euler–Lagrange equation of `q_k` is the derivative
+/// of the discrete Lagrangian in its first point. Where the chart transitions
+/// `R_{q'}⁻¹ ∘ R_q` are affine in `ξ` ([`AFFINE`](Self::AFFINE): `Euclidean`, `Positive`, an
+/// abelian group with `exp`), `L_d` does not depend on where its chart is centred and that
+/// derivative is `∂L_d/∂ξ_0` in the fixed chart. Otherwise (a rotation, a unit vector: the
+/// [`Product`](crate::product::Product) spaces) it is taken through the moving chart centred at
+/// `R_{q_k}(η)` ([`retract_moved`](Self::retract_moved), [`transition`](Self::transition)), which
+/// keeps the step symplectic; the fixed chart there would give a consistent step that is not
+/// (measured on `R_q(ξ) = q + sinh ξ`: `det A − 1 = O(h³)` per step and a drifting energy).
 ///
 /// ```
 /// use dirac_runtime::configuration_space::{ConfigurationSpace, Euclidean};
@@ -65,47 +76,56 @@ pub struct StepCovectors<const N: usize> {
 /// assert_eq!(Euclidean.local(&q, &moved), Some(vector![0.5, -0.5]));
 /// ```
 pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
+    /// The points and tangent vectors the model is written over.
+    type Manifold: Manifold<N>;
+
     /// Whether `R_q(ξ) = q + ξ` with `T_ξR_q` the identity (`Rⁿ`): the Lagrangian in the chart is
     /// then the model's at `q + ξ`, and the runtime adds `q` before it seeds the dual numbers
     /// rather than after (the same values, with no dual-number arithmetic for the chart).
     const TRANSLATION: bool = false;
 
+    /// Whether the chart transitions `R_{R_q(η)}⁻¹ ∘ R_q` are `ξ ↦ ξ − η`: then the moving-chart
+    /// maps are the fixed chart's, and a step needs no moving chart.
+    const AFFINE: bool = true;
+
     /// Whether `q` is a point of the space (a start outside it is refused).
-    fn contains(&self, q: &SVector<f64, N>) -> bool {
-        q.iter().all(|x| x.is_finite())
-    }
+    fn contains(&self, q: &Point<Self, N, f64>) -> bool;
 
     /// `R_q(ξ)`: the point at chart coordinates `ξ` of the chart centred at `q`.
-    fn retract<D: Scalar>(&self, q: &SVector<f64, N>, xi: &SVector<D, N>) -> SVector<D, N>;
+    fn retract<D: Scalar>(&self, q: &Point<Self, N, f64>, xi: &SVector<D, N>) -> Point<Self, N, D>;
 
     /// `T_ξ R_q · ξ̇`: the model's velocity along the chart velocity `ξ̇` at `ξ`.
     fn push_forward<D: Scalar>(
         &self,
-        q: &SVector<f64, N>,
+        q: &Point<Self, N, f64>,
         xi: &SVector<D, N>,
         xi_dot: &SVector<D, N>,
-    ) -> SVector<D, N>;
+    ) -> Tangent<Self, N, D>;
 
     /// `R_q⁻¹(q1)`: the chart coordinates of `q1` in the chart centred at `q`, `None` outside
     /// the chart.
-    fn local(&self, q: &SVector<f64, N>, q1: &SVector<f64, N>) -> Option<SVector<f64, N>>;
+    fn local(&self, q: &Point<Self, N, f64>, q1: &Point<Self, N, f64>) -> Option<SVector<f64, N>>;
 
     /// `(T_ξ R_q)ᵀ α`: the covector `α` at `R_q(ξ)` read in the chart.
     fn pull_back<D: Scalar>(
         &self,
-        q: &SVector<f64, N>,
+        q: &Point<Self, N, f64>,
         xi: &SVector<D, N>,
-        covector: &SVector<D, N>,
+        covector: &Tangent<Self, N, D>,
     ) -> SVector<D, N> {
         SVector::from_fn(|j, _| {
             let e = SVector::<D, N>::from_fn(|i, _| D::from(if i == j { 1.0 } else { 0.0 }));
-            covector.dot(&self.push_forward(q, xi, &e))
+            Self::Manifold::pair(covector, &self.push_forward(q, xi, &e))
         })
     }
 
     /// The chart velocity `ξ̇` at `ξ = 0` whose push-forward is the model's velocity `v`, `None`
     /// where the tangent map is singular.
-    fn chart_velocity(&self, q: &SVector<f64, N>, v: &SVector<f64, N>) -> Option<SVector<f64, N>> {
+    fn chart_velocity(
+        &self,
+        q: &Point<Self, N, f64>,
+        v: &Tangent<Self, N, f64>,
+    ) -> Option<SVector<f64, N>> {
         self.chart_rate(q, &SVector::zeros(), v)
     }
 
@@ -113,16 +133,19 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
     /// `R_q(ξ)`, `None` where the tangent map is singular.
     fn chart_rate(
         &self,
-        q: &SVector<f64, N>,
+        q: &Point<Self, N, f64>,
         xi: &SVector<f64, N>,
-        v: &SVector<f64, N>,
-    ) -> Option<SVector<f64, N>> {
-        solve(&tangent_map(self, q, xi), v)
-    }
+        v: &Tangent<Self, N, f64>,
+    ) -> Option<SVector<f64, N>>;
 
     /// Moves `q` to `R_q(ξ)`. `carry` is for spaces that compensate round-off over many steps
     /// (on `Rⁿ`, a Kahan sum); the default ignores it.
-    fn advance(&self, q: &mut SVector<f64, N>, carry: &mut SVector<f64, N>, xi: &SVector<f64, N>) {
+    fn advance(
+        &self,
+        q: &mut Point<Self, N, f64>,
+        carry: &mut SVector<f64, N>,
+        xi: &SVector<f64, N>,
+    ) {
         let _ = carry;
         *q = self.retract(q, xi);
     }
@@ -131,27 +154,57 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
     /// `(T_ξ R_q)ᵀ p_{k+1} = covectors.end`. `None` where the tangent map is singular.
     fn advance_momentum(
         &self,
-        q: &SVector<f64, N>,
+        q: &Point<Self, N, f64>,
         xi: &SVector<f64, N>,
-        p: &mut SVector<f64, N>,
+        p: &mut Tangent<Self, N, f64>,
         carry: &mut SVector<f64, N>,
         covectors: &StepCovectors<N>,
-    ) -> Option<()> {
-        let _ = carry;
-        *p = solve(&tangent_map(self, q, xi).transpose(), &covectors.end)?;
-        Some(())
+    ) -> Option<()>;
+
+    /// `R_{R_q(η)}(ζ)`: the point at `ζ` of the chart centred at `R_q(η)`.
+    fn retract_moved<D: Scalar>(
+        &self,
+        q: &Point<Self, N, f64>,
+        eta: &SVector<D, N>,
+        zeta: &SVector<D, N>,
+    ) -> Point<Self, N, D> {
+        self.retract(q, &(eta + zeta))
+    }
+
+    /// `T_ζ R_{R_q(η)} ζ̇`: the velocity along `ζ̇` at `ζ` of the chart centred at `R_q(η)`.
+    fn push_forward_moved<D: Scalar>(
+        &self,
+        q: &Point<Self, N, f64>,
+        eta: &SVector<D, N>,
+        zeta: &SVector<D, N>,
+        zeta_dot: &SVector<D, N>,
+    ) -> Tangent<Self, N, D> {
+        self.push_forward(q, &(eta + zeta), zeta_dot)
+    }
+
+    /// `R_{R_q(η)}⁻¹(R_q(ξ))`: the point at `ξ` of the chart at `q` read in the chart centred at
+    /// `R_q(η)` (for the `η` and `ξ` of one step, inside both charts).
+    fn transition<D: Scalar>(
+        &self,
+        q: &Point<Self, N, f64>,
+        eta: &SVector<D, N>,
+        xi: &SVector<D, N>,
+    ) -> SVector<D, N> {
+        let _ = q;
+        xi - eta
     }
 }
 
-mod sealed {
+pub(crate) mod sealed {
     /// Implemented by the library's spaces only (see [`ConfigurationSpace`](super::ConfigurationSpace)).
     pub trait Sealed {}
     impl Sealed for super::Euclidean {}
     impl Sealed for super::Positive {}
 }
 
-/// The matrix of `T_ξ R_q` (columns: the push-forwards of the chart's unit vectors).
-fn tangent_map<C: ConfigurationSpace<N>, const N: usize>(
+/// The matrix of `T_ξ R_q` (columns: the push-forwards of the chart's unit vectors) of a space
+/// of vectors.
+fn tangent_map<C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>(
     space: &C,
     q: &SVector<f64, N>,
     xi: &SVector<f64, N>,
@@ -162,6 +215,28 @@ fn tangent_map<C: ConfigurationSpace<N>, const N: usize>(
         map.set_column(j, &space.push_forward(q, xi, &e));
     }
     map
+}
+
+/// [`ConfigurationSpace::chart_rate`] of a space of vectors from its tangent map.
+pub(crate) fn chart_rate_by_tangent_map<C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>(
+    space: &C,
+    q: &SVector<f64, N>,
+    xi: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+) -> Option<SVector<f64, N>> {
+    solve(&tangent_map(space, q, xi), v)
+}
+
+/// [`ConfigurationSpace::advance_momentum`] of a space of vectors from its tangent map.
+pub(crate) fn momentum_by_tangent_map<C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>(
+    space: &C,
+    q: &SVector<f64, N>,
+    xi: &SVector<f64, N>,
+    p: &mut SVector<f64, N>,
+    covectors: &StepCovectors<N>,
+) -> Option<()> {
+    *p = solve(&tangent_map(space, q, xi).transpose(), &covectors.end)?;
+    Some(())
 }
 
 /// `x` with `a x = b`, `None` where `a` is singular or the answer is not finite.
@@ -192,7 +267,13 @@ fn solve<const N: usize>(a: &SMatrix<f64, N, N>, b: &SVector<f64, N>) -> Option<
 pub struct Euclidean;
 
 impl<const N: usize> ConfigurationSpace<N> for Euclidean {
+    type Manifold = Vectors;
+
     const TRANSLATION: bool = true;
+
+    fn contains(&self, q: &SVector<f64, N>) -> bool {
+        q.iter().all(|x| x.is_finite())
+    }
 
     #[inline]
     fn retract<D: Scalar>(&self, q: &SVector<f64, N>, xi: &SVector<D, N>) -> SVector<D, N> {
@@ -270,6 +351,8 @@ impl<const N: usize> ConfigurationSpace<N> for Euclidean {
 pub struct Positive;
 
 impl<const N: usize> ConfigurationSpace<N> for Positive {
+    type Manifold = Vectors;
+
     fn contains(&self, q: &SVector<f64, N>) -> bool {
         q.iter().all(|x| *x > 0.0 && x.is_finite())
     }
@@ -293,6 +376,26 @@ impl<const N: usize> ConfigurationSpace<N> for Positive {
             .iter()
             .all(|r| *r > 0.0 && r.is_finite())
             .then(|| ratio.map(f64::ln))
+    }
+
+    fn chart_rate(
+        &self,
+        q: &SVector<f64, N>,
+        xi: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Option<SVector<f64, N>> {
+        chart_rate_by_tangent_map(self, q, xi, v)
+    }
+
+    fn advance_momentum(
+        &self,
+        q: &SVector<f64, N>,
+        xi: &SVector<f64, N>,
+        p: &mut SVector<f64, N>,
+        _carry: &mut SVector<f64, N>,
+        covectors: &StepCovectors<N>,
+    ) -> Option<()> {
+        momentum_by_tangent_map(self, q, xi, p, covectors)
     }
 }
 
@@ -331,6 +434,12 @@ mod tests {
     impl sealed::Sealed for Sheared {}
 
     impl ConfigurationSpace<2> for Sheared {
+        type Manifold = Vectors;
+
+        fn contains(&self, q: &SVector<f64, 2>) -> bool {
+            q.iter().all(|x| x.is_finite())
+        }
+
         fn retract<D: Scalar>(&self, q: &SVector<f64, 2>, xi: &SVector<D, 2>) -> SVector<D, 2> {
             let m = shear();
             SVector::from_fn(|i, _| xi[0] * m[(i, 0)] + xi[1] * m[(i, 1)] + q[i])
@@ -348,6 +457,26 @@ mod tests {
 
         fn local(&self, q: &SVector<f64, 2>, q1: &SVector<f64, 2>) -> Option<SVector<f64, 2>> {
             shear().try_inverse().map(|inverse| inverse * (q1 - q))
+        }
+
+        fn chart_rate(
+            &self,
+            q: &SVector<f64, 2>,
+            xi: &SVector<f64, 2>,
+            v: &SVector<f64, 2>,
+        ) -> Option<SVector<f64, 2>> {
+            chart_rate_by_tangent_map(self, q, xi, v)
+        }
+
+        fn advance_momentum(
+            &self,
+            q: &SVector<f64, 2>,
+            xi: &SVector<f64, 2>,
+            p: &mut SVector<f64, 2>,
+            _carry: &mut SVector<f64, 2>,
+            covectors: &StepCovectors<2>,
+        ) -> Option<()> {
+            momentum_by_tangent_map(self, q, xi, p, covectors)
         }
     }
 
@@ -379,7 +508,7 @@ mod tests {
         }
     }
 
-    fn run<C: ConfigurationSpace<2>, const FORMS: usize>(
+    fn run<C: ConfigurationSpace<2, Manifold = Vectors>, const FORMS: usize>(
         space: C,
         quadrature: Quadrature,
     ) -> (SVector<f64, 2>, SVector<f64, 2>) {

@@ -22,7 +22,8 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
-use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
+use crate::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors};
+use crate::manifold::Vectors;
 pub use crate::constraint_point::ConstraintPoint;
 use crate::derivatives::{gradient, lift};
 use crate::layout::Layout;
@@ -31,10 +32,14 @@ use crate::system::DiracSystem;
 
 /// One-form `a` read in the chart centred at `base`, at `xi`: the row `Ã_a(ξ)` and its
 /// derivative `∂Ã_a,i/∂ξ_j` (row `i`, column `j`).
-pub(crate) fn one_form_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
+pub(crate) fn one_form_in_chart<
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+    const N: usize,
+>(
     system: &S,
     space: &C,
-    base: &SVector<f64, N>,
+    base: &Point<C, N, f64>,
     xi: &SVector<f64, N>,
     a: usize,
 ) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
@@ -47,10 +52,14 @@ pub(crate) fn one_form_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, con
 
 /// Holonomic constraint `b` read in the chart centred at `base`, at `xi`: `g_b(R(ξ))` and its
 /// gradient in `ξ`.
-pub(crate) fn holonomic_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
+pub(crate) fn holonomic_in_chart<
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+    const N: usize,
+>(
     system: &S,
     space: &C,
-    base: &SVector<f64, N>,
+    base: &Point<C, N, f64>,
     xi: &SVector<f64, N>,
     b: usize,
 ) -> (f64, SVector<f64, N>) {
@@ -80,11 +89,11 @@ pub(crate) fn holonomic<S: DiracSystem<N>, const N: usize>(
 /// where the one-forms are evaluated, the start `q_k`, the layout of the unknowns, and the
 /// holonomic impulse directions `d(g_b∘R_{q_k})(0)` (constant over the step, see
 /// [`holonomic_forms`]).
-pub(crate) struct StepConstraints<'a, S, C, const N: usize> {
+pub(crate) struct StepConstraints<'a, S, C: ConfigurationSpace<N>, const N: usize> {
     pub system: &'a S,
     pub space: &'a C,
     pub point: ConstraintPoint,
-    pub base: &'a SVector<f64, N>,
+    pub base: &'a Point<C, N, f64>,
     pub layout: &'a Layout,
     pub holonomic_forms: &'a [SVector<f64, N>],
     /// The step's quadrature and size (one-forms of a Galerkin step hold at its nodes).
@@ -92,7 +101,60 @@ pub(crate) struct StepConstraints<'a, S, C, const N: usize> {
     pub h: f64,
 }
 
-impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraints<'_, S, C, N> {
+impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
+    StepConstraints<'_, S, C, N>
+{
+    /// The one-forms of a degree-1 step, held at its constraint point `ξ_c = θ ξ_s`: adds
+    /// `σ Ã(ξ_c)ᵀμ` to the rows of `p_k`'s equation, writes the rows `Ã(ξ_c) ξ_s`, fills the
+    /// matching Jacobian entries, and returns the impulse `Ã(ξ_c)ᵀμ` (its end point's share is
+    /// `1 − σ`) with the size of the rows' terms.
+    pub(crate) fn add_one_forms(
+        &self,
+        x: &DVector<f64>,
+        residual: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> (SVector<f64, N>, f64) {
+        let Self {
+            system,
+            space,
+            point,
+            base,
+            layout,
+            ..
+        } = *self;
+        let step_col = layout.end_point();
+        let step = x.fixed_rows::<N>(step_col).into_owned();
+        let (theta, share) = (point.theta(), point.share());
+        let mut impulse = SVector::<f64, N>::zeros();
+        let mut scale = 0.0_f64;
+        let xi_c = step * theta;
+        for a in 0..S::ONE_FORMS {
+            let (row, derivative) = one_form_in_chart(system, space, base, &xi_c, a);
+            let col = layout.one_form(a);
+            let mu = x[col];
+            impulse += row * mu;
+            for i in 0..N {
+                residual[i] += share * mu * row[i];
+                jacobian[(i, col)] += share * row[i];
+                for j in 0..N {
+                    jacobian[(i, step_col + j)] += share * theta * mu * derivative[(i, j)];
+                }
+            }
+            // Ã_a(ξ_c) · ξ_s and its derivative in ξ_s (ξ_c moves with ξ_s by θ).
+            residual[col] = row.dot(&step);
+            scale = scale.max(row.abs().dot(&step.abs()));
+            let through_point = derivative.transpose() * step * theta;
+            for j in 0..N {
+                jacobian[(col, step_col + j)] = row[j] + through_point[j];
+            }
+        }
+        (impulse, scale)
+    }
+}
+
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
+    StepConstraints<'_, S, C, N>
+{
     /// Adds the constraint forces to the rows of `p_k`'s equation, writes the constraint rows,
     /// fills the matching Jacobian entries, and returns the constraint impulses (total, and the
     /// share on the end point) with the size of the terms of the constraint rows.
@@ -113,35 +175,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraint
         } = *self;
         let step_col = layout.end_point();
         let step = x.fixed_rows::<N>(step_col).into_owned();
-        let (theta, share) = (point.theta(), point.share());
-        let mut impulse = SVector::<f64, N>::zeros();
-        let mut scale = 0.0_f64;
-        let xi_c = step * theta;
-        let one_forms = if layout.points() == 1 {
-            S::ONE_FORMS
+        let share = point.share();
+        let (mut impulse, mut scale) = if layout.points() == 1 {
+            self.add_one_forms(x, residual, jacobian)
         } else {
-            0
+            (SVector::zeros(), 0.0)
         };
-        for a in 0..one_forms {
-            let (row, derivative) = one_form_in_chart(system, space, base, &xi_c, a);
-            let col = layout.one_form(a);
-            let mu = x[col];
-            impulse += row * mu;
-            for i in 0..N {
-                residual[i] += share * mu * row[i];
-                jacobian[(i, col)] += share * row[i];
-                for j in 0..N {
-                    jacobian[(i, step_col + j)] += share * theta * mu * derivative[(i, j)];
-                }
-            }
-            // Ã_a(ξ_c) · ξ_s and its derivative in ξ_s (ξ_c moves with ξ_s by θ).
-            residual[col] = row.dot(&step);
-            scale = scale.max(row.abs().dot(&step.abs()));
-            let through_point = derivative.transpose() * step * theta;
-            for j in 0..N {
-                jacobian[(col, step_col + j)] = row[j] + through_point[j];
-            }
-        }
         let mut end = impulse * (1.0 - share);
         if layout.points() > 1 && S::ONE_FORMS > 0 {
             let (forces, size) = self.add_at_nodes(x, residual, jacobian);
@@ -278,10 +317,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepConstraint
 
 /// Fills `forms[b] = d(g_b∘R_q)(0)`: the directions of the holonomic constraint impulses of a
 /// step from `q`, in the chart at `q`.
-pub(crate) fn holonomic_forms<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
+pub(crate) fn holonomic_forms<
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+    const N: usize,
+>(
     system: &S,
     space: &C,
-    q: &SVector<f64, N>,
+    q: &Point<C, N, f64>,
     forms: &mut [SVector<f64, N>],
 ) {
     for (b, form) in forms.iter_mut().enumerate() {
@@ -291,13 +334,13 @@ pub(crate) fn holonomic_forms<S: DiracSystem<N>, C: ConfigurationSpace<N>, const
 
 /// The largest constraint violation of a step `ξ` from `q0` to `q1`: `|Ã(ξ_c) ξ|` over the
 /// one-forms (on `Rⁿ`, `|A(q_c)(q1 − q0)|`) and `|g(q1)|` over the holonomic constraints.
-pub(crate) fn violation<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
+pub(crate) fn violation<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>(
     system: &S,
     space: &C,
     point: ConstraintPoint,
-    q0: &SVector<f64, N>,
+    q0: &Point<C, N, f64>,
     xi: &SVector<f64, N>,
-    q1: &SVector<f64, N>,
+    q1: &Point<C, N, f64>,
 ) -> f64 {
     let xi_c = xi * point.theta();
     let forms = (0..S::ONE_FORMS).map(|a| {

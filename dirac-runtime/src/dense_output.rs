@@ -24,6 +24,8 @@
 
 use nalgebra::SVector;
 
+use crate::manifold::{Manifold, Vectors};
+
 /// The solution at one time: position, velocity and momentum.
 ///
 /// ```
@@ -44,15 +46,23 @@ use nalgebra::SVector;
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct Sample<const N: usize> {
+#[cfg_attr(
+    feature = "serde",
+    serde(bound(
+        serialize = "M::Point<f64>: serde::Serialize, M::Tangent<f64>: serde::Serialize",
+        deserialize = "M::Point<f64>: serde::Deserialize<'de>, \
+                       M::Tangent<f64>: serde::Deserialize<'de>"
+    ))
+)]
+pub struct Sample<const N: usize, M: Manifold<N> = Vectors> {
     /// Time.
     pub t: f64,
     /// Position.
-    pub q: SVector<f64, N>,
+    pub q: M::Point<f64>,
     /// Velocity.
-    pub v: SVector<f64, N>,
+    pub v: M::Tangent<f64>,
     /// Momentum.
-    pub p: SVector<f64, N>,
+    pub p: M::Tangent<f64>,
 }
 
 /// The correction at fraction `theta` of a step of size `h` whose path has degree `degree`, from

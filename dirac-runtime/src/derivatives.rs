@@ -10,7 +10,7 @@ use nalgebra::{Const, SMatrix, SVector, U1};
 use num_dual::{Derivative, DualSVec64, HyperDualSVec64, HyperHyperDual64};
 
 use crate::closed_form::{LagrangianGradient, LagrangianHessian};
-use crate::configuration_space::ConfigurationSpace;
+use crate::configuration_space::{ConfigurationSpace, Point};
 use crate::scalar::Scalar;
 use crate::system::DiracSystem;
 
@@ -63,13 +63,14 @@ impl<S: DiracSystem<N>, const N: usize> PhaseFunction<N> for S {
 }
 
 /// The model's Lagrangian read in the chart centred at `base`: `ℓ(ξ, ξ̇) = L(R(ξ), TR(ξ) ξ̇)`.
-pub(crate) struct InChart<'a, S, C, const N: usize> {
+/// On a translation chart (`Rⁿ`) its closed-form derivatives are the model's at `base + ξ`.
+pub(crate) struct InChart<'a, S, C: ConfigurationSpace<N>, const N: usize> {
     pub system: &'a S,
     pub space: &'a C,
-    pub base: &'a SVector<f64, N>,
+    pub base: &'a Point<C, N, f64>,
 }
 
-impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> PhaseFunction<N>
+impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> PhaseFunction<N>
     for InChart<'_, S, C, N>
 {
     #[inline]
@@ -77,6 +78,34 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> PhaseFunction<
         let q = self.space.retract(self.base, xi);
         let v = self.space.push_forward(self.base, xi, xi_dot);
         self.system.lagrangian(&q, &v)
+    }
+
+    #[inline]
+    fn closed_gradient(
+        &self,
+        xi: &SVector<f64, N>,
+        xi_dot: &SVector<f64, N>,
+    ) -> Option<LagrangianGradient<N>> {
+        if !C::TRANSLATION {
+            return None;
+        }
+        let q = self.space.retract(self.base, xi);
+        let v = self.space.push_forward(self.base, xi, xi_dot);
+        self.system.lagrangian_gradient(&q, &v)
+    }
+
+    #[inline]
+    fn closed_hessian(
+        &self,
+        xi: &SVector<f64, N>,
+        xi_dot: &SVector<f64, N>,
+    ) -> Option<LagrangianHessian<N>> {
+        if !C::TRANSLATION {
+            return None;
+        }
+        let q = self.space.retract(self.base, xi);
+        let v = self.space.push_forward(self.base, xi, xi_dot);
+        self.system.lagrangian_hessian(&q, &v)
     }
 }
 
@@ -183,20 +212,6 @@ pub(crate) fn hessian<F: PhaseFunction<N>, const N: usize>(
     }
 }
 
-/// [`hessian`] of `ℓ(ξ, ξ̇)`: for a translation chart, of `L` at `q_k + ξ`.
-#[inline]
-pub(crate) fn hessian_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
-    chart: &InChart<'_, S, C, N>,
-    xi: &SVector<f64, N>,
-    xi_dot: &SVector<f64, N>,
-) -> LagrangianHessian<N> {
-    if C::TRANSLATION {
-        hessian(chart.system, &(chart.base + xi), xi_dot)
-    } else {
-        hessian(chart, xi, xi_dot)
-    }
-}
-
 /// Evaluates `L(q, v)` over hyper-dual numbers seeded along `x` and `y`.
 pub(crate) fn seeded_by_duals<F: PhaseFunction<N>, const N: usize>(
     lagrangian: &F,
@@ -279,23 +294,6 @@ pub(crate) fn third_derivative<S: DiracSystem<N>, const N: usize>(
         .eps1eps2eps3
 }
 
-/// `ℓ(ξ, ξ̇)` seeded along `x` and `y`: for a translation chart, `L` at `q_k + ξ` seeded
-/// directly.
-#[inline]
-pub(crate) fn seeded_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
-    chart: &InChart<'_, S, C, N>,
-    xi: &SVector<f64, N>,
-    xi_dot: &SVector<f64, N>,
-    x: Seed,
-    y: Seed,
-) -> Seeded<N> {
-    if C::TRANSLATION {
-        seeded(chart.system, &(chart.base + xi), xi_dot, x, y)
-    } else {
-        seeded(chart, xi, xi_dot, x, y)
-    }
-}
-
 /// `(∂L/∂q, ∂L/∂v)` at `(q, v)`: two passes of first-order duals, no second derivatives.
 pub(crate) fn gradients<F: PhaseFunction<N>, const N: usize>(
     lagrangian: &F,
@@ -323,39 +321,6 @@ pub(crate) fn directional_gradient<F: PhaseFunction<N>, const N: usize>(
         return weighted(&g.q, seed.position) + weighted(&g.v, seed.velocity);
     }
     gradient(&lagrangian.value(&lift(q, seed.position), &lift(v, seed.velocity)))
-}
-
-/// [`directional_gradient`] of `ℓ(ξ, ξ̇)`: for a translation chart, of `L` at `q_k + ξ`.
-#[inline]
-pub(crate) fn directional_gradient_in_chart<
-    S: DiracSystem<N>,
-    C: ConfigurationSpace<N>,
-    const N: usize,
->(
-    chart: &InChart<'_, S, C, N>,
-    xi: &SVector<f64, N>,
-    xi_dot: &SVector<f64, N>,
-    seed: Seed,
-) -> SVector<f64, N> {
-    if C::TRANSLATION {
-        directional_gradient(chart.system, &(chart.base + xi), xi_dot, seed)
-    } else {
-        directional_gradient(chart, xi, xi_dot, seed)
-    }
-}
-
-/// [`gradients`] of `ℓ(ξ, ξ̇)`: for a translation chart, of `L` at `q_k + ξ` directly.
-#[inline]
-pub(crate) fn gradients_in_chart<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>(
-    chart: &InChart<'_, S, C, N>,
-    xi: &SVector<f64, N>,
-    xi_dot: &SVector<f64, N>,
-) -> (SVector<f64, N>, SVector<f64, N>) {
-    if C::TRANSLATION {
-        gradients(chart.system, &(chart.base + xi), xi_dot)
-    } else {
-        gradients(chart, xi, xi_dot)
-    }
 }
 
 /// First-order dual numbers with `N` directions.

@@ -16,11 +16,12 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::closed_form::LagrangianHessian;
-use crate::configuration_space::{ConfigurationSpace, Euclidean, StepCovectors};
+use crate::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors};
 use crate::derivatives::{
-    InChart, PhaseFunction, Seed, directional_gradient_in_chart, gradients_in_chart,
-    hessian_in_chart, seeded_in_chart, third_derivative,
+    InChart, PhaseFunction, Seed, directional_gradient, gradients, hessian, seeded,
+    third_derivative,
 };
+use crate::manifold::Vectors;
 use crate::error::DiracError;
 use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
@@ -58,7 +59,9 @@ impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
     }
 }
 
-impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagrangian<S, N, C> {
+impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
+    DiscreteLagrangian<S, N, C>
+{
     /// `L_d` for step `h`, with the step's points `R_{q_k}(ξ_j)` in `space`.
     pub fn on_space(system: S, space: C, quadrature: Quadrature, h: f64) -> Self {
         Self {
@@ -90,7 +93,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
     }
 
     /// The Lagrangian read in the chart centred at `base`.
-    pub(crate) fn in_chart<'a>(&'a self, base: &'a SVector<f64, N>) -> InChart<'a, S, C, N> {
+    pub(crate) fn in_chart<'a>(&'a self, base: &'a Point<C, N, f64>) -> InChart<'a, S, C, N> {
         InChart {
             system: &self.system,
             space: &self.space,
@@ -127,7 +130,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
 
     /// `L_d(Q_0, …, Q_s)`; `points` holds the `s + 1` points of the step (an error otherwise, or
     /// when a point lies outside the chart centred at `Q_0`).
-    pub fn value(&self, points: &[SVector<f64, N>]) -> Result<f64, DiracError> {
+    pub fn value(&self, points: &[Point<C, N, f64>]) -> Result<f64, DiracError> {
         if points.len() != self.quadrature.degree() + 1 {
             return Err(DiracError::Dimension(format!(
                 "L_d under {} takes {} points, got {}",
@@ -164,7 +167,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
     /// the slot covectors and the size of the terms summed into the residual.
     pub(crate) fn euler_lagrange(
         &self,
-        base: &SVector<f64, N>,
+        base: &Point<C, N, f64>,
         increments: &[SVector<f64, N>],
         momentum: &SVector<f64, N>,
         residual: &mut DVector<f64>,
@@ -187,7 +190,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
             let d = |j: usize| quad.ell_prime(i, j) / h;
             // A gradient in closed form brings every slot at the cost of the residual's alone.
             let closed = match jacobian {
-                None if C::TRANSLATION => self.system.lagrangian_gradient(&(base + xi), &xi_dot),
+                None => chart.closed_gradient(&xi, &xi_dot),
                 _ => None,
             };
             let (lq, lv) = match jacobian.as_deref_mut() {
@@ -203,16 +206,16 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
                         position: a(0),
                         velocity: d(0),
                     };
-                    let first = directional_gradient_in_chart(&chart, &xi, &xi_dot, seed);
+                    let first = directional_gradient(&chart, &xi, &xi_dot, seed);
                     let mut r = residual.rows_mut(0, N);
                     r += first * w;
                     magnitude += first.abs() * w;
                     continue;
                 }
-                None => gradients_in_chart(&chart, &xi, &xi_dot),
+                None => gradients(&chart, &xi, &xi_dot),
                 jacobian if s == 1 => {
                     // One pair of slots: seed the directions of ξ_0 and ξ_1 themselves.
-                    let l = seeded_in_chart(
+                    let l = seeded(
                         &chart,
                         &xi,
                         &xi_dot,
@@ -238,7 +241,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
                 }
                 Some(jacobian) => {
                     // Many pairs: the Hessian of ℓ at the node, then the chain rule.
-                    let l = hessian_in_chart(&chart, &xi, &xi_dot);
+                    let l = hessian(&chart, &xi, &xi_dot);
                     for j in 0..s {
                         for k in 1..=s {
                             let mut block = jacobian.fixed_view_mut::<N, N>(j * N, (k - 1) * N);
@@ -276,7 +279,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
     /// `Σ_j ∂L_d/∂ξ_j` and `∂L_d/∂ξ_s` (first derivatives only).
     pub(crate) fn slot_covectors(
         &self,
-        base: &SVector<f64, N>,
+        base: &Point<C, N, f64>,
         increments: &[SVector<f64, N>],
     ) -> StepCovectors<N> {
         let (quad, h, s) = (&self.quadrature, self.h, self.quadrature.degree());
@@ -287,7 +290,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         };
         for (i, &b) in quad.weights().iter().enumerate() {
             let (xi, xi_dot) = self.node(i, increments);
-            let (lq, lv) = gradients_in_chart(&chart, &xi, &xi_dot);
+            let (lq, lv) = gradients(&chart, &xi, &xi_dot);
             covectors.impulse += lq * (h * b);
             covectors.end += (lq * quad.ell(i, s) + lv * (quad.ell_prime(i, s) / h)) * (h * b);
         }
@@ -295,7 +298,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
     }
 }
 
-impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagrangian<S, N, C> {
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
+    DiscreteLagrangian<S, N, C>
+{
     /// `D³L_d` along three displacements of the step's points (`d[k][m]` moves point `m`,
     /// `m = 0..=s`), on a translation chart: `h Σ_i b_i D³L(q_i, v_i)` along the node
     /// displacements `(Σ_m ℓ_m(c_i) d_m, Σ_m ℓ'_m(c_i) d_m / h)`.
@@ -329,7 +334,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         for (i, &b) in quad.weights().iter().enumerate() {
             let w = h * b;
             let (xi, xi_dot) = self.node(i, increments);
-            let LagrangianHessian { qq, qv, vv, .. } = hessian_in_chart(&chart, &xi, &xi_dot);
+            let LagrangianHessian { qq, qv, vv, .. } = hessian(&chart, &xi, &xi_dot);
             let a = |j: usize| quad.ell(i, j);
             let d = |j: usize| quad.ell_prime(i, j) / h;
             for (j, row) in blocks.iter_mut().enumerate() {
@@ -364,7 +369,7 @@ mod tests {
 
     /// `L_d` as a function of all `s + 1` chart points `ξ_0, …, ξ_s` in the chart fixed at `base`
     /// (`ξ_0` free too), summed from the quadrature's basis independently of `node`.
-    fn in_fixed_chart<C: ConfigurationSpace<2>>(
+    fn in_fixed_chart<C: ConfigurationSpace<2, Manifold = Vectors>>(
         ld: &DiscreteLagrangian<Coupled, 2, C>,
         base: &SVector<f64, 2>,
         xis: &[SVector<f64, 2>],
@@ -401,7 +406,7 @@ mod tests {
 
     /// The residual, slot covectors and Jacobian of `euler_lagrange` against central
     /// differences of `L_d` in the chart at `base`, and `value` against the chart sum.
-    fn check<C: ConfigurationSpace<2>>(space: C, quadrature: Quadrature) {
+    fn check<C: ConfigurationSpace<2, Manifold = Vectors>>(space: C, quadrature: Quadrature) {
         let s = quadrature.degree();
         let name = quadrature.name();
         let ld = DiscreteLagrangian::on_space(Coupled, space, quadrature, 0.1);

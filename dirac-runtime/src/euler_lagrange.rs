@@ -31,6 +31,7 @@ use crate::holonomic_scheme::HolonomicScheme;
 use crate::initial_state;
 use crate::layout::Layout;
 use crate::legendre;
+use crate::manifold::Vectors;
 use crate::newton::{Newton, NewtonFailure};
 use crate::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step_equations::{State, StepEquations};
@@ -92,7 +93,9 @@ pub struct EulerLagrange<S, const N: usize, C> {
     scratch: DMatrix<f64>,
 }
 
-impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<S, N, C> {
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
+    EulerLagrange<S, N, C>
+{
     /// The equations of `discrete`, with the constraint one-forms evaluated at the system's
     /// [`constraint_point`](DiracSystem::constraint_point) and every input at 0. Fails on a
     /// non-positive or non-finite step, a non-finite parameter, constraint one-forms with a
@@ -263,11 +266,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         })
     }
 
-    /// Current input values.
-    pub fn inputs(&self) -> &[f64] {
-        &self.inputs
-    }
-
     /// Sets every input, in the order of the system's inputs; fails on the wrong number of
     /// values or a value that is not finite, and then changes nothing.
     pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
@@ -288,10 +286,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
         Ok(())
     }
 
-    /// Input values, in the order of the system's inputs (checked by the stepper).
-    pub(crate) fn inputs_mut(&mut self) -> &mut [f64] {
-        &mut self.inputs
-    }
 
     fn constrained() -> bool {
         S::ONE_FORMS + S::HOLONOMIC > 0
@@ -666,7 +660,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     }
 }
 
-impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<S, N, C> {
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
+    EulerLagrange<S, N, C>
+{
     /// The collocated rows of the coordinates linear in their velocities (see
     /// [`first_order`]), with their Jacobian.
     fn collocate(
@@ -773,10 +769,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> EulerLagrange<
     }
 }
 
-impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<N>
-    for EulerLagrange<S, N, C>
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
+    StepEquations<N> for EulerLagrange<S, N, C>
 {
     type System = S;
+    type Manifold = Vectors;
 
     fn system(&self) -> &S {
         self.discrete.system()
@@ -1225,6 +1222,43 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> StepEquations<
 
     fn energy(&self, q: &SVector<f64, N>, _p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64 {
         legendre::energy(self.discrete.system(), q, v)
+    }
+
+    fn momentum(
+        &self,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, DiracError> {
+        let system = self.discrete.system();
+        check_finite(system, "initial position", q)?;
+        check_finite(system, "initial velocity", v)?;
+        let p = legendre::momentum(system, q, v);
+        check_finite(system, "initial momentum", &p)?;
+        Ok(p)
+    }
+
+    fn check_finite(
+        &self,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+    ) -> Result<(), DiracError> {
+        let system = self.discrete.system();
+        check_finite(system, "initial position", q)?;
+        check_finite(system, "initial momentum", p)?;
+        check_finite(system, "velocity guess", guess)
+    }
+
+    fn inputs(&self) -> &[f64] {
+        &self.inputs
+    }
+
+    fn inputs_mut(&mut self) -> &mut [f64] {
+        &mut self.inputs
+    }
+
+    fn input_name(&self, i: usize) -> String {
+        self.discrete.system().input_name(i)
     }
 
     /// By the implicit function theorem on the step's rows `R(x; q_k, p_k, u) = 0` with

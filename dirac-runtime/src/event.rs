@@ -7,10 +7,9 @@
 //! dense output, not the step. Two crossings inside one step cancel and are not seen; a step
 //! shorter than the time between crossings sees every one.
 
-use nalgebra::SVector;
-
 use crate::dense_output::Sample;
 use crate::error::DiracError;
+use crate::manifold::{Manifold, Vectors};
 
 /// Which sign changes of an event function count.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -26,8 +25,9 @@ pub enum Direction {
 }
 
 /// The user function of an event.
-type EventFunction<'a, const N: usize> =
-    Box<dyn FnMut(f64, &SVector<f64, N>, &SVector<f64, N>) -> f64 + 'a>;
+type EventFunction<'a, const N: usize, M> = Box<
+    dyn FnMut(f64, &<M as Manifold<N>>::Point<f64>, &<M as Manifold<N>>::Tangent<f64>) -> f64 + 'a,
+>;
 
 /// An event of a [`Run`](crate::Run): a function `g(t, q, v)` whose sign changes are located
 /// inside the steps, optionally ending the run at the first one.
@@ -54,14 +54,14 @@ type EventFunction<'a, const N: usize> =
 /// assert!((solution.events[0].sample.t - exact).abs() < 1e-12);
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
-pub struct Event<'a, const N: usize> {
+pub struct Event<'a, const N: usize, M: Manifold<N> = Vectors> {
     name: String,
-    function: EventFunction<'a, N>,
+    function: EventFunction<'a, N, M>,
     direction: Direction,
     terminal: bool,
 }
 
-impl<const N: usize> std::fmt::Debug for Event<'_, N> {
+impl<const N: usize, M: Manifold<N>> std::fmt::Debug for Event<'_, N, M> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Event")
             .field("name", &self.name)
@@ -71,12 +71,12 @@ impl<const N: usize> std::fmt::Debug for Event<'_, N> {
     }
 }
 
-impl<'a, const N: usize> Event<'a, N> {
+impl<'a, const N: usize, M: Manifold<N>> Event<'a, N, M> {
     /// The event called `name` whose function is `g(t, q, v)`; every sign change counts and the
     /// run goes on after it.
     pub fn new(
         name: impl Into<String>,
-        function: impl FnMut(f64, &SVector<f64, N>, &SVector<f64, N>) -> f64 + 'a,
+        function: impl FnMut(f64, &M::Point<f64>, &M::Tangent<f64>) -> f64 + 'a,
     ) -> Self {
         Self {
             name: name.into(),
@@ -121,7 +121,7 @@ impl<'a, const N: usize> Event<'a, N> {
     }
 
     /// `g` at `sample`; an error when it is not finite.
-    pub(crate) fn value(&mut self, sample: &Sample<N>) -> Result<f64, DiracError> {
+    pub(crate) fn value(&mut self, sample: &Sample<N, M>) -> Result<f64, DiracError> {
         let g = (self.function)(sample.t, &sample.q, &sample.v);
         if g.is_finite() {
             Ok(g)
@@ -148,7 +148,15 @@ impl<'a, const N: usize> Event<'a, N> {
 /// A located sign change of an event.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct Crossing<const N: usize> {
+#[cfg_attr(
+    feature = "serde",
+    serde(bound(
+        serialize = "M::Point<f64>: serde::Serialize, M::Tangent<f64>: serde::Serialize",
+        deserialize = "M::Point<f64>: serde::Deserialize<'de>, \
+                       M::Tangent<f64>: serde::Deserialize<'de>"
+    ))
+)]
+pub struct Crossing<const N: usize, M: Manifold<N> = Vectors> {
     /// Index of the event in the run (in the order the events were added).
     pub event: usize,
     /// The event's name.
@@ -156,7 +164,7 @@ pub struct Crossing<const N: usize> {
     /// Which way `g` changed sign.
     pub direction: Direction,
     /// The solution at the crossing (dense output).
-    pub sample: Sample<N>,
+    pub sample: Sample<N, M>,
 }
 
 /// The root in `[0, 1]` of `g`, with `g(0) = g0` and `g(1) = g1` of opposite signs (or `g1 = 0`),
@@ -204,6 +212,7 @@ pub(crate) fn locate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::SVector;
 
     #[test]
     fn locates_a_root_to_round_off() {
@@ -218,14 +227,14 @@ mod tests {
     #[test]
     fn directions_count_only_their_sign_changes() {
         let g = |_t: f64, q: &SVector<f64, 1>, _v: &SVector<f64, 1>| q[0];
-        let either = Event::new("x", g);
+        let either = Event::<1>::new("x", g);
         assert_eq!(either.crossing(-1.0, 1.0), Some(Direction::Rising));
         assert_eq!(either.crossing(1.0, 0.0), Some(Direction::Falling));
         assert_eq!(either.crossing(0.0, 1.0), None);
-        let rising = Event::new("x", g).rising();
+        let rising = Event::<1>::new("x", g).rising();
         assert_eq!(rising.crossing(1.0, -1.0), None);
         assert_eq!(rising.crossing(-1.0, 0.0), Some(Direction::Rising));
-        let falling = Event::new("x", g).falling();
+        let falling = Event::<1>::new("x", g).falling();
         assert_eq!(falling.crossing(-1.0, 1.0), None);
     }
 }

@@ -5,20 +5,23 @@
 
 use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
 
-use crate::configuration_space::{ConfigurationSpace, StepCovectors};
+use crate::configuration_space::{ConfigurationSpace, Point, StepCovectors};
+use crate::manifold::Vectors;
 use num_dual::{Dual64, HyperDual64};
 
 use crate::derivatives::{Dual, lift};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::system::DiracSystem;
 
-impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagrangian<S, N, C> {
+impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
+    DiscreteLagrangian<S, N, C>
+{
     /// Adds `f_j` to the residual rows of points `j = 0..s−1` and their derivatives in the
     /// unknowns `ξ_1..ξ_s` to the Jacobian; returns the forces' slot covectors (total and on the
     /// end point) and the size of their terms. `t` is the time at the start of the step.
     pub(crate) fn add_forces(
         &self,
-        base: &SVector<f64, N>,
+        base: &Point<C, N, f64>,
         increments: &[SVector<f64, N>],
         t: f64,
         inputs: &[Dual<N>],
@@ -63,7 +66,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize> DiscreteLagran
         }
         (StepCovectors { impulse, end }, scale)
     }
+}
 
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
+    DiscreteLagrangian<S, N, C>
+{
     /// The forces' slot derivatives `∂f_j/∂ξ_m` (`j, m = 0..=s`, `ξ_0 = 0`) as blocks `[j][m]`:
     /// `h Σ_i b_i ℓ_j(c_i) (∂_q F ℓ_m(c_i) + ∂_v F ℓ'_m(c_i)/h)` at the nodes, on a translation
     /// chart (`Rⁿ`).

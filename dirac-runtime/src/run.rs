@@ -11,6 +11,7 @@ use std::ops::ControlFlow;
 use crate::dense_output::Sample;
 use crate::error::DiracError;
 use crate::event::{Crossing, Event};
+use crate::manifold::{Manifold, Vectors};
 use crate::newton::NewtonReport;
 use crate::step_equations::State;
 use crate::trajectory::Trajectory;
@@ -23,7 +24,7 @@ enum Horizon {
 }
 
 /// The watcher of a run.
-type Observer<'a, const N: usize> = Box<dyn FnMut(&Progress<'_, N>) -> ControlFlow<()> + 'a>;
+type Observer<'a, const N: usize, M> = Box<dyn FnMut(&Progress<'_, N, M>) -> ControlFlow<()> + 'a>;
 
 /// A run: its horizon, the samples to save, the events to locate and an observer called after
 /// every step. Built by chaining, handed to [`Stepper::solve`](crate::Stepper::solve).
@@ -51,15 +52,15 @@ type Observer<'a, const N: usize> = Box<dyn FnMut(&Progress<'_, N>) -> ControlFl
 /// assert!((solution.trajectory.q()[2][0] - 1.5_f64.cos()).abs() < 1e-5);
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
-pub struct Run<'a, const N: usize> {
+pub struct Run<'a, const N: usize, M: Manifold<N> = Vectors> {
     horizon: Horizon,
     saveat: Option<Vec<f64>>,
     every: usize,
-    pub(crate) events: Vec<Event<'a, N>>,
-    pub(crate) observer: Option<Observer<'a, N>>,
+    pub(crate) events: Vec<Event<'a, N, M>>,
+    pub(crate) observer: Option<Observer<'a, N, M>>,
 }
 
-impl<const N: usize> std::fmt::Debug for Run<'_, N> {
+impl<const N: usize, M: Manifold<N>> std::fmt::Debug for Run<'_, N, M> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Run")
             .field("horizon", &self.horizon)
@@ -71,7 +72,7 @@ impl<const N: usize> std::fmt::Debug for Run<'_, N> {
     }
 }
 
-impl<'a, const N: usize> Run<'a, N> {
+impl<'a, const N: usize, M: Manifold<N>> Run<'a, N, M> {
     /// A run to time `t_end`: the fewest whole steps that reach it.
     pub fn until(t_end: f64) -> Self {
         Self::new(Horizon::Until(t_end))
@@ -110,13 +111,16 @@ impl<'a, const N: usize> Run<'a, N> {
     }
 
     /// Locates the sign changes of `event` (events are numbered in the order they are added).
-    pub fn event(mut self, event: Event<'a, N>) -> Self {
+    pub fn event(mut self, event: Event<'a, N, M>) -> Self {
         self.events.push(event);
         self
     }
 
     /// Calls `observer` after every step; [`ControlFlow::Break`] ends the run there.
-    pub fn observe(self, observer: impl FnMut(&Progress<'_, N>) -> ControlFlow<()> + 'a) -> Self {
+    pub fn observe(
+        self,
+        observer: impl FnMut(&Progress<'_, N, M>) -> ControlFlow<()> + 'a,
+    ) -> Self {
         Self {
             observer: Some(Box::new(observer)),
             ..self
@@ -184,13 +188,13 @@ impl<'a, const N: usize> Run<'a, N> {
 
 /// What the observer of a run sees after each step.
 #[derive(Debug, Clone, Copy)]
-pub struct Progress<'s, const N: usize> {
+pub struct Progress<'s, const N: usize, M: Manifold<N> = Vectors> {
     /// Steps taken in this run.
     pub steps: u64,
     /// Steps the run will take if nothing stops it.
     pub total: u64,
     /// The state reached.
-    pub state: &'s State<N>,
+    pub state: &'s State<N, M>,
     /// How Newton's method went on the step.
     pub newton: NewtonReport,
 }
@@ -208,16 +212,20 @@ pub enum Status {
 
 /// What a run returns: the saved trajectory, the located events and how it ended.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Solution<const N: usize> {
+pub struct Solution<const N: usize, M: Manifold<N> = Vectors> {
     /// The saved samples.
-    pub trajectory: Trajectory<N>,
+    pub trajectory: Trajectory<N, M>,
     /// The located event crossings, in time order.
-    pub events: Vec<Crossing<N>>,
+    pub events: Vec<Crossing<N, M>>,
     /// How the run ended.
     pub status: Status,
 }
 
 /// The sample at time `t` of the step from `before`'s time over `h`: the fraction of the step.
-pub(crate) fn fraction<const N: usize>(before: &Sample<N>, t: f64, h: f64) -> f64 {
+pub(crate) fn fraction<const N: usize, M: Manifold<N>>(
+    before: &Sample<N, M>,
+    t: f64,
+    h: f64,
+) -> f64 {
     ((t - before.t) / h).clamp(0.0, 1.0)
 }

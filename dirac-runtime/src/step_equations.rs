@@ -12,8 +12,17 @@ use nalgebra::{DMatrix, DVector, SVector};
 
 use crate::dense_output::Sample;
 use crate::error::DiracError;
+use crate::manifold::{Manifold, Vectors};
 use crate::newton::{Newton, NewtonFailure};
 use crate::step_derivatives::StepDerivatives;
+
+/// The point type of the step equations `E` (on `Rⁿ`, `SVector<f64, N>`).
+pub type Point<E, const N: usize> =
+    <<E as StepEquations<N>>::Manifold as Manifold<N>>::Point<f64>;
+
+/// The tangent vector (and covector) type of the step equations `E`.
+pub type Tangent<E, const N: usize> =
+    <<E as StepEquations<N>>::Manifold as Manifold<N>>::Tangent<f64>;
 
 /// The state a stepper advances: time, position and momentum, with a velocity near the one at
 /// `(q, p)` and the round-off its compensated updates carry.
@@ -35,22 +44,22 @@ use crate::step_derivatives::StepDerivatives;
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct State<const N: usize> {
+pub struct State<const N: usize, M: Manifold<N> = Vectors> {
     pub(crate) t: f64,
-    pub(crate) q: SVector<f64, N>,
-    pub(crate) p: SVector<f64, N>,
+    pub(crate) q: M::Point<f64>,
+    pub(crate) p: M::Tangent<f64>,
     /// A velocity near the one at `(q, p)`: the initial velocity, then the last step's velocity
     /// at its end. It seeds the first predictor and the Legendre inversion.
-    pub(crate) velocity: SVector<f64, N>,
+    pub(crate) velocity: M::Tangent<f64>,
     /// Round-off left out of `q` and `p` by compensated updates.
     pub(crate) q_carry: SVector<f64, N>,
     pub(crate) p_carry: SVector<f64, N>,
 }
 
-impl<const N: usize> State<N> {
+impl<const N: usize, M: Manifold<N>> State<N, M> {
     /// The state at time `t`, position `q`, momentum `p`, with `velocity` a velocity near the
     /// one at `(q, p)` (exact or approximate: it seeds solves, it is never trusted).
-    pub fn new(t: f64, q: SVector<f64, N>, p: SVector<f64, N>, velocity: SVector<f64, N>) -> Self {
+    pub fn new(t: f64, q: M::Point<f64>, p: M::Tangent<f64>, velocity: M::Tangent<f64>) -> Self {
         Self {
             t,
             q,
@@ -67,18 +76,18 @@ impl<const N: usize> State<N> {
     }
 
     /// Position.
-    pub fn q(&self) -> &SVector<f64, N> {
+    pub fn q(&self) -> &M::Point<f64> {
         &self.q
     }
 
     /// Momentum.
-    pub fn p(&self) -> &SVector<f64, N> {
+    pub fn p(&self) -> &M::Tangent<f64> {
         &self.p
     }
 
     /// A velocity near the one at `(q, p)` (the last step's velocity at its end), the seed of
     /// the exact velocity [`Stepper::v`](crate::Stepper::v) solves for.
-    pub fn velocity_hint(&self) -> &SVector<f64, N> {
+    pub fn velocity_hint(&self) -> &M::Tangent<f64> {
         &self.velocity
     }
 }
@@ -96,6 +105,9 @@ impl<const N: usize> State<N> {
 pub trait StepEquations<const N: usize> {
     /// The model the equations discretise.
     type System;
+
+    /// The points and tangent vectors of the model's configuration.
+    type Manifold: Manifold<N>;
 
     /// The model.
     fn system(&self) -> &Self::System;
@@ -129,12 +141,12 @@ pub trait StepEquations<const N: usize> {
     /// Checks that `state` is a valid initial state (finite, in the model's domain, consistent
     /// with its constraints to the relative `tolerance`, which the stepper scales to its solver
     /// tolerance): the error says what is violated.
-    fn check_start(&self, state: &State<N>, tolerance: f64) -> Result<(), DiracError>;
+    fn check_start(&self, state: &State<N, Self::Manifold>, tolerance: f64) -> Result<(), DiracError>;
 
     /// Called once a checked `state` becomes the start of a run, before its first step: what the
     /// equations find out about the model there (e.g. which coordinates carry no kinetic
     /// energy) they keep for the run.
-    fn begin(&mut self, state: &State<N>) {
+    fn begin(&mut self, state: &State<N, Self::Manifold>) {
         let _ = state;
     }
 
@@ -142,7 +154,7 @@ pub trait StepEquations<const N: usize> {
     /// stepper's prediction from the accepted steps, when there is one: the last solution, or
     /// the last two or three extrapolated (the line `2 x_k − x_{k−1}`, the parabola
     /// `3 x_k − 3 x_{k−1} + x_{k−2}`; not across a start or a change of inputs).
-    fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>);
+    fn predict(&mut self, state: &State<N, Self::Manifold>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>);
 
     /// Writes the residual `F(x)` and, when one is asked for, adds its Jacobian into
     /// `jacobian` (zeroed by the caller; Newton asks only when a Jacobian is due, see
@@ -151,7 +163,7 @@ pub trait StepEquations<const N: usize> {
     /// whether the Jacobian was asked for.
     fn assemble(
         &mut self,
-        state: &State<N>,
+        state: &State<N, Self::Manifold>,
         x: &DVector<f64>,
         residual: &mut DVector<f64>,
         jacobian: Option<&mut DMatrix<f64>>,
@@ -169,10 +181,10 @@ pub trait StepEquations<const N: usize> {
     /// for error messages.
     fn advance(
         &self,
-        state: &State<N>,
+        state: &State<N, Self::Manifold>,
         x: &DVector<f64>,
         step: u64,
-    ) -> Result<(State<N>, f64), DiracError>;
+    ) -> Result<(State<N, Self::Manifold>, f64), DiracError>;
 
     /// Where in `x` the multipliers are: they are `x[first..first + multipliers()]`.
     fn first_multiplier(&self) -> usize;
@@ -194,10 +206,10 @@ pub trait StepEquations<const N: usize> {
         &self,
         newton: &mut Newton,
         t: f64,
-        q: &SVector<f64, N>,
-        p: &SVector<f64, N>,
-        guess: &SVector<f64, N>,
-    ) -> Result<SVector<f64, N>, NewtonFailure> {
+        q: &Point<Self, N>,
+        p: &Tangent<Self, N>,
+        guess: &Tangent<Self, N>,
+    ) -> Result<Tangent<Self, N>, NewtonFailure> {
         self.velocity(newton, t, q, p, guess)
     }
 
@@ -207,22 +219,71 @@ pub trait StepEquations<const N: usize> {
         &self,
         newton: &mut Newton,
         t: f64,
-        q: &SVector<f64, N>,
-        p: &SVector<f64, N>,
-        guess: &SVector<f64, N>,
-    ) -> Result<SVector<f64, N>, NewtonFailure>;
+        q: &Point<Self, N>,
+        p: &Tangent<Self, N>,
+        guess: &Tangent<Self, N>,
+    ) -> Result<Tangent<Self, N>, NewtonFailure>;
+
+    /// The momentum `∂L/∂v` at position `q` with velocity `v`, for a start from a velocity; an
+    /// error names the first of the position, the velocity and the momentum that is not finite.
+    fn momentum(
+        &self,
+        q: &Point<Self, N>,
+        v: &Tangent<Self, N>,
+    ) -> Result<Tangent<Self, N>, DiracError>;
+
+    /// Fails naming the first of the position `q`, the momentum `p` and the velocity guess that
+    /// is not finite (a start from a momentum).
+    fn check_finite(
+        &self,
+        q: &Point<Self, N>,
+        p: &Tangent<Self, N>,
+        guess: &Tangent<Self, N>,
+    ) -> Result<(), DiracError> {
+        let point = <Self::Manifold as Manifold<N>>::point_components(q);
+        let tangent = <Self::Manifold as Manifold<N>>::tangent_components;
+        [
+            ("initial position", point),
+            ("initial momentum", tangent(p)),
+            ("velocity guess", tangent(guess)),
+        ]
+        .into_iter()
+        .find_map(|(what, values)| {
+            let value = values.into_iter().find(|x| !x.is_finite())?;
+            Some(DiracError::NonFinite {
+                what: what.into(),
+                value,
+            })
+        })
+        .map_or(Ok(()), Err)
+    }
+
+    /// Current values of the model's inputs (none by default).
+    fn inputs(&self) -> &[f64] {
+        &[]
+    }
+
+    /// The inputs' values, to be set (in range and finite: the stepper checks them).
+    fn inputs_mut(&mut self) -> &mut [f64] {
+        &mut []
+    }
+
+    /// The name of input `i`.
+    fn input_name(&self, i: usize) -> String {
+        format!("u{i}")
+    }
 
     /// Dense output: the solution at fraction `theta ∈ [0, 1]` of the step between `ends` (the
     /// state it started from and the one it reached, with their exact velocities) solved by `x`
     /// (see [`dense_output`](crate::dense_output)). `None` where the equations have no path to
     /// interpolate (the default): the stepper then refuses dense output with `Unsupported`.
-    fn dense(&self, ends: [&Sample<N>; 2], x: &DVector<f64>, theta: f64) -> Option<Sample<N>> {
+    fn dense(&self, ends: [&Sample<N, Self::Manifold>; 2], x: &DVector<f64>, theta: f64) -> Option<Sample<N, Self::Manifold>> {
         let _ = (ends, x, theta);
         None
     }
 
     /// The energy at position `q` with velocity `v` and momentum `p`.
-    fn energy(&self, q: &SVector<f64, N>, p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64;
+    fn energy(&self, q: &Point<Self, N>, p: &Tangent<Self, N>, v: &Tangent<Self, N>) -> f64;
 
     /// The derivatives of the step from `state` solved by `x` (the point assembled last) with
     /// respect to `(q_k, p_k)` and the inputs `u`; `newton` must hold the Jacobian factorised at
@@ -230,7 +291,7 @@ pub trait StepEquations<const N: usize> {
     /// default refuses: equations that can differentiate their step override it.
     fn linearise(
         &self,
-        state: &State<N>,
+        state: &State<N, Self::Manifold>,
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<StepDerivatives<N>, DiracError> {

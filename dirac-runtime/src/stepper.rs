@@ -29,7 +29,8 @@ use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 use crate::predictor::Predictor;
 use crate::quadrature::Quadrature;
 use crate::step_derivatives::{StepDerivatives, StepHessians};
-use crate::step_equations::{State, StepEquations};
+use crate::manifold::{Manifold, Vectors};
+use crate::step_equations::{Point, State, StepEquations, Tangent};
 use crate::system::DiracSystem;
 use crate::trajectory::{Metadata, Trajectory};
 
@@ -48,8 +49,8 @@ enum Problem {
 
 /// A solved step, not yet current: the new state, how Newton went, the constraint violation.
 #[derive(Debug, Clone, Copy)]
-struct Proposal<const N: usize> {
-    next: State<N>,
+struct Proposal<const N: usize, M: Manifold<N>> {
+    next: State<N, M>,
     report: NewtonReport,
     violation: f64,
 }
@@ -83,21 +84,21 @@ struct Proposal<const N: usize> {
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
 #[derive(Debug, Clone)]
-pub struct Stepper<S, const N: usize, E = EulerLagrange<S, N, Euclidean>> {
+pub struct Stepper<S, const N: usize, E: StepEquations<N> = EulerLagrange<S, N, Euclidean>> {
     equations: E,
     newton: Newton,
     /// The workspaces of the velocity solves of recorded samples (reused: no allocation per
     /// sample).
     velocity: VelocitySolver,
-    state: Option<State<N>>,
+    state: Option<State<N, E::Manifold>>,
     /// The state the last step started from (none before the first step of a run).
-    before: Option<State<N>>,
+    before: Option<State<N, E::Manifold>>,
     /// The time the next start from a position, velocity or momentum begins at.
     initial_time: f64,
     /// Time of the initial state.
     start: f64,
     /// The initial state, which the equations examined when the run began.
-    origin: Option<State<N>>,
+    origin: Option<State<N, E::Manifold>>,
     steps: u64,
     /// Newton unknowns (the iterate), laid out by the equations.
     unknowns: DVector<f64>,
@@ -158,7 +159,7 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     }
 }
 
-impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
     Stepper<S, N, EulerLagrange<S, N, C>>
 {
     /// A stepper for `system` whose steps work in the charts of `space` (see
@@ -217,37 +218,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         self
     }
 
-    /// Starts from position `q0` and velocity `v0` at the [start time](Self::with_start_time), with `p0 = ∂L/∂v(q0, v0)`.
-    /// Fails if `(q0, v0)` violates a constraint, including the hidden constraints of
-    /// coordinates without kinetic energy.
-    ///
-    /// ```
-    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
-    /// # use nalgebra::{SVector, vector};
-    /// # struct Oscillator;
-    /// # impl DiracSystem<1> for Oscillator {
-    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
-    /// #     }
-    /// # }
-    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
-    /// stepper.start_from_velocity(vector![1.0], vector![0.5])?;
-    /// assert_eq!((stepper.t(), stepper.p()[0]), (0.0, 0.5));
-    /// assert!(stepper.start_from_velocity(vector![f64::NAN], vector![0.0]).is_err());
-    /// # Ok::<(), dirac_runtime::DiracError>(())
-    /// ```
-    pub fn start_from_velocity(
-        &mut self,
-        q0: SVector<f64, N>,
-        v0: SVector<f64, N>,
-    ) -> Result<(), DiracError> {
-        check_finite(self.system(), "initial position", &q0)?;
-        check_finite(self.system(), "initial velocity", &v0)?;
-        let p0 = legendre::momentum(self.system(), &q0, &v0);
-        check_finite(self.system(), "initial momentum", &p0)?;
-        self.start_from_state(State::new(self.initial_time, q0, p0, v0))
-    }
-
     /// Starts a Lagrangian linear in the velocities, `L = ϑ(q)·v − H(q)`, from its position
     /// alone at the [start time](Self::with_start_time): its momentum is `ϑ(q0)` and its velocity solves its first-order
     /// equations `(ϑ'ᵀ − ϑ') v = ∇H`. Fails for a model with kinetic energy (whose state needs a
@@ -284,64 +254,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
         let v0 = self.velocity_at(t0, &q0, &theta, &zero, false)?;
         let p0 = legendre::momentum(self.system(), &q0, &v0);
         check_finite(self.system(), "initial momentum", &p0)?;
-        self.start_from_state(State::new(t0, q0, p0, v0))
-    }
-
-    /// Starts from position `q0` and momentum `p0` at the [start time](Self::with_start_time). The velocity is found by a
-    /// globalised Newton solve of `∂L/∂v(q0, v) = p0` from `v = 0`; when that fails (several
-    /// velocities share the momentum, or `v = 0` is far from the answer), use
-    /// [`start_from_momentum_near`](Self::start_from_momentum_near).
-    ///
-    /// ```
-    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
-    /// # use nalgebra::{SVector, vector};
-    /// # struct Oscillator;
-    /// # impl DiracSystem<1> for Oscillator {
-    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
-    /// #     }
-    /// # }
-    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
-    /// stepper.start_from_momentum(vector![1.0], vector![0.5])?;
-    /// assert!((stepper.v()?[0] - 0.5).abs() < 1e-15);
-    /// # Ok::<(), dirac_runtime::DiracError>(())
-    /// ```
-    pub fn start_from_momentum(
-        &mut self,
-        q0: SVector<f64, N>,
-        p0: SVector<f64, N>,
-    ) -> Result<(), DiracError> {
-        self.start_from_momentum_near(q0, p0, SVector::zeros())
-    }
-
-    /// Starts from position `q0` and momentum `p0` at the [start time](Self::with_start_time), solving for the velocity from
-    /// the guess `v_guess`.
-    ///
-    /// ```
-    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
-    /// # use nalgebra::{SVector, vector};
-    /// # struct Oscillator;
-    /// # impl DiracSystem<1> for Oscillator {
-    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
-    /// #     }
-    /// # }
-    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
-    /// stepper.start_from_momentum_near(vector![1.0], vector![0.5], vector![0.4])?;
-    /// assert!((stepper.v()?[0] - 0.5).abs() < 1e-15);
-    /// # Ok::<(), dirac_runtime::DiracError>(())
-    /// ```
-    pub fn start_from_momentum_near(
-        &mut self,
-        q0: SVector<f64, N>,
-        p0: SVector<f64, N>,
-        v_guess: SVector<f64, N>,
-    ) -> Result<(), DiracError> {
-        check_finite(self.system(), "initial position", &q0)?;
-        check_finite(self.system(), "initial momentum", &p0)?;
-        check_finite(self.system(), "velocity guess", &v_guess)?;
-        let t0 = self.initial_time;
-        let v0 = self.velocity_at(t0, &q0, &p0, &v_guess, false)?;
         self.start_from_state(State::new(t0, q0, p0, v0))
     }
 
@@ -462,220 +374,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N>, const N: usize>
     /// ```
     pub fn constraint_point(&self) -> ConstraintPoint {
         self.equations.constraint_point()
-    }
-
-    /// Sets the input called `name` (held constant over the following steps until set again).
-    /// In a loop, resolve the name once with [`input`](Self::input) and use
-    /// [`set_input_value`](Self::set_input_value).
-    ///
-    /// ```
-    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
-    /// # use nalgebra::{SVector, vector};
-    /// /// An oscillator driven by the force `u`.
-    /// struct Driven;
-    /// impl DiracSystem<1> for Driven {
-    ///     const FORCES: bool = true;
-    ///     const INPUTS: usize = 1;
-    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
-    ///     }
-    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
-    ///         -> SVector<D, 1> {
-    ///         SVector::from([u[0]])
-    ///     }
-    ///     fn input_name(&self, _i: usize) -> String {
-    ///         "u".into()
-    ///     }
-    /// }
-    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
-    /// stepper.set_input("u", 2.0)?;
-    /// assert_eq!(stepper.inputs(), &[2.0]);
-    /// assert!(stepper.set_input("v", 1.0).is_err());
-    /// # Ok::<(), dirac_runtime::DiracError>(())
-    /// ```
-    pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), DiracError> {
-        let input = self.input(name)?;
-        self.set_input_value(input, value)
-    }
-
-    /// The input called `name`, or `UnknownInput` naming the system's inputs.
-    ///
-    /// ```
-    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
-    /// # use nalgebra::{SVector, vector};
-    /// /// An oscillator driven by the force `u`.
-    /// struct Driven;
-    /// impl DiracSystem<1> for Driven {
-    ///     const FORCES: bool = true;
-    ///     const INPUTS: usize = 1;
-    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
-    ///     }
-    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
-    ///         -> SVector<D, 1> {
-    ///         SVector::from([u[0]])
-    ///     }
-    ///     fn input_name(&self, _i: usize) -> String {
-    ///         "u".into()
-    ///     }
-    /// }
-    /// let stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
-    /// assert_eq!(stepper.input("u")?.index(), 0);
-    /// assert!(stepper.input("v").is_err());
-    /// # Ok::<(), dirac_runtime::DiracError>(())
-    /// ```
-    pub fn input(&self, name: &str) -> Result<Input, DiracError> {
-        (0..S::INPUTS)
-            .find(|&i| self.system().input_name(i) == name)
-            .map(Input::new)
-            .ok_or_else(|| {
-                let names: Vec<String> = (0..S::INPUTS)
-                    .map(|i| self.system().input_name(i))
-                    .collect();
-                DiracError::UnknownInput(format!(
-                    "no input called `{name}`; the inputs are {names:?}"
-                ))
-            })
-    }
-
-    /// Sets `input` (held constant over the following steps until set again); a value that is
-    /// not finite is refused and changes nothing.
-    ///
-    /// ```
-    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
-    /// # use nalgebra::{SVector, vector};
-    /// /// An oscillator driven by the force `u`.
-    /// struct Driven;
-    /// impl DiracSystem<1> for Driven {
-    ///     const FORCES: bool = true;
-    ///     const INPUTS: usize = 1;
-    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
-    ///     }
-    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
-    ///         -> SVector<D, 1> {
-    ///         SVector::from([u[0]])
-    ///     }
-    ///     fn input_name(&self, _i: usize) -> String {
-    ///         "u".into()
-    ///     }
-    /// }
-    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.01)?;
-    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
-    /// let u = stepper.input("u")?; // resolved once, outside the loop
-    /// for _ in 0..100 {
-    ///     let feedback = -stepper.q()[0]; // a second spring, held over each step
-    ///     stepper.set_input_value(u, feedback)?;
-    ///     stepper.step()?;
-    /// }
-    /// assert!((stepper.q()[0] - 2.0_f64.sqrt().cos()).abs() < 0.05);
-    /// # Ok::<(), dirac_runtime::DiracError>(())
-    /// ```
-    pub fn set_input_value(&mut self, input: Input, value: f64) -> Result<(), DiracError> {
-        let index = input.index();
-        if index >= S::INPUTS {
-            return Err(DiracError::UnknownInput(format!(
-                "input {index} of a system with {} input(s)",
-                S::INPUTS
-            )));
-        }
-        if !value.is_finite() {
-            return Err(DiracError::NonFinite {
-                what: format!("input {}", self.system().input_name(index)),
-                value,
-            });
-        }
-        if self.equations.inputs()[index] != value {
-            // A step after a change of inputs is predicted from the last one alone.
-            self.predictor.restart();
-        }
-        self.equations.inputs_mut()[index] = value;
-        Ok(())
-    }
-
-    /// Sets every input at once, in the order of the system's `inputs(...)`.
-    ///
-    /// ```
-    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
-    /// # use nalgebra::{SVector, vector};
-    /// /// An oscillator driven by the force `u`.
-    /// struct Driven;
-    /// impl DiracSystem<1> for Driven {
-    ///     const FORCES: bool = true;
-    ///     const INPUTS: usize = 1;
-    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
-    ///     }
-    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
-    ///         -> SVector<D, 1> {
-    ///         SVector::from([u[0]])
-    ///     }
-    ///     fn input_name(&self, _i: usize) -> String {
-    ///         "u".into()
-    ///     }
-    /// }
-    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
-    /// stepper.set_inputs(&[1.5])?;
-    /// assert_eq!(stepper.inputs(), &[1.5]);
-    /// assert!(stepper.set_inputs(&[1.0, 2.0]).is_err());
-    /// # Ok::<(), dirac_runtime::DiracError>(())
-    /// ```
-    pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
-        let changed = self.equations.inputs() != values;
-        self.equations.set_inputs(values)?;
-        if changed {
-            // A step after a change of inputs is predicted from the last one alone.
-            self.predictor.restart();
-        }
-        Ok(())
-    }
-
-    /// Current input values.
-    ///
-    /// ```
-    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
-    /// # use nalgebra::{SVector, vector};
-    /// /// An oscillator driven by the force `u`.
-    /// struct Driven;
-    /// impl DiracSystem<1> for Driven {
-    ///     const FORCES: bool = true;
-    ///     const INPUTS: usize = 1;
-    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
-    ///     }
-    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
-    ///         -> SVector<D, 1> {
-    ///         SVector::from([u[0]])
-    ///     }
-    ///     fn input_name(&self, _i: usize) -> String {
-    ///         "u".into()
-    ///     }
-    /// }
-    /// let stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
-    /// assert_eq!(stepper.inputs(), &[0.0]); // inputs start at zero
-    /// # Ok::<(), dirac_runtime::DiracError>(())
-    /// ```
-    pub fn inputs(&self) -> &[f64] {
-        self.equations.inputs()
-    }
-
-    /// The system.
-    ///
-    /// ```
-    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
-    /// # use nalgebra::{SVector, vector};
-    /// # struct Oscillator;
-    /// # impl DiracSystem<1> for Oscillator {
-    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
-    /// #     }
-    /// # }
-    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
-    /// assert_eq!(stepper.system().coordinate_name(0), "q0");
-    /// # Ok::<(), dirac_runtime::DiracError>(())
-    /// ```
-    pub fn system(&self) -> &S {
-        self.equations.discrete().system()
     }
 
     /// The configuration space whose charts the steps work in.
@@ -817,6 +515,317 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         Ok(self)
     }
 
+    /// Starts from position `q0` and velocity `v0` at the [start time](Self::with_start_time), with `p0 = ∂L/∂v(q0, v0)`.
+    /// Fails if `(q0, v0)` violates a constraint, including the hidden constraints of
+    /// coordinates without kinetic energy.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.5])?;
+    /// assert_eq!((stepper.t(), stepper.p()[0]), (0.0, 0.5));
+    /// assert!(stepper.start_from_velocity(vector![f64::NAN], vector![0.0]).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn start_from_velocity(
+        &mut self,
+        q0: Point<E, N>,
+        v0: Tangent<E, N>,
+    ) -> Result<(), DiracError> {
+        let p0 = self.equations.momentum(&q0, &v0)?;
+        self.start_from_state(State::new(self.initial_time, q0, p0, v0))
+    }
+
+    /// Starts from position `q0` and momentum `p0` at the [start time](Self::with_start_time). The velocity is found by a
+    /// globalised Newton solve of `∂L/∂v(q0, v) = p0` from `v = 0`; when that fails (several
+    /// velocities share the momentum, or `v = 0` is far from the answer), use
+    /// [`start_from_momentum_near`](Self::start_from_momentum_near).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_momentum(vector![1.0], vector![0.5])?;
+    /// assert!((stepper.v()?[0] - 0.5).abs() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn start_from_momentum(
+        &mut self,
+        q0: Point<E, N>,
+        p0: Tangent<E, N>,
+    ) -> Result<(), DiracError> {
+        self.start_from_momentum_near(q0, p0, <E::Manifold as Manifold<N>>::zero())
+    }
+
+    /// Starts from position `q0` and momentum `p0` at the [start time](Self::with_start_time), solving for the velocity from
+    /// the guess `v_guess`.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_momentum_near(vector![1.0], vector![0.5], vector![0.4])?;
+    /// assert!((stepper.v()?[0] - 0.5).abs() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn start_from_momentum_near(
+        &mut self,
+        q0: Point<E, N>,
+        p0: Tangent<E, N>,
+        v_guess: Tangent<E, N>,
+    ) -> Result<(), DiracError> {
+        self.equations.check_finite(&q0, &p0, &v_guess)?;
+        let t0 = self.initial_time;
+        let v0 = self.velocity_at(t0, &q0, &p0, &v_guess, false)?;
+        self.start_from_state(State::new(t0, q0, p0, v0))
+    }
+
+    /// Sets the input called `name` (held constant over the following steps until set again).
+    /// In a loop, resolve the name once with [`input`](Self::input) and use
+    /// [`set_input_value`](Self::set_input_value).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// stepper.set_input("u", 2.0)?;
+    /// assert_eq!(stepper.inputs(), &[2.0]);
+    /// assert!(stepper.set_input("v", 1.0).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), DiracError> {
+        let input = self.input(name)?;
+        self.set_input_value(input, value)
+    }
+
+    /// The input called `name`, or `UnknownInput` naming the system's inputs.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.input("u")?.index(), 0);
+    /// assert!(stepper.input("v").is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn input(&self, name: &str) -> Result<Input, DiracError> {
+        let count = self.equations.inputs().len();
+        (0..count)
+            .find(|&i| self.equations.input_name(i) == name)
+            .map(Input::new)
+            .ok_or_else(|| {
+                let names: Vec<String> =
+                    (0..count).map(|i| self.equations.input_name(i)).collect();
+                DiracError::UnknownInput(format!(
+                    "no input called `{name}`; the inputs are {names:?}"
+                ))
+            })
+    }
+
+    /// Sets `input` (held constant over the following steps until set again); a value that is
+    /// not finite is refused and changes nothing.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.01)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// let u = stepper.input("u")?; // resolved once, outside the loop
+    /// for _ in 0..100 {
+    ///     let feedback = -stepper.q()[0]; // a second spring, held over each step
+    ///     stepper.set_input_value(u, feedback)?;
+    ///     stepper.step()?;
+    /// }
+    /// assert!((stepper.q()[0] - 2.0_f64.sqrt().cos()).abs() < 0.05);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn set_input_value(&mut self, input: Input, value: f64) -> Result<(), DiracError> {
+        let index = input.index();
+        let count = self.equations.inputs().len();
+        if index >= count {
+            return Err(DiracError::UnknownInput(format!(
+                "input {index} of a system with {count} input(s)"
+            )));
+        }
+        if !value.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: format!("input {}", self.equations.input_name(index)),
+                value,
+            });
+        }
+        if self.equations.inputs()[index] != value {
+            // A step after a change of inputs is predicted from the last one alone.
+            self.predictor.restart();
+        }
+        self.equations.inputs_mut()[index] = value;
+        Ok(())
+    }
+
+    /// Sets every input at once, in the order of the system's `inputs(...)`.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// stepper.set_inputs(&[1.5])?;
+    /// assert_eq!(stepper.inputs(), &[1.5]);
+    /// assert!(stepper.set_inputs(&[1.0, 2.0]).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
+        let count = self.equations.inputs().len();
+        if values.len() != count {
+            return Err(DiracError::UnknownInput(format!(
+                "the system has {count} input(s), got {} value(s)",
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(DiracError::NonFinite {
+                what: format!("input {}", self.equations.input_name(i)),
+                value: values[i],
+            });
+        }
+        let changed = self.equations.inputs() != values;
+        self.equations.inputs_mut().copy_from_slice(values);
+        if changed {
+            // A step after a change of inputs is predicted from the last one alone.
+            self.predictor.restart();
+        }
+        Ok(())
+    }
+
+    /// Current input values.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.inputs(), &[0.0]); // inputs start at zero
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn inputs(&self) -> &[f64] {
+        self.equations.inputs()
+    }
+
+    /// The system.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.system().coordinate_name(0), "q0");
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn system(&self) -> &E::System {
+        self.equations.system()
+    }
+
     /// The step equations.
     ///
     /// ```
@@ -842,11 +851,11 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     fn velocity_at(
         &self,
         t: f64,
-        q: &SVector<f64, N>,
-        p: &SVector<f64, N>,
-        guess: &SVector<f64, N>,
+        q: &Point<E, N>,
+        p: &Tangent<E, N>,
+        guess: &Tangent<E, N>,
         in_run: bool,
-    ) -> Result<SVector<f64, N>, DiracError> {
+    ) -> Result<Tangent<E, N>, DiracError> {
         // As a recorded sample's velocity is solved, in a workspace of its own.
         let mut solver =
             VelocitySolver::new(self.equations.velocity_unknowns(), self.newton.options())?;
@@ -861,9 +870,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// the stepper's own workspace.
     fn sample_velocity(
         &mut self,
-        state: &State<N>,
-        guess: &SVector<f64, N>,
-    ) -> Result<SVector<f64, N>, DiracError> {
+        state: &State<N, E::Manifold>,
+        guess: &Tangent<E, N>,
+    ) -> Result<Tangent<E, N>, DiracError> {
         let unknowns = self.equations.velocity_unknowns();
         if self.velocity.fast.unknowns() != unknowns {
             self.velocity = VelocitySolver::new(unknowns, self.newton.options())?;
@@ -896,7 +905,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert_eq!((stepper.t(), stepper.steps()), (2.0, 0));
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn start_from_state(&mut self, state: State<N>) -> Result<(), DiracError> {
+    pub fn start_from_state(&mut self, state: State<N, E::Manifold>) -> Result<(), DiracError> {
         if !state.t.is_finite() {
             return Err(DiracError::NonFinite {
                 what: "the initial time".into(),
@@ -933,7 +942,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
 
     /// Lets the equations examine the start of a run, and sizes the solver for the unknowns
     /// they then have.
-    fn begin(&mut self, state: &State<N>) -> Result<(), DiracError> {
+    fn begin(&mut self, state: &State<N, E::Manifold>) -> Result<(), DiracError> {
         self.equations.begin(state);
         let unknowns = self.equations.unknowns();
         if unknowns != self.unknowns.len() {
@@ -944,7 +953,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         Ok(())
     }
 
-    fn reset(&mut self, state: State<N>) {
+    fn reset(&mut self, state: State<N, E::Manifold>) {
         self.violation = 0.0;
         self.multipliers.fill(0.0);
         self.start = state.t;
@@ -1014,7 +1023,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
 
     /// [`solve_step`](Self::solve_step) ending, where Newton's method runs, with the Jacobian
     /// at the root (the derivatives that follow need it).
-    fn solve_step_at_root(&mut self) -> Result<Proposal<N>, DiracError> {
+    fn solve_step_at_root(&mut self) -> Result<Proposal<N, E::Manifold>, DiracError> {
         self.newton.set_jacobian_at_root(true);
         let proposal = self.solve_step();
         self.newton.set_jacobian_at_root(false);
@@ -1024,7 +1033,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// Factorises the Jacobian at the root of the step just solved (the implicit function
     /// theorem needs it there; the solve may have ended with an earlier one) and returns the
     /// state the step started from.
-    fn factorise_at_root(&mut self) -> Result<State<N>, DiracError> {
+    fn factorise_at_root(&mut self) -> Result<State<N, E::Manifold>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
         let equations = &mut self.equations;
         self.newton
@@ -1036,7 +1045,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// Solves the next step without making it current: the state is unchanged whatever happens.
-    fn solve_step(&mut self) -> Result<Proposal<N>, DiracError> {
+    fn solve_step(&mut self) -> Result<Proposal<N, E::Manifold>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
         // The last solutions extrapolated (see `predictor`).
         let predictor = self.predictor.predict();
@@ -1057,7 +1066,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// Makes a solved step current; its solution is still in `unknowns`.
-    fn accept(&mut self, proposal: Proposal<N>) {
+    fn accept(&mut self, proposal: Proposal<N, E::Manifold>) {
         let first = self.equations.first_multiplier();
         let count = self.multipliers.len();
         self.multipliers
@@ -1183,7 +1192,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert_eq!(stepper.state().map(|s| s.q()[0]), Some(1.0));
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn state(&self) -> Option<&State<N>> {
+    pub fn state(&self) -> Option<&State<N, E::Manifold>> {
         self.state.as_ref()
     }
 
@@ -1225,8 +1234,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert!((stepper.q()[0] - 1.0_f64.cos()).abs() < 1e-2);
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn q(&self) -> SVector<f64, N> {
-        self.state.map_or(SVector::zeros(), |s| s.q)
+    pub fn q(&self) -> Point<E, N> {
+        self.state
+            .map_or_else(<E::Manifold as Manifold<N>>::origin, |s| s.q)
     }
 
     /// Current momentum (zeros before the start).
@@ -1246,8 +1256,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert!((stepper.p()[0] + 1.0_f64.sin()).abs() < 1e-2);
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn p(&self) -> SVector<f64, N> {
-        self.state.map_or(SVector::zeros(), |s| s.p)
+    pub fn p(&self) -> Tangent<E, N> {
+        self.state
+            .map_or_else(<E::Manifold as Manifold<N>>::zero, |s| s.p)
     }
 
     /// Current velocity: the solution `v` of `∂L/∂v(q, v) = p` (Newton's method with the exact
@@ -1268,7 +1279,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert_eq!(stepper.v()?, stepper.p()); // L = (v² − q²)/2: p = v
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn v(&self) -> Result<SVector<f64, N>, DiracError> {
+    pub fn v(&self) -> Result<Tangent<E, N>, DiracError> {
         let state = self.state.ok_or(DiracError::NotStarted)?;
         self.velocity_at(state.t, &state.q, &state.p, &state.velocity, true)
     }
@@ -1298,7 +1309,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// The energy of `state`, reached after `steps` steps (for the error message).
-    fn energy_of(&self, state: &State<N>, steps: u64) -> Result<f64, DiracError> {
+    fn energy_of(&self, state: &State<N, E::Manifold>, steps: u64) -> Result<f64, DiracError> {
         let v = self.velocity_at(state.t, &state.q, &state.p, &state.velocity, true)?;
         self.energy_at(state, &v, steps)
     }
@@ -1307,8 +1318,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// is not finite.
     fn energy_at(
         &self,
-        state: &State<N>,
-        v: &SVector<f64, N>,
+        state: &State<N, E::Manifold>,
+        v: &Tangent<E, N>,
         steps: u64,
     ) -> Result<f64, DiracError> {
         let energy = self.equations.energy(&state.q, &state.p, v);
@@ -1360,7 +1371,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert_eq!(trajectory.column_names(), ["t", "q0", "v_q0", "p_q0", "energy"]);
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn trajectory(&self) -> Trajectory<N> {
+    pub fn trajectory(&self) -> Trajectory<N, E::Manifold> {
         let names = self.coordinate_names();
         let options = self.newton.options();
         let model = std::any::type_name::<E::System>();
@@ -1397,7 +1408,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn coordinate_names(&self) -> Vec<String> {
-        (0..N).map(|i| self.equations.coordinate_name(i)).collect()
+        (0..<E::Manifold as Manifold<N>>::VARIABLES)
+            .map(|i| self.equations.coordinate_name(i))
+            .collect()
     }
 
     /// Turns a Newton failure into an error naming the step and, if singular, the unknowns.

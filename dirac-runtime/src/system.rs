@@ -1,16 +1,22 @@
 //! The trait a model implements: its Lagrangian, coordinate names, parameters and default quadrature.
 
-use nalgebra::SVector;
-
 use crate::closed_form::{LagrangianGradient, LagrangianHessian};
 use crate::constraint_point::ConstraintPoint;
 use crate::error::DiracError;
+use crate::manifold::{Manifold, Vectors};
 use crate::quadrature::Quadrature;
 use crate::scalar::Scalar;
 
-/// A mechanical or electrical model on `Q = R^N`: its continuous Lagrangian `L(q, v)` and, where
-/// it has them, constraint one-forms `A(q) v = 0`, holonomic constraints `g(q) = 0`, forces
-/// `F(q, v, t, u)` and named inputs `u`.
+/// A mechanical or electrical model on a [`Manifold`] of dimension `N` (`Rᴺ` unless named): its
+/// continuous Lagrangian `L(q, v)` and, where it has them, constraint one-forms `A(q) v = 0`,
+/// holonomic constraints `g(q) = 0`, forces `F(q, v, t, u)` and named inputs `u`.
+///
+/// On `Rᴺ` (`M = Vectors`, the default) points and velocities are `SVector<D, N>`. On a product
+/// of vectors, rotations and unit vectors (`M = Product<K, A, B>`, see
+/// [`product`](crate::product)) they are a [`Configuration`](crate::product::Configuration) and
+/// [`Rates`](crate::product::Rates): attitudes with their body angular velocities, unit vectors
+/// with their velocities. One-forms and forces are covectors in the velocities'
+/// representation (for a rotation, a body torque).
 ///
 /// `#[dirac_system(...)]` implements this trait; writing the `impl` by hand works the same way.
 /// Only [`lagrangian`](Self::lagrangian) is required; everything else defaults to "none", and a
@@ -37,7 +43,7 @@ use crate::scalar::Scalar;
 /// assert!((stepper.q()[0] - 0.1_f64.cos()).abs() < 1e-3);
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
-pub trait DiracSystem<const N: usize> {
+pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// Number of constraint one-forms `w^a(q)` (rows of `A(q)`).
     const ONE_FORMS: usize = 0;
     /// Number of holonomic constraints `g_b(q) = 0`.
@@ -48,17 +54,17 @@ pub trait DiracSystem<const N: usize> {
     const INPUTS: usize = 0;
 
     /// The continuous Lagrangian `L(q, v)` at position `q` and velocity `v`.
-    fn lagrangian<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D;
+    fn lagrangian<D: Scalar>(&self, q: &M::Point<D>, v: &M::Tangent<D>) -> D;
 
-    /// `L` and its gradient at `(q, v)` in closed form, where the model has them:
+    /// `L` and its gradient at `(q, v)` in closed form, where a model on `Rᴺ` has them:
     /// `#[dirac_system]` derives them at compile time from a Lagrangian written as an
     /// expression. `None` (the default) lets the runtime take them by dual numbers. They must
     /// be the derivatives of [`lagrangian`](Self::lagrangian): a stepper compares the two at the
     /// start of every run ([`closed_form::check`](crate::closed_form::check)).
     fn lagrangian_gradient(
         &self,
-        q: &SVector<f64, N>,
-        v: &SVector<f64, N>,
+        q: &M::Point<f64>,
+        v: &M::Tangent<f64>,
     ) -> Option<LagrangianGradient<N>> {
         let _ = (q, v);
         None
@@ -68,22 +74,23 @@ pub trait DiracSystem<const N: usize> {
     /// has them (as [`lagrangian_gradient`](Self::lagrangian_gradient)).
     fn lagrangian_hessian(
         &self,
-        q: &SVector<f64, N>,
-        v: &SVector<f64, N>,
+        q: &M::Point<f64>,
+        v: &M::Tangent<f64>,
     ) -> Option<LagrangianHessian<N>> {
         let _ = (q, v);
         None
     }
 
-    /// Constraint one-form `a` (`0 <= a < ONE_FORMS`) at `q`: the row `A_a(q)` of `A(q) v = 0`.
-    fn one_form<D: Scalar>(&self, q: &SVector<D, N>, a: usize) -> SVector<D, N> {
+    /// Constraint one-form `a` (`0 <= a < ONE_FORMS`) at `q`: the row `A_a(q)` of `A(q) v = 0`
+    /// (a covector, paired with the velocity).
+    fn one_form<D: Scalar>(&self, q: &M::Point<D>, a: usize) -> M::Tangent<D> {
         let _ = (q, a);
-        SVector::zeros()
+        M::zero()
     }
 
     /// Holonomic constraint `b` (`0 <= b < HOLONOMIC`): the value `g_b(q)`, zero on the
     /// constraint set. Its one-form `dg_b` is derived by dual numbers.
-    fn holonomic<D: Scalar>(&self, q: &SVector<D, N>, b: usize) -> D {
+    fn holonomic<D: Scalar>(&self, q: &M::Point<D>, b: usize) -> D {
         let _ = (q, b);
         D::zero()
     }
@@ -93,13 +100,13 @@ pub trait DiracSystem<const N: usize> {
     /// type as `q` and `v`, so that the derivatives of a step with respect to them are exact.
     fn force<D: Scalar>(
         &self,
-        q: &SVector<D, N>,
-        v: &SVector<D, N>,
+        q: &M::Point<D>,
+        v: &M::Tangent<D>,
         t: f64,
         inputs: &[D],
-    ) -> SVector<D, N> {
+    ) -> M::Tangent<D> {
         let _ = (q, v, t, inputs);
-        SVector::zeros()
+        M::zero()
     }
 
     /// The name of input `i`, used by [`Stepper::set_input`](crate::Stepper::set_input).
@@ -112,7 +119,9 @@ pub trait DiracSystem<const N: usize> {
         ConstraintPoint::Midpoint
     }
 
-    /// The name of coordinate `i` (`0 <= i < N`), used in CSV headers and error messages.
+    /// The name of variable `i`, used in CSV headers and error messages: on `Rᴺ` coordinate `i`
+    /// (`0 <= i < N`); on a product, the `K` coordinates, then the rotations, then the unit
+    /// vectors ([`Manifold::VARIABLES`] in all).
     fn coordinate_name(&self, i: usize) -> String {
         format!("q{i}")
     }

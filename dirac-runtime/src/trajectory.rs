@@ -4,13 +4,12 @@
 use std::io::Write;
 use std::path::Path;
 
-use nalgebra::SVector;
-
 use thiserror::Error;
 
 use crate::dense_output::Sample;
 use crate::error::DiracError;
 use crate::event::Crossing;
+use crate::manifold::{Manifold, Vectors};
 
 /// What produced a trajectory: the model, the method and the solver's tolerances.
 #[derive(Debug, Clone, PartialEq)]
@@ -30,12 +29,13 @@ pub struct Metadata {
     pub step_tolerance: f64,
 }
 
-/// A sampled trajectory `(t, q, v, p, E)` of a system with `N` coordinates.
+/// A sampled trajectory `(t, q, v, p, E)` of a system with `N` coordinates on the manifold `M`
+/// (`Rᴺ` unless named).
 ///
 /// ```
 /// use dirac_runtime::{Sample, Trajectory};
 /// use nalgebra::vector;
-/// let mut trajectory = Trajectory::new(vec!["x".into()])?;
+/// let mut trajectory = Trajectory::<1>::new(vec!["x".into()])?;
 /// assert!(Trajectory::<1>::new(vec![]).is_err()); // one name per coordinate
 /// let sample = |t, q, v| Sample { t, q: vector![q], v: vector![v], p: vector![v] };
 /// trajectory.push(&sample(0.0, 1.0, 0.0), 0.5)?;
@@ -49,13 +49,22 @@ pub struct Metadata {
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct Trajectory<const N: usize> {
+#[cfg_attr(
+    feature = "serde",
+    serde(bound(
+        serialize = "M::Point<f64>: serde::Serialize, M::Tangent<f64>: serde::Serialize",
+        deserialize = "M::Point<f64>: serde::Deserialize<'de>, \
+                       M::Tangent<f64>: serde::Deserialize<'de>"
+    ))
+)]
+pub struct Trajectory<const N: usize, M: Manifold<N> = Vectors> {
+    /// The model's variables.
     names: Vec<String>,
     metadata: Option<Metadata>,
     t: Vec<f64>,
-    q: Vec<SVector<f64, N>>,
-    v: Vec<SVector<f64, N>>,
-    p: Vec<SVector<f64, N>>,
+    q: Vec<M::Point<f64>>,
+    v: Vec<M::Tangent<f64>>,
+    p: Vec<M::Tangent<f64>>,
     energy: Vec<f64>,
     /// Names of the multipliers (empty for an unconstrained system).
     multiplier_names: Vec<String>,
@@ -65,8 +74,9 @@ pub struct Trajectory<const N: usize> {
     violation: Vec<f64>,
 }
 
-impl<const N: usize> Trajectory<N> {
-    /// An empty trajectory whose coordinates are called `names` (one per coordinate).
+impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
+    /// An empty trajectory whose variables are called `names` (one per coordinate on `Rᴺ`; see
+    /// [`DiracSystem::coordinate_name`](crate::DiracSystem::coordinate_name)).
     pub fn new(names: Vec<String>) -> Result<Self, DiracError> {
         Self::with_multipliers(names, Vec::new())
     }
@@ -77,9 +87,11 @@ impl<const N: usize> Trajectory<N> {
         names: Vec<String>,
         multiplier_names: Vec<String>,
     ) -> Result<Self, DiracError> {
-        if names.len() != N {
+        if names.len() != M::VARIABLES {
             return Err(DiracError::Dimension(format!(
-                "a trajectory of {N} coordinates needs {N} names, got {}",
+                "a trajectory of {} variables needs {} names, got {}",
+                M::VARIABLES,
+                M::VARIABLES,
                 names.len()
             )));
         }
@@ -113,7 +125,7 @@ impl<const N: usize> Trajectory<N> {
     /// Appends a sample of a constrained system: one multiplier per name given at construction.
     pub fn push_constrained(
         &mut self,
-        sample: &Sample<N>,
+        sample: &Sample<N, M>,
         energy: f64,
         violation: f64,
         multipliers: &[f64],
@@ -183,7 +195,7 @@ impl<const N: usize> Trajectory<N> {
 
     /// Appends a sample of an unconstrained system; a trajectory that records multipliers takes
     /// [`push_constrained`](Self::push_constrained) instead (an error here).
-    pub fn push(&mut self, sample: &Sample<N>, energy: f64) -> Result<(), DiracError> {
+    pub fn push(&mut self, sample: &Sample<N, M>, energy: f64) -> Result<(), DiracError> {
         if !self.multiplier_names.is_empty() {
             return Err(DiracError::Dimension(format!(
                 "the trajectory records {} multipliers: use push_constrained",
@@ -194,7 +206,7 @@ impl<const N: usize> Trajectory<N> {
         Ok(())
     }
 
-    fn append(&mut self, sample: &Sample<N>, energy: f64) {
+    fn append(&mut self, sample: &Sample<N, M>, energy: f64) {
         self.t.push(sample.t);
         self.q.push(sample.q);
         self.v.push(sample.v);
@@ -223,17 +235,17 @@ impl<const N: usize> Trajectory<N> {
     }
 
     /// Positions.
-    pub fn q(&self) -> &[SVector<f64, N>] {
+    pub fn q(&self) -> &[M::Point<f64>] {
         &self.q
     }
 
     /// Velocities.
-    pub fn v(&self) -> &[SVector<f64, N>] {
+    pub fn v(&self) -> &[M::Tangent<f64>] {
         &self.v
     }
 
     /// Momenta.
-    pub fn p(&self) -> &[SVector<f64, N>] {
+    pub fn p(&self) -> &[M::Tangent<f64>] {
         &self.p
     }
 
@@ -243,7 +255,7 @@ impl<const N: usize> Trajectory<N> {
     }
 
     /// Sample `k`.
-    pub fn sample(&self, k: usize) -> Option<Sample<N>> {
+    pub fn sample(&self, k: usize) -> Option<Sample<N, M>> {
         (k < self.len()).then(|| Sample {
             t: self.t[k],
             q: self.q[k],
@@ -262,13 +274,16 @@ impl<const N: usize> Trajectory<N> {
 
     /// The names of the columns, in the CSV's order: `t`, the coordinates, `v_<coordinate>`,
     /// `p_<coordinate>`, `energy`, and for a constrained system `constraint_violation` and the
-    /// multipliers.
+    /// multipliers. On a product manifold a rotation `R` has the columns `R_11` … `R_33`, its
+    /// body angular velocity `v_R_x` … and momentum `p_R_x` …; a unit vector `n` has `n_x` …,
+    /// `v_n_x` … and `p_n_x` … (see [`Manifold::point_names`]).
     pub fn column_names(&self) -> Vec<String> {
         let constrained = !self.multiplier_names.is_empty();
+        let tangent = M::tangent_names(&self.names);
         std::iter::once("t".to_string())
-            .chain(self.names.iter().cloned())
-            .chain(self.names.iter().map(|n| format!("v_{n}")))
-            .chain(self.names.iter().map(|n| format!("p_{n}")))
+            .chain(M::point_names(&self.names))
+            .chain(tangent.iter().map(|n| format!("v_{n}")))
+            .chain(tangent.iter().map(|n| format!("p_{n}")))
             .chain(std::iter::once("energy".to_string()))
             .chain(constrained.then(|| "constraint_violation".to_string()))
             .chain(self.multiplier_names.iter().cloned())
@@ -286,9 +301,9 @@ impl<const N: usize> Trajectory<N> {
     fn row(&self, k: usize) -> Vec<f64> {
         let mut row = Vec::with_capacity(3 * N + 3 + self.multiplier_names.len());
         row.push(self.t[k]);
-        row.extend(self.q[k].iter());
-        row.extend(self.v[k].iter());
-        row.extend(self.p[k].iter());
+        row.extend(M::point_components(&self.q[k]));
+        row.extend(M::tangent_components(&self.v[k]));
+        row.extend(M::tangent_components(&self.p[k]));
         row.push(self.energy[k]);
         if let (Some(v), Some(m)) = (self.violation.get(k), self.multipliers_at(k)) {
             row.push(*v);
@@ -351,18 +366,18 @@ pub(crate) fn create(path: &Path) -> Result<std::io::BufWriter<std::fs::File>, D
 /// ```
 #[derive(Debug, Clone, PartialEq, Error)]
 #[error("the run stopped after {} samples: {error}", trajectory.len())]
-pub struct Interrupted<const N: usize> {
+pub struct Interrupted<const N: usize, M: Manifold<N> = Vectors> {
     /// Every sample recorded before the failing step.
-    pub trajectory: Trajectory<N>,
+    pub trajectory: Trajectory<N, M>,
     /// The event crossings located before the failing step.
-    pub events: Vec<Crossing<N>>,
+    pub events: Vec<Crossing<N, M>>,
     /// Why the step failed.
     #[source]
     pub error: DiracError,
 }
 
-impl<const N: usize> From<Box<Interrupted<N>>> for DiracError {
-    fn from(interrupted: Box<Interrupted<N>>) -> Self {
+impl<const N: usize, M: Manifold<N>> From<Box<Interrupted<N, M>>> for DiracError {
+    fn from(interrupted: Box<Interrupted<N, M>>) -> Self {
         interrupted.error
     }
 }

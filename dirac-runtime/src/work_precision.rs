@@ -52,7 +52,7 @@ type Start<'a, S, const N: usize> = Box<dyn Fn(&mut Stepper<S, N>) -> Result<(),
 /// assert!(choice.error <= 1e-6);
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
-pub struct Study<'a, S, const N: usize> {
+pub struct Study<'a, S: DiracSystem<N>, const N: usize> {
     system: S,
     horizon: f64,
     start: Start<'a, S, N>,
@@ -63,7 +63,7 @@ pub struct Study<'a, S, const N: usize> {
     reference: Option<(Sample<N>, f64)>,
 }
 
-impl<S, const N: usize> std::fmt::Debug for Study<'_, S, N> {
+impl<S: DiracSystem<N>, const N: usize> std::fmt::Debug for Study<'_, S, N> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Study")
             .field("horizon", &self.horizon)

@@ -3,12 +3,11 @@
 
 use std::ops::ControlFlow;
 
-use nalgebra::SVector;
-
 use super::Stepper;
 use crate::dense_output::Sample;
 use crate::error::DiracError;
 use crate::event::{self, Crossing};
+use crate::manifold::Manifold;
 use crate::run::{self, Progress, Run, Solution, Status};
 use crate::step_equations::{State, StepEquations};
 use crate::trajectory::{Interrupted, Trajectory};
@@ -37,7 +36,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert!((trajectory.q()[10][0] - 1.0).abs() < 1e-15);
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn run(&mut self, steps: u64) -> Result<Trajectory<N>, Box<Interrupted<N>>> {
+    pub fn run(&mut self, steps: u64) -> Result<Trajectory<N, E::Manifold>, Box<Interrupted<N, E::Manifold>>> {
         self.solve(Run::steps(steps))
             .map(|solution| solution.trajectory)
     }
@@ -62,7 +61,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert!((stepper.t() - 1.1).abs() < 1e-15);
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn run_until(&mut self, t_end: f64) -> Result<Trajectory<N>, Box<Interrupted<N>>> {
+    pub fn run_until(&mut self, t_end: f64) -> Result<Trajectory<N, E::Manifold>, Box<Interrupted<N, E::Manifold>>> {
         self.solve(Run::until(t_end))
             .map(|solution| solution.trajectory)
     }
@@ -93,7 +92,10 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert_eq!(solution.trajectory.len(), 6); // t = 0, 2, 4, 6, 8, 10
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn solve(&mut self, run: Run<'_, N>) -> Result<Solution<N>, Box<Interrupted<N>>> {
+    pub fn solve(
+        &mut self,
+        run: Run<'_, N, E::Manifold>,
+    ) -> Result<Solution<N, E::Manifold>, Box<Interrupted<N, E::Manifold>>> {
         let mut solution = Solution {
             trajectory: self.trajectory(),
             events: Vec::new(),
@@ -133,7 +135,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert!(stepper.interpolate(0.2).is_err());
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn interpolate(&self, t: f64) -> Result<Sample<N>, DiracError> {
+    pub fn interpolate(&self, t: f64) -> Result<Sample<N, E::Manifold>, DiracError> {
         let after = self.state.ok_or(DiracError::NotStarted)?;
         let before = self.before.ok_or_else(|| {
             DiracError::InvalidRun("dense output needs a step: none was taken yet".into())
@@ -160,10 +162,10 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// The dense output at fraction `theta` of the last step, between the samples `a` and `b`.
     fn dense_sample(
         &self,
-        a: &Sample<N>,
-        b: &Sample<N>,
+        a: &Sample<N, E::Manifold>,
+        b: &Sample<N, E::Manifold>,
         theta: f64,
-    ) -> Result<Sample<N>, DiracError> {
+    ) -> Result<Sample<N, E::Manifold>, DiracError> {
         let x = self.predictor.last().ok_or(DiracError::NotStarted)?;
         self.equations
             .dense([a, b], x, theta)
@@ -173,8 +175,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// The run's loop; `solution` keeps what was saved whatever happens.
     fn carry_out(
         &mut self,
-        mut run: Run<'_, N>,
-        solution: &mut Solution<N>,
+        mut run: Run<'_, N, E::Manifold>,
+        solution: &mut Solution<N, E::Manifold>,
     ) -> Result<(), DiracError> {
         let start = self.state.ok_or(DiracError::NotStarted)?;
         let h = self.h();
@@ -223,7 +225,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                 // The step's velocity hint is its mean velocity, half a step behind its end:
                 // extrapolated by half the change since the last one, it is O(h²) off.
                 let hint = proposal.next.velocity;
-                let guess = hint + (hint - current.v) * 0.5;
+                let guess = <E::Manifold as Manifold<N>>::extrapolate(&hint, &current.v, 0.5);
                 let v = self.sample_velocity(&proposal.next, &guess)?;
                 let energy = match sampled {
                     true => Some(self.energy_at(&proposal.next, &v, self.steps + 1)?),
@@ -315,8 +317,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// step's multipliers.
     fn save(
         &self,
-        trajectory: &mut Trajectory<N>,
-        sample: &Sample<N>,
+        trajectory: &mut Trajectory<N, E::Manifold>,
+        sample: &Sample<N, E::Manifold>,
         energy: Option<f64>,
     ) -> Result<(), DiracError> {
         let state = State::new(sample.t, sample.q, sample.p, sample.v);
@@ -333,7 +335,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
 }
 
 /// The sample of `state` with velocity `v`.
-fn sample<const N: usize>(state: &State<N>, v: SVector<f64, N>) -> Sample<N> {
+fn sample<const N: usize, M: Manifold<N>>(state: &State<N, M>, v: M::Tangent<f64>) -> Sample<N, M> {
     Sample {
         t: state.t,
         q: state.q,
