@@ -150,8 +150,18 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
         *q = self.retract(q, xi);
     }
 
-    /// The momentum at `R_q(ξ)` after a step from `(q, p)` (`p` is overwritten): solves
-    /// `(T_ξ R_q)ᵀ p_{k+1} = covectors.end`. `None` where the tangent map is singular.
+    /// The covector at `R_q(ξ)` whose pull-back to the chart at `q` is `covector`: solves
+    /// `(T_ξ R_q)ᵀ α = covector`. `None` where the tangent map is singular.
+    fn push_covector(
+        &self,
+        q: &Point<Self, N, f64>,
+        xi: &SVector<f64, N>,
+        covector: &SVector<f64, N>,
+    ) -> Option<Tangent<Self, N, f64>>;
+
+    /// The momentum at `R_q(ξ)` after a step from `(q, p)` (`p` is overwritten): by default
+    /// [`push_covector`](Self::push_covector) of `covectors.end`. `None` where the tangent map
+    /// is singular.
     fn advance_momentum(
         &self,
         q: &Point<Self, N, f64>,
@@ -159,7 +169,11 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
         p: &mut Tangent<Self, N, f64>,
         carry: &mut SVector<f64, N>,
         covectors: &StepCovectors<N>,
-    ) -> Option<()>;
+    ) -> Option<()> {
+        let _ = carry;
+        *p = self.push_covector(q, xi, &covectors.end)?;
+        Some(())
+    }
 
     /// `R_{R_q(η)}(ζ)`: the point at `ζ` of the chart centred at `R_q(η)`.
     fn retract_moved<D: Scalar>(
@@ -227,16 +241,14 @@ pub(crate) fn chart_rate_by_tangent_map<C: ConfigurationSpace<N, Manifold = Vect
     solve(&tangent_map(space, q, xi), v)
 }
 
-/// [`ConfigurationSpace::advance_momentum`] of a space of vectors from its tangent map.
-pub(crate) fn momentum_by_tangent_map<C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>(
+/// [`ConfigurationSpace::push_covector`] of a space of vectors from its tangent map.
+pub(crate) fn covector_by_tangent_map<C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>(
     space: &C,
     q: &SVector<f64, N>,
     xi: &SVector<f64, N>,
-    p: &mut SVector<f64, N>,
-    covectors: &StepCovectors<N>,
-) -> Option<()> {
-    *p = solve(&tangent_map(space, q, xi).transpose(), &covectors.end)?;
-    Some(())
+    covector: &SVector<f64, N>,
+) -> Option<SVector<f64, N>> {
+    solve(&tangent_map(space, q, xi).transpose(), covector)
 }
 
 /// `x` with `a x = b`, `None` where `a` is singular or the answer is not finite.
@@ -317,6 +329,15 @@ impl<const N: usize> ConfigurationSpace<N> for Euclidean {
         compensated_add(q, carry, xi);
     }
 
+    fn push_covector(
+        &self,
+        _q: &SVector<f64, N>,
+        _xi: &SVector<f64, N>,
+        covector: &SVector<f64, N>,
+    ) -> Option<SVector<f64, N>> {
+        Some(*covector)
+    }
+
     fn advance_momentum(
         &self,
         _q: &SVector<f64, N>,
@@ -387,15 +408,13 @@ impl<const N: usize> ConfigurationSpace<N> for Positive {
         chart_rate_by_tangent_map(self, q, xi, v)
     }
 
-    fn advance_momentum(
+    fn push_covector(
         &self,
         q: &SVector<f64, N>,
         xi: &SVector<f64, N>,
-        p: &mut SVector<f64, N>,
-        _carry: &mut SVector<f64, N>,
-        covectors: &StepCovectors<N>,
-    ) -> Option<()> {
-        momentum_by_tangent_map(self, q, xi, p, covectors)
+        covector: &SVector<f64, N>,
+    ) -> Option<SVector<f64, N>> {
+        covector_by_tangent_map(self, q, xi, covector)
     }
 }
 
@@ -468,15 +487,13 @@ mod tests {
             chart_rate_by_tangent_map(self, q, xi, v)
         }
 
-        fn advance_momentum(
+        fn push_covector(
             &self,
             q: &SVector<f64, 2>,
             xi: &SVector<f64, 2>,
-            p: &mut SVector<f64, 2>,
-            _carry: &mut SVector<f64, 2>,
-            covectors: &StepCovectors<2>,
-        ) -> Option<()> {
-            momentum_by_tangent_map(self, q, xi, p, covectors)
+            covector: &SVector<f64, 2>,
+        ) -> Option<SVector<f64, 2>> {
+            covector_by_tangent_map(self, q, xi, covector)
         }
     }
 

@@ -24,7 +24,9 @@
 
 use nalgebra::SVector;
 
+use crate::configuration_space::ConfigurationSpace;
 use crate::manifold::{Manifold, Vectors};
+use crate::quadrature::Quadrature;
 
 /// The solution at one time: position, velocity and momentum.
 ///
@@ -65,10 +67,46 @@ pub struct Sample<const N: usize, M: Manifold<N> = Vectors> {
     pub p: M::Tangent<f64>,
 }
 
+/// The dense output's path in the chart centred at the step's start `a`: its value and rate at
+/// fraction `theta` of the step between the samples `a` and `b` whose internal points are
+/// `internal` (chart coordinates at `a.q`), with the end slopes corrected to the samples'
+/// velocities; also the end point's chart coordinates. `None` where a chart map fails.
+pub(crate) fn chart_path<C: ConfigurationSpace<N>, const N: usize>(
+    space: &C,
+    quadrature: &Quadrature,
+    h: f64,
+    ends: [&Sample<N, C::Manifold>; 2],
+    internal: impl Iterator<Item = SVector<f64, N>>,
+    theta: f64,
+) -> Option<ChartPath<N>> {
+    let [a, b] = ends;
+    let end = space.local(&a.q, &b.q)?;
+    let points: Vec<SVector<f64, N>> = internal.chain(std::iter::once(end)).collect();
+    let (_, start_rate) = quadrature.path_through(0.0, &points, h);
+    let (_, end_rate) = quadrature.path_through(1.0, &points, h);
+    let d0 = space.chart_velocity(&a.q, &a.v)? - start_rate;
+    let d1 = space.chart_rate(&a.q, &end, &b.v)? - end_rate;
+    let (path, rate) = quadrature.path_through(theta, &points, h);
+    let (correction, rate_correction) = end_slope_correction(theta, h, points.len(), &d0, &d1);
+    Some(ChartPath {
+        xi: path + correction,
+        xi_dot: rate + rate_correction,
+        end,
+    })
+}
+
+/// A point of the dense output's path in the chart at the step's start (see [`chart_path`]).
+pub(crate) struct ChartPath<const N: usize> {
+    pub xi: SVector<f64, N>,
+    pub xi_dot: SVector<f64, N>,
+    /// The chart coordinates of the step's end.
+    pub end: SVector<f64, N>,
+}
+
 /// The correction at fraction `theta` of a step of size `h` whose path has degree `degree`, from
 /// the defects `d0`, `d1` of the path's rates at the ends: its value (`h ω (α + β θ)`) and its
 /// rate in time.
-pub(crate) fn end_slope_correction<const N: usize>(
+fn end_slope_correction<const N: usize>(
     theta: f64,
     h: f64,
     degree: usize,

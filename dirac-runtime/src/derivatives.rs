@@ -11,6 +11,7 @@ use num_dual::{Derivative, DualSVec64, HyperDualSVec64, HyperHyperDual64};
 
 use crate::closed_form::{LagrangianGradient, LagrangianHessian};
 use crate::configuration_space::{ConfigurationSpace, Point};
+use crate::quadrature::Quadrature;
 use crate::scalar::Scalar;
 use crate::system::DiracSystem;
 
@@ -106,6 +107,131 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> P
         let q = self.space.retract(self.base, xi);
         let v = self.space.push_forward(self.base, xi, xi_dot);
         self.system.lagrangian_hessian(&q, &v)
+    }
+}
+
+/// `D1 L_d` of a step through the moving chart, with what the same passes give besides: for
+/// `Λ(η; ξ_1..ξ_s) = h Σ_i b_i ℓ^{R_q(η)}(ζ_i, ζ̇_i)`, the discrete Lagrangian in the chart
+/// centred at the moved first point `R_q(η)` with the step's other points held where they are on
+/// the manifold (`ζ_j = R_{R_q(η)}⁻¹(R_q(ξ_j))`, `ζ_i` and `ζ̇_i` the path through them at node
+/// `i`), `row = ∂Λ/∂η` at `η = 0`.
+pub(crate) struct MovingRow<const N: usize> {
+    /// `∂Λ/∂η` at `η = 0`: `D1 L_d` read in the chart at `q`.
+    pub row: SVector<f64, N>,
+    /// `Σ_i |∂Λ_i/∂η|` over the nodes' terms: the size of what `row` sums.
+    pub magnitude: SVector<f64, N>,
+    /// `∂L_d/∂ξ_m` (`m = 1..=s`) in the chart at `q`, where the mixed derivatives were asked for.
+    pub slots: Vec<SVector<f64, N>>,
+    /// `∂²Λ/∂η∂ξ_m` (`m = 1..=s`; rows: `η`), where asked for.
+    pub blocks: Vec<SMatrix<f64, N, N>>,
+}
+
+/// [`MovingRow`] of the model `system` on `space` from `base` with the step's points `points`
+/// (`ξ_1..ξ_s` in the chart at `base`): by first-order duals in `η` alone, or, with `mixed`, by
+/// one hyper-dual pass per point seeded along `η` and `ξ_m`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn moving_row<S, C, const N: usize>(
+    system: &S,
+    space: &C,
+    base: &Point<C, N, f64>,
+    quadrature: &Quadrature,
+    h: f64,
+    points: &[SVector<f64, N>],
+    mixed: bool,
+) -> MovingRow<N>
+where
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+{
+    let unit = |i: usize| SVector::<f64, N>::from_fn(|r, _| if r == i { 1.0 } else { 0.0 });
+    let mut out = MovingRow {
+        row: SVector::zeros(),
+        magnitude: SVector::zeros(),
+        slots: Vec::new(),
+        blocks: Vec::new(),
+    };
+    if !mixed {
+        let eta = SVector::<Dual<N>, N>::from_fn(|i, _| {
+            Dual::<N>::new(0.0, Derivative::some(unit(i)))
+        });
+        let lifted: Vec<SVector<Dual<N>, N>> =
+            points.iter().map(|x| x.map(Dual::<N>::from)).collect();
+        moving_action(system, space, base, quadrature, h, &eta, &lifted, |term| {
+            let g = gradient(&term);
+            out.row += g;
+            out.magnitude += g.abs();
+        });
+        return out;
+    }
+    type H<const N: usize> = HyperDualSVec64<N, N>;
+    for m in 0..points.len() {
+        let eta = SVector::<H<N>, N>::from_fn(|i, _| {
+            H::<N>::new(0.0, Derivative::some(unit(i)), Derivative::none(), Derivative::none())
+        });
+        let seeded: Vec<SVector<H<N>, N>> = points
+            .iter()
+            .enumerate()
+            .map(|(j, x)| {
+                SVector::from_fn(|c, _| {
+                    let eps2 = (j == m).then(|| SMatrix::<f64, 1, N>::from_fn(|_, i| if i == c { 1.0 } else { 0.0 }));
+                    H::<N>::new(x[c], Derivative::none(), Derivative::new(eps2), Derivative::none())
+                })
+            })
+            .collect();
+        let (mut slot, mut block) = (SVector::zeros(), SMatrix::zeros());
+        moving_action(system, space, base, quadrature, h, &eta, &seeded, |term| {
+            let g = term.eps1.unwrap_generic(Const::<N>, U1);
+            if m == 0 {
+                out.row += g;
+                out.magnitude += g.abs();
+            }
+            slot += term.eps2.unwrap_generic(U1, Const::<N>).transpose();
+            block += term.eps1eps2.unwrap_generic(Const::<N>, Const::<N>);
+        });
+        out.slots.push(slot);
+        out.blocks.push(block);
+    }
+    out
+}
+
+/// The terms `h b_i ℓ^{R_q(η)}(ζ_i, ζ̇_i)` of `Λ(η; ξ_1..ξ_s)` (see [`MovingRow`]), handed to
+/// `term` node by node.
+#[allow(clippy::too_many_arguments)]
+fn moving_action<S, C, D, const N: usize>(
+    system: &S,
+    space: &C,
+    base: &Point<C, N, f64>,
+    quadrature: &Quadrature,
+    h: f64,
+    eta: &SVector<D, N>,
+    points: &[SVector<D, N>],
+    mut term: impl FnMut(D),
+) where
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+    D: Scalar,
+{
+    // At η = 0 the transition is the identity: the round-off of its round trip through the
+    // retraction is taken out of the values (not the derivatives), so that D1 L_d is taken at the
+    // very points whose end covector advances the momentum.
+    let moved: Vec<SVector<D, N>> = points
+        .iter()
+        .map(|xi| {
+            let z = space.transition(base, eta, xi);
+            z.zip_map(xi, |z, x| z + (x.re() - z.re()))
+        })
+        .collect();
+    let zero = D::from(0.0);
+    for (i, &b) in quadrature.weights().iter().enumerate() {
+        let mut zeta = SVector::<D, N>::from_element(zero);
+        let mut rate = SVector::<D, N>::from_element(zero);
+        for (j, z) in moved.iter().enumerate() {
+            zeta += z * D::from(quadrature.ell(i, j + 1));
+            rate += z * D::from(quadrature.ell_prime(i, j + 1) / h);
+        }
+        let q = space.retract_moved(base, eta, &zeta);
+        let v = space.push_forward_moved(base, eta, &zeta, &rate);
+        term(system.lagrangian(&q, &v) * (h * b));
     }
 }
 

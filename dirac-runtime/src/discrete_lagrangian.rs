@@ -18,7 +18,7 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 use crate::closed_form::LagrangianHessian;
 use crate::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors};
 use crate::derivatives::{
-    InChart, PhaseFunction, Seed, directional_gradient, gradients, hessian, seeded,
+    InChart, PhaseFunction, Seed, directional_gradient, gradients, hessian, moving_row, seeded,
     third_derivative,
 };
 use crate::manifold::Vectors;
@@ -69,6 +69,26 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             space,
             quadrature,
             h,
+        }
+    }
+
+    /// Fails on a non-positive or non-finite step or a non-finite parameter.
+    pub(crate) fn check(&self) -> Result<(), DiracError> {
+        let h = self.h;
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(DiracError::InvalidStep { h });
+        }
+        match self
+            .system
+            .parameters()
+            .into_iter()
+            .find(|(_, v)| !v.is_finite())
+        {
+            Some((name, value)) => Err(DiracError::NonFinite {
+                what: format!("parameter {name}"),
+                value,
+            }),
+            None => Ok(()),
         }
     }
 
@@ -173,6 +193,9 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         residual: &mut DVector<f64>,
         mut jacobian: Option<&mut DMatrix<f64>>,
     ) -> (Option<StepCovectors<N>>, f64) {
+        if !C::AFFINE {
+            return self.euler_lagrange_moving(base, increments, momentum, residual, jacobian);
+        }
         let s = self.quadrature.degree();
         let h = self.h;
         residual.fill(0.0);
@@ -273,6 +296,85 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             complete.then_some(StepCovectors { impulse, end }),
             magnitude.amax(),
         )
+    }
+
+    /// [`euler_lagrange`](Self::euler_lagrange) on a space whose charts have non-affine
+    /// transitions: row 0 is `π_k + D1 L_d` through the moving chart (see
+    /// [`MovingRow`](crate::derivatives::MovingRow)), the internal points' rows and the end
+    /// covector are read in the chart at `base`. The end covector comes with the residual where a
+    /// Jacobian is asked for or the step has internal points; otherwise it is left to
+    /// [`slot_covectors`](Self::slot_covectors) (`None`).
+    fn euler_lagrange_moving(
+        &self,
+        base: &Point<C, N, f64>,
+        increments: &[SVector<f64, N>],
+        momentum: &SVector<f64, N>,
+        residual: &mut DVector<f64>,
+        mut jacobian: Option<&mut DMatrix<f64>>,
+    ) -> (Option<StepCovectors<N>>, f64) {
+        let (quad, h) = (&self.quadrature, self.h);
+        let s = quad.degree();
+        residual.fill(0.0);
+        let moving = moving_row(
+            &self.system,
+            &self.space,
+            base,
+            quad,
+            h,
+            increments,
+            jacobian.is_some(),
+        );
+        residual.rows_mut(0, N).copy_from(&(momentum + moving.row));
+        let mut magnitude = momentum.abs() + moving.magnitude;
+        if let Some(jacobian) = jacobian.as_deref_mut() {
+            for (m, block) in moving.blocks.iter().enumerate() {
+                let mut target = jacobian.fixed_view_mut::<N, N>(0, m * N);
+                target += block;
+            }
+        }
+        if s == 1 {
+            let end = moving.slots.first().map(|&end| StepCovectors {
+                impulse: SVector::zeros(),
+                end,
+            });
+            return (end, magnitude.amax());
+        }
+        let chart = self.in_chart(base);
+        let mut end = SVector::zeros();
+        for (i, &b) in quad.weights().iter().enumerate() {
+            let w = h * b;
+            let (xi, xi_dot) = self.node(i, increments);
+            let a = |j: usize| quad.ell(i, j);
+            let d = |j: usize| quad.ell_prime(i, j) / h;
+            let (lq, lv) = match jacobian.as_deref_mut() {
+                Some(jacobian) => {
+                    let l = hessian(&chart, &xi, &xi_dot);
+                    for j in 1..s {
+                        for k in 1..=s {
+                            let mut block = jacobian.fixed_view_mut::<N, N>(j * N, (k - 1) * N);
+                            block += (l.qq * (a(j) * a(k))
+                                + l.qv * (a(j) * d(k))
+                                + l.qv.transpose() * (d(j) * a(k))
+                                + l.vv * (d(j) * d(k)))
+                                * w;
+                        }
+                    }
+                    (l.gradient.q, l.gradient.v)
+                }
+                None => gradients(&chart, &xi, &xi_dot),
+            };
+            end += (lq * a(s) + lv * d(s)) * w;
+            magnitude += (lq.abs() + lv.abs() * s as f64 / h) * w;
+            for j in 1..s {
+                let mut r = residual.rows_mut(j * N, N);
+                r += (lq * a(j) + lv * d(j)) * w;
+            }
+        }
+        let covectors = StepCovectors {
+            impulse: SVector::zeros(),
+            end,
+        };
+        (Some(covectors), magnitude.amax())
     }
 
     /// The slot covectors of the step with points `ξ_1..ξ_s` in the chart at `base`:

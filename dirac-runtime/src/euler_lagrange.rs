@@ -20,7 +20,7 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::configuration_space::{ConfigurationSpace, StepCovectors};
 use crate::constraint::{self, ConstraintPoint, StepConstraints};
-use crate::dense_output::{Sample, end_slope_correction};
+use crate::dense_output::{ChartPath, Sample, chart_path};
 use crate::derivatives::{Dual, Seed, seeded};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
@@ -106,21 +106,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// every point of the step's path (`g(Q_j) = 0` with an impulse `dg(Q_j)ᵀλ_j` on the row of
     /// each internal point), which gives order 4 at degree 2 and still 4 above it.
     pub fn new(discrete: DiscreteLagrangian<S, N, C>) -> Result<Self, DiracError> {
-        let h = discrete.h();
-        if !(h > 0.0 && h.is_finite()) {
-            return Err(DiracError::InvalidStep { h });
-        }
-        if let Some((name, value)) = discrete
-            .system()
-            .parameters()
-            .into_iter()
-            .find(|(_, v)| !v.is_finite())
-        {
-            return Err(DiracError::NonFinite {
-                what: format!("parameter {name}"),
-                value,
-            });
-        }
+        discrete.check()?;
         let quadrature = discrete.quadrature();
         if S::ONE_FORMS > 0
             && quadrature.degree() > 1
@@ -793,26 +779,17 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     fn dense(&self, ends: [&Sample<N>; 2], x: &DVector<f64>, theta: f64) -> Option<Sample<N>> {
         let [a, b] = ends;
         let (space, system) = (self.discrete.space(), self.discrete.system());
-        let (quadrature, h) = (self.discrete.quadrature(), self.discrete.h());
-        // The step's points in the chart at q_k: the internal points (from the shifted start of
-        // a projected step) and the stored end.
+        // The step's internal points in the chart at q_k (from the shifted start of a projected
+        // step).
         let shift = if self.projected() {
             x.fixed_rows::<N>(self.layout.projection()).into_owned()
         } else {
             SVector::zeros()
         };
-        let end = space.local(&a.q, &b.q)?;
-        let points: Vec<SVector<f64, N>> = (1..self.layout.points())
-            .map(|j| x.fixed_rows::<N>(self.layout.point(j)) + shift)
-            .chain(std::iter::once(end))
-            .collect();
-        let (_, start_rate) = quadrature.path_through(0.0, &points, h);
-        let (_, end_rate) = quadrature.path_through(1.0, &points, h);
-        let d0 = space.chart_velocity(&a.q, &a.v)? - start_rate;
-        let d1 = space.chart_rate(&a.q, &end, &b.v)? - end_rate;
-        let (path, rate) = quadrature.path_through(theta, &points, h);
-        let (correction, rate_correction) = end_slope_correction(theta, h, points.len(), &d0, &d1);
-        let (xi, xi_dot) = (path + correction, rate + rate_correction);
+        let internal = (1..self.layout.points())
+            .map(|j| x.fixed_rows::<N>(self.layout.point(j)) + shift);
+        let (quadrature, h) = (self.discrete.quadrature(), self.discrete.h());
+        let ChartPath { xi, xi_dot, .. } = chart_path(space, quadrature, h, ends, internal, theta)?;
         let q = space.retract(&a.q, &xi);
         let v = space.push_forward(&a.q, &xi, &xi_dot);
         let momentum = |q, v| legendre::momentum(system, q, v);
@@ -1027,21 +1004,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// `ξ_j = c_j h ξ̇` along the state's velocity with zero multipliers.
     fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>) {
         let space = self.discrete.space();
-        match previous {
-            Some(previous) if previous.len() == x.len() => x.copy_from(previous),
-            _ => {
-                x.fill(0.0);
-                let (s, h) = (self.layout.points(), self.discrete.h());
-                let xi_dot = space
-                    .chart_velocity(&state.q, &state.velocity)
-                    .unwrap_or_else(SVector::zeros);
-                for j in 1..=s {
-                    let c = j as f64 / s as f64;
-                    x.rows_mut(self.layout.point(j), N)
-                        .copy_from(&(xi_dot * (c * h)));
-                }
-            }
-        }
+        let xi_dot = space
+            .chart_velocity(&state.q, &state.velocity)
+            .unwrap_or_else(SVector::zeros);
+        self.layout.predict(previous, &xi_dot, self.discrete.h(), x);
         self.momentum = space.pull_back(&state.q, &SVector::zeros(), &state.p);
         for (lifted, &u) in self.lifted_inputs.iter_mut().zip(&self.inputs) {
             *lifted = Dual::from(u);

@@ -39,6 +39,29 @@ impl Layout {
         Self { projection, ..self }
     }
 
+    /// The predictor of a step: `previous` (the stepper's extrapolation of the last solutions)
+    /// where there is one of the right size, else the path `ξ_j = c_j h ξ̇` along the chart
+    /// velocity `xi_dot` (`c_j = j/s`) with zero multipliers.
+    pub(crate) fn predict<const N: usize>(
+        &self,
+        previous: Option<&nalgebra::DVector<f64>>,
+        xi_dot: &nalgebra::SVector<f64, N>,
+        h: f64,
+        x: &mut nalgebra::DVector<f64>,
+    ) {
+        match previous {
+            Some(previous) if previous.len() == x.len() => x.copy_from(previous),
+            _ => {
+                x.fill(0.0);
+                let s = self.points;
+                for j in 1..=s {
+                    let c = j as f64 / s as f64;
+                    x.rows_mut(self.point(j), N).copy_from(&(xi_dot * (c * h)));
+                }
+            }
+        }
+    }
+
     /// Number of unknowns.
     pub(crate) fn len(&self) -> usize {
         self.projection() + self.projection

@@ -2,7 +2,7 @@
 
 use nalgebra::{DMatrix, DVector, SVector};
 
-use crate::derivatives::{Seed, seeded};
+use crate::derivatives::{PhaseFunction, Seed, seeded};
 use crate::newton::{Newton, NewtonFailure};
 use crate::system::DiracSystem;
 
@@ -54,8 +54,8 @@ pub fn energy<S: DiracSystem<N>, const N: usize>(
 ///
 /// Velocities without kinetic energy (`dead`, the coordinates whose rows of `∂²L/∂v²` vanish)
 /// are not determined by `p`; they keep their guess, and the energy does not depend on them.
-pub(crate) fn velocity<S: DiracSystem<N>, const N: usize>(
-    system: &S,
+pub(crate) fn velocity<F: PhaseFunction<N>, const N: usize>(
+    system: &F,
     newton: &mut Newton,
     q: &SVector<f64, N>,
     p: &SVector<f64, N>,
@@ -116,8 +116,8 @@ pub(crate) fn velocity<S: DiracSystem<N>, const N: usize>(
 /// impulses on `D`). The rows stay as many as the unknowns, and the velocity satisfies the
 /// constraints and the first-order equations at `q` exactly, so that a state started from
 /// `(q, p)` passes the start checks.
-pub(crate) fn constrained_velocity<S: DiracSystem<N>, const N: usize>(
-    system: &S,
+pub(crate) fn constrained_velocity<F: PhaseFunction<N>, const N: usize>(
+    system: &F,
     newton: &mut Newton,
     q: &SVector<f64, N>,
     p: &SVector<f64, N>,

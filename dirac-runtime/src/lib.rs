@@ -25,6 +25,7 @@ pub mod event;
 mod first_order;
 mod first_order_scheme;
 mod force;
+pub mod group_euler_lagrange;
 mod hidden_constraint;
 mod holonomic_scheme;
 mod initial_state;

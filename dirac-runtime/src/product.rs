@@ -19,7 +19,7 @@
 
 use nalgebra::{Matrix3, SVector, Vector2, Vector3};
 
-use crate::configuration_space::{ConfigurationSpace, StepCovectors, sealed};
+use crate::configuration_space::{ConfigurationSpace, sealed};
 use crate::manifold::Manifold;
 use crate::rotation::{self, Retraction};
 use crate::scalar::Scalar;
@@ -537,24 +537,22 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
         *q = next;
     }
 
-    fn advance_momentum(
+    fn push_covector(
         &self,
         q: &Configuration<f64, K, A, B>,
         xi: &SVector<f64, N>,
-        p: &mut Rates<f64, K, A, B>,
-        _carry: &mut SVector<f64, N>,
-        covectors: &StepCovectors<N>,
-    ) -> Option<()> {
+        covector: &SVector<f64, N>,
+    ) -> Option<Rates<f64, K, A, B>> {
         const { dimension::<N, K, A, B>() };
         let tau = self.retraction;
-        let end = &covectors.end;
+        let mut p = Rates::zero();
         for i in 0..K {
-            p.vector[i] = end[i];
+            p.vector[i] = covector[i];
         }
         for a in 0..A {
             let at = Self::rotation_at(a);
             let d = tau.differential(&rows3(xi, at));
-            p.rotation[a] = d.transpose().try_inverse()? * rows3(end, at);
+            p.rotation[a] = d.transpose().try_inverse()? * rows3(covector, at);
         }
         for b in 0..B {
             let at = Self::direction_at(b);
@@ -564,10 +562,10 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
                 base,
                 &sphere::frame(base),
                 &rows2(xi, at),
-                &rows2(end, at),
+                &rows2(covector, at),
             )?;
         }
-        Some(())
+        Some(p)
     }
 
     fn retract_moved<D: Scalar>(

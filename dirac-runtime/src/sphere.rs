@@ -117,7 +117,9 @@ pub fn chart_rate(
 }
 
 /// The covector at `R_q(Bζ)` (as a vector of the tangent plane there) whose pull-back to the
-/// chart is `end`: `p = M (MᵀM)⁻¹ end`. `None` where `M` is singular.
+/// chart is `end`: `p = M (MᵀM)⁻¹ end`, for the point [`normalised`]: the radial projection
+/// `y ↦ y/|y|` shrinks tangent vectors by `|y|`, so covectors grow by it (and `q × p`, the
+/// angular momentum, is the same before and after). `None` where `M` is singular.
 pub fn push_covector(
     retraction: Retraction,
     q: &Vector3<f64>,
@@ -126,7 +128,8 @@ pub fn push_covector(
     end: &Vector2<f64>,
 ) -> Option<Vector3<f64>> {
     let m = velocity_map(retraction, q, b, zeta);
-    (m.transpose() * m).try_inverse().map(|g| m * g * end)
+    let radius = retract(retraction, q, &(b * zeta)).norm();
+    (m.transpose() * m).try_inverse().map(|g| m * g * end * radius)
 }
 
 /// `M`: the velocities of the chart's two coordinate directions at `ζ`.

@@ -22,6 +22,7 @@ use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
 use crate::euler_lagrange::{EulerLagrange, check_finite};
 use crate::first_order_scheme::FirstOrderScheme;
+use crate::group_euler_lagrange::GroupEulerLagrange;
 use crate::holonomic_scheme::HolonomicScheme;
 use crate::input::Input;
 use crate::legendre;
@@ -411,6 +412,74 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// assert_eq!(stepper.quadrature().degree(), 2);
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
+    pub fn quadrature(&self) -> &Quadrature {
+        self.equations.discrete().quadrature()
+    }
+}
+
+impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
+    Stepper<S, N, GroupEulerLagrange<S, N, C>>
+{
+    /// A stepper for a model on rotations and unit vectors (a [`Product`](crate::Product) of
+    /// them with ordinary coordinates) whose steps work in the charts of `space`, with
+    /// `quadrature` and step `h` (see [`GroupEulerLagrange`]). Fails as
+    /// [`GroupEulerLagrange::new`] does.
+    ///
+    /// ```
+    /// use dirac_runtime::{Configuration, DiracSystem, Product, Quadrature, Rates, Scalar, Stepper};
+    /// use nalgebra::{Matrix3, vector};
+    ///
+    /// /// A free rigid body with principal moments of inertia (1, 2, 3).
+    /// struct Body;
+    /// impl DiracSystem<3, Product<0, 1, 0>> for Body {
+    ///     fn lagrangian<D: Scalar>(
+    ///         &self,
+    ///         _q: &Configuration<D, 0, 1, 0>,
+    ///         v: &Rates<D, 0, 1, 0>,
+    ///     ) -> D {
+    ///         let w = v.rotation[0];
+    ///         (w[0] * w[0] + w[1] * w[1] * 2.0 + w[2] * w[2] * 3.0) * 0.5
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::on_manifold(Body, Product::cayley(), Quadrature::midpoint(), 0.05)?;
+    /// let start = Configuration { vector: vector![], rotation: [Matrix3::identity()], direction: [] };
+    /// let spin = Rates { vector: vector![], rotation: [vector![0.3, 1.0, 0.2]], direction: [] };
+    /// stepper.start_from_velocity(start, spin)?;
+    /// let before = stepper.q().spatial(&stepper.p(), 0);
+    /// stepper.run(200)?;
+    /// let after = stepper.q().spatial(&stepper.p(), 0);
+    /// assert!((after - before).amax() < 1e-13); // discrete Noether
+    /// let r = stepper.q().rotation[0];
+    /// assert!((r.transpose() * r - Matrix3::identity()).amax() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn on_manifold(
+        system: S,
+        space: C,
+        quadrature: Quadrature,
+        h: f64,
+    ) -> Result<Self, DiracError> {
+        let discrete = DiscreteLagrangian::on_space(system, space, quadrature, h);
+        Self::with_equations(GroupEulerLagrange::new(discrete)?)
+    }
+
+    /// Evaluates the constraint one-forms at `point` of each step instead of the system's default.
+    pub fn with_constraint_point(mut self, point: ConstraintPoint) -> Self {
+        self.equations.set_constraint_point(point);
+        self
+    }
+
+    /// Where the constraint one-forms are evaluated on a step.
+    pub fn constraint_point(&self) -> ConstraintPoint {
+        self.equations.constraint_point()
+    }
+
+    /// The configuration space whose charts the steps work in.
+    pub fn space(&self) -> &C {
+        self.equations.discrete().space()
+    }
+
+    /// The quadrature.
     pub fn quadrature(&self) -> &Quadrature {
         self.equations.discrete().quadrature()
     }
