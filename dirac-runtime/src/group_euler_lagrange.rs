@@ -64,7 +64,7 @@ use crate::system::DiracSystem;
 /// let discrete = DiscreteLagrangian::on_space(Body, Product::cayley(), Quadrature::midpoint(), 0.1);
 /// let equations = GroupEulerLagrange::new(discrete)?;
 /// assert_eq!(equations.unknowns(), 3);
-/// assert_eq!(equations.unknown_name(0), "g0_x (q_{k+1})");
+/// assert_eq!(equations.unknown_name(0), "q0_x (q_{k+1})"); // variable 0 is called q0
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
 #[derive(Debug, Clone)]
