@@ -111,7 +111,11 @@ impl StepEquations<1> for ImplicitMidpoint {
         2
     }
 
-    fn momentum(&self, _q: &SVector<f64, 1>, v: &SVector<f64, 1>) -> Result<SVector<f64, 1>, DiracError> {
+    fn momentum(
+        &self,
+        _q: &SVector<f64, 1>,
+        v: &SVector<f64, 1>,
+    ) -> Result<SVector<f64, 1>, DiracError> {
         Ok(*v)
     }
 

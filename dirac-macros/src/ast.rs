@@ -22,24 +22,70 @@ impl Length {
     }
 }
 
-/// One entry of `coordinates(...)`: `x` or `theta[8]`.
+/// What a coordinate is: a real number, a rotation (`SO3`) or a unit vector (`S2`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    Real,
+    Rotation,
+    Direction,
+}
+
+/// One entry of `coordinates(...)`: `x`, `theta[8]`, `R: SO3`, `n: S2` or `bodies[3]: SO3`.
 #[derive(Clone)]
 pub struct Coordinate {
     pub name: Ident,
     pub length: Option<Length>,
+    pub kind: Kind,
 }
+
+impl Coordinate {
+    /// Whether it is a rotation or a unit vector.
+    pub fn is_group(&self) -> bool {
+        self.kind != Kind::Real
+    }
+}
+
+const SPACES: &str = "a coordinate is real (`x`), a rotation (`R: SO3`) or a unit vector (`n: S2`)";
 
 impl Parse for Coordinate {
     fn parse(input: ParseStream) -> syn::Result<Self> {
         let name: Ident = input.parse().map_err(|e| {
             syn::Error::new(
                 e.span(),
-                "expected a coordinate: a name such as `x` or an array such as `theta[4]`",
+                "expected a coordinate: a name such as `x`, an array such as `theta[4]`, or a \
+                 rotation or unit vector such as `R: SO3`, `n: S2`",
             )
         })?;
-        if !input.peek(syn::token::Bracket) {
-            return Ok(Self { name, length: None });
-        }
+        let length = match input.peek(syn::token::Bracket) {
+            true => Some(Self::length(input)?),
+            false => None,
+        };
+        let kind = match input.peek(Token![:]) {
+            false => Kind::Real,
+            true => {
+                input.parse::<Token![:]>()?;
+                let space: Ident = input.parse().map_err(|e| {
+                    syn::Error::new(e.span(), format!("expected `SO3` or `S2`: {SPACES}"))
+                })?;
+                match space.to_string().as_str() {
+                    "SO3" => Kind::Rotation,
+                    "S2" => Kind::Direction,
+                    other => {
+                        return Err(syn::Error::new(
+                            space.span(),
+                            format!("unknown space `{other}`: {SPACES}"),
+                        ));
+                    }
+                }
+            }
+        };
+        Ok(Self { name, length, kind })
+    }
+}
+
+impl Coordinate {
+    /// `[n]` after a coordinate's name.
+    fn length(input: ParseStream) -> syn::Result<Length> {
         let content;
         bracketed!(content in input);
         let length = match content.parse::<Expr>()? {
@@ -57,10 +103,7 @@ impl Parse for Coordinate {
                 ));
             }
         };
-        Ok(Self {
-            name,
-            length: Some(length),
-        })
+        Ok(length)
     }
 }
 
@@ -94,10 +137,20 @@ pub enum Lagrangian {
     Function(syn::Path),
 }
 
-/// A parameter field of the struct: `f64` or `[f64; K]`.
+/// A parameter field of the struct: `f64`, `[f64; K]` or `[[f64; C]; R]`.
 pub struct Parameter {
     pub name: Ident,
-    pub array: bool,
+    pub shape: Shape,
+}
+
+/// The shape of a parameter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    Scalar,
+    /// `[f64; K]`, with `K` when it is a literal (a 3-vector where `K = 3`).
+    Array(Option<usize>),
+    /// `[[f64; C]; R]`, with `(R, C)` when both are literals (a matrix where both are 3).
+    Matrix(Option<(usize, usize)>),
 }
 
 /// Everything `expand` needs, validated; expressions already rewritten for the scalar `__D`.
@@ -125,14 +178,20 @@ pub struct Model {
     pub krate: syn::Path,
 }
 
-/// Number of coordinates as a const expression (a literal when every length is one).
+/// Number of coordinates as a const expression (a literal when every length is one). A rotation
+/// has three chart coordinates and a unit vector two.
 pub fn dimension(coordinates: &[Coordinate]) -> TokenStream {
+    let width = |c: &Coordinate| match c.kind {
+        Kind::Real => 1,
+        Kind::Rotation => 3,
+        Kind::Direction => 2,
+    };
     // `None` also when the sum overflows: rustc then reports the overflow in the expression.
     let literal: Option<usize> = coordinates
         .iter()
         .try_fold(0usize, |sum, c| match &c.length {
-            None => sum.checked_add(1),
-            Some(Length::Literal(n, _)) => sum.checked_add(*n),
+            None => sum.checked_add(width(c)),
+            Some(Length::Literal(n, _)) => sum.checked_add(n.checked_mul(width(c))?),
             Some(Length::Named(_)) => None,
         });
     match (literal, coordinates) {
@@ -153,19 +212,46 @@ pub fn dimension(coordinates: &[Coordinate]) -> TokenStream {
     }
 }
 
-/// Offset of each coordinate in `q` (expressions).
+/// Where each coordinate starts among those of its kind (expressions): a real coordinate's index
+/// in `q` (on a product, in its vector part), a rotation's or unit vector's index among the
+/// rotations or unit vectors.
 pub fn offsets(coordinates: &[Coordinate]) -> Vec<TokenStream> {
-    let mut offset = quote::quote!(0usize);
+    let mut next =
+        [Kind::Real, Kind::Rotation, Kind::Direction].map(|k| (k, quote::quote!(0usize)));
     coordinates
         .iter()
         .map(|c| {
+            let (_, offset) = next
+                .iter_mut()
+                .find(|(k, _)| *k == c.kind)
+                .expect("every kind has a counter");
             let this = offset.clone();
             let length = c
                 .length
                 .as_ref()
                 .map_or(quote::quote!(1usize), Length::tokens);
-            offset = quote::quote!(#offset + #length);
+            *offset = quote::quote!(#offset + #length);
             this
         })
         .collect()
+}
+
+/// The sizes `(K, A, B)` of a product model: its real coordinates, rotations and unit vectors
+/// (every length a literal: checked before).
+pub fn product_sizes(coordinates: &[Coordinate]) -> (usize, usize, usize) {
+    let count = |kind: Kind| {
+        coordinates
+            .iter()
+            .filter(|c| c.kind == kind)
+            .map(|c| match &c.length {
+                Some(Length::Literal(n, _)) => *n,
+                _ => 1,
+            })
+            .sum::<usize>()
+    };
+    (
+        count(Kind::Real),
+        count(Kind::Rotation),
+        count(Kind::Direction),
+    )
 }

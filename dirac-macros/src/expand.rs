@@ -4,7 +4,9 @@ use proc_macro2::{Span, TokenStream};
 use quote::{quote, quote_spanned};
 use syn::spanned::Spanned;
 
-use crate::ast::{Arguments, Coordinate, Lagrangian, Model, dimension, offsets};
+use crate::ast::{
+    Arguments, Coordinate, Kind, Lagrangian, Model, Shape, dimension, offsets, product_sizes,
+};
 use crate::expression::{Context, bind_coordinate, part_ident};
 use crate::validate::{self, Outcome};
 
@@ -55,19 +57,61 @@ fn in_scope(krate: &syn::Path, items: TokenStream) -> TokenStream {
     }
 }
 
-fn header(item: &syn::ItemStruct, n: &TokenStream) -> TokenStream {
+/// The types the generated code is written in: on `Rⁿ`, vectors; with rotations or unit vectors,
+/// the `Product` space's points and tangent vectors.
+struct Space {
+    /// `DiracSystem<N>` or `DiracSystem<N, Product<K, A, B>>`.
+    trait_: TokenStream,
+    /// The type of `__q` (over `__D`).
+    point: TokenStream,
+    /// The type of `__v` and of one-forms and forces (over `__D`).
+    tangent: TokenStream,
+    /// A zero tangent vector over `__D`.
+    zero: TokenStream,
+    /// Whether the space is a `Product` (real coordinates are then in `__q.vector`).
+    product: bool,
+}
+
+impl Space {
+    fn of(coordinates: &[Coordinate]) -> Self {
+        let n = dimension(coordinates);
+        if !validate::is_product(coordinates) {
+            let vector = quote!(__dirac::nalgebra::SVector<__D, #n>);
+            let zero = quote!(<__D as ::core::convert::From<f64>>::from(0.0));
+            return Self {
+                trait_: quote!(__dirac::DiracSystem<#n>),
+                point: vector.clone(),
+                tangent: vector.clone(),
+                zero: quote!(__dirac::nalgebra::SVector::<__D, #n>::from_element(#zero)),
+                product: false,
+            };
+        }
+        let (k, a, b) = product_sizes(coordinates);
+        Self {
+            trait_: quote!(__dirac::DiracSystem<#n, __dirac::Product<#k, #a, #b>>),
+            point: quote!(__dirac::Configuration<__D, #k, #a, #b>),
+            tangent: quote!(__dirac::Rates<__D, #k, #a, #b>),
+            zero: quote!(__dirac::Rates::<__D, #k, #a, #b>::zero()),
+            product: true,
+        }
+    }
+}
+
+fn header(item: &syn::ItemStruct, space: &Space) -> TokenStream {
     let name = &item.ident;
+    let trait_ = &space.trait_;
     let (impl_generics, ty_generics, where_clause) = item.generics.split_for_impl();
-    quote!(impl #impl_generics __dirac::DiracSystem<#n> for #name #ty_generics #where_clause)
+    quote!(impl #impl_generics #trait_ for #name #ty_generics #where_clause)
 }
 
 fn expand(model: &Model) -> TokenStream {
     let item = &model.item;
     let n = dimension(&model.coordinates);
-    let header = header(item, &n);
+    let space = Space::of(&model.coordinates);
+    let header = header(item, &space);
     let offsets = offsets(&model.coordinates);
     let bindings = |velocities: bool| {
-        // Parameters stay f64: constant subexpressions cost no dual arithmetic.
+        // Parameters stay f64: constant subexpressions cost no dual-number work.
         let parameters = model.parameters.iter().map(|p| {
             let name = &p.name;
             quote_spanned!(name.span()=> let #name = self.#name;)
@@ -76,7 +120,7 @@ fn expand(model: &Model) -> TokenStream {
             .coordinates
             .iter()
             .zip(&offsets)
-            .map(move |(c, o)| bind_coordinate(c, o, velocities));
+            .map(move |(c, o)| bind_coordinate(c, o, velocities, space.product));
         quote!(#(#parameters)* #(#coordinates)*)
     };
     let body = match &model.lagrangian {
@@ -90,37 +134,31 @@ fn expand(model: &Model) -> TokenStream {
             }
         }
     };
-    let dirac = dirac_items(model, &n, &bindings);
+    let dirac = dirac_items(model, &space, &bindings);
     let closed_form = closed_form(model, &n);
-    let parts = parts(model, &n, &bindings);
-    let names = model.coordinates.iter().zip(&offsets).map(|(c, offset)| {
-        let name = c.name.to_string();
-        match &c.length {
-            None => quote!(if __i == #offset { return ::std::string::String::from(#name); }),
-            Some(length) => {
-                let length = length.tokens();
-                quote! {
-                    if __i >= #offset && __i < #offset + #length {
-                        return ::std::format!("{}[{}]", #name, __i - (#offset));
-                    }
-                }
-            }
-        }
-    });
+    let parts = parts(model, &space, &bindings);
+    let names = variable_names(&model.coordinates);
     let parameters = model.parameters.iter().map(|p| {
         let name = &p.name;
         let label = name.to_string();
-        if p.array {
-            quote! {
+        match p.shape {
+            Shape::Scalar => quote!(__p.push((::std::string::String::from(#label), self.#name));),
+            Shape::Array(_) => quote! {
                 for (__k, __x) in self.#name.iter().enumerate() {
                     __p.push((::std::format!("{}[{}]", #label, __k), *__x));
                 }
-            }
-        } else {
-            quote!(__p.push((::std::string::String::from(#label), self.#name));)
+            },
+            Shape::Matrix(_) => quote! {
+                for (__r, __row) in self.#name.iter().enumerate() {
+                    for (__c, __x) in __row.iter().enumerate() {
+                        __p.push((::std::format!("{}[{}][{}]", #label, __r, __c), *__x));
+                    }
+                }
+            },
         }
     });
     let quadrature = &model.quadrature;
+    let (point, tangent) = (&space.point, &space.tangent);
     let implementation = quote! {
         #parts
 
@@ -129,15 +167,15 @@ fn expand(model: &Model) -> TokenStream {
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
             fn lagrangian<__D: __dirac::Scalar>(
                 &self,
-                __q: &__dirac::nalgebra::SVector<__D, #n>,
-                __v: &__dirac::nalgebra::SVector<__D, #n>,
+                __q: &#point,
+                __v: &#tangent,
             ) -> __D {
                 #body
             }
 
             #[allow(clippy::all)]
             fn coordinate_name(&self, __i: usize) -> ::std::string::String {
-                #(#names)*
+                #names
                 ::std::format!("q{}", __i)
             }
 
@@ -158,6 +196,35 @@ fn expand(model: &Model) -> TokenStream {
     };
     let implementation = in_scope(&model.krate, implementation);
     quote!(#item #implementation)
+}
+
+/// The body of `coordinate_name`: the model's variables in the manifold's order (on a product,
+/// the real coordinates, then the rotations, then the unit vectors), array elements as `x[i]`.
+fn variable_names(coordinates: &[Coordinate]) -> TokenStream {
+    let mut next = quote!(0usize);
+    let mut arms = Vec::new();
+    for kind in [Kind::Real, Kind::Rotation, Kind::Direction] {
+        for c in coordinates.iter().filter(|c| c.kind == kind) {
+            let name = c.name.to_string();
+            let offset = next.clone();
+            arms.push(match &c.length {
+                None => {
+                    next = quote!(#next + 1usize);
+                    quote!(if __i == #offset { return ::std::string::String::from(#name); })
+                }
+                Some(length) => {
+                    let length = length.tokens();
+                    next = quote!(#next + #length);
+                    quote! {
+                        if __i >= #offset && __i < #offset + #length {
+                            return ::std::format!("{}[{}]", #name, __i - (#offset));
+                        }
+                    }
+                }
+            });
+        }
+    }
+    quote!(#(#arms)*)
 }
 
 /// `lagrangian_gradient` and `lagrangian_hessian` where the Lagrangian has closed forms: the
@@ -215,23 +282,23 @@ fn input_bindings(model: &Model) -> TokenStream {
 
 /// The hoisted continuations of long chains, as private methods of the model (none for a model
 /// without chains longer than one chunk). Each binds what its context's method binds.
-fn parts(model: &Model, n: &TokenStream, bindings: &dyn Fn(bool) -> TokenStream) -> TokenStream {
+fn parts(model: &Model, space: &Space, bindings: &dyn Fn(bool) -> TokenStream) -> TokenStream {
     if model.parts.is_empty() {
         return TokenStream::new();
     }
-    let vector = quote!(&__dirac::nalgebra::SVector<__D, #n>);
+    let (point, tangent) = (&space.point, &space.tangent);
     let methods = model.parts.iter().enumerate().map(|(k, part)| {
         let (parameters, prelude) = match part.context {
-            Context::Lagrangian => (quote!(__q: #vector, __v: #vector,), bindings(true)),
+            Context::Lagrangian => (quote!(__q: &#point, __v: &#tangent,), bindings(true)),
             Context::Force => {
                 let state = bindings(true);
                 let inputs = input_bindings(model);
                 (
-                    quote!(__q: #vector, __v: #vector, t: f64, __inputs: &[__D],),
+                    quote!(__q: &#point, __v: &#tangent, t: f64, __inputs: &[__D],),
                     quote!(#state #inputs),
                 )
             }
-            Context::Positions => (quote!(__q: #vector,), bindings(false)),
+            Context::Positions => (quote!(__q: &#point,), bindings(false)),
         };
         let (name, body, scalar) = (part_ident(k), &part.body, &part.scalar);
         quote! {
@@ -266,11 +333,12 @@ fn accumulate(target: &TokenStream, terms: &[crate::ast::Term]) -> TokenStream {
 /// The one-forms, holonomic constraints, forces and inputs: only those the model names.
 fn dirac_items(
     model: &Model,
-    n: &TokenStream,
+    space: &Space,
     bindings: &dyn Fn(bool) -> TokenStream,
 ) -> TokenStream {
     let mut items = TokenStream::new();
     let zero = quote!(<__D as ::core::convert::From<f64>>::from(0.0));
+    let (point, tangent, zero_tangent) = (&space.point, &space.tangent, &space.zero);
     if !model.one_forms.is_empty() {
         let count = model.one_forms.len();
         let positions = bindings(false);
@@ -284,11 +352,11 @@ fn dirac_items(
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
             fn one_form<__D: __dirac::Scalar>(
                 &self,
-                __q: &__dirac::nalgebra::SVector<__D, #n>,
+                __q: &#point,
                 __a: usize,
-            ) -> __dirac::nalgebra::SVector<__D, #n> {
+            ) -> #tangent {
                 #positions
-                let mut __w = __dirac::nalgebra::SVector::<__D, #n>::from_element(#zero);
+                let mut __w = #zero_tangent;
                 match __a {
                     #(#arms)*
                     _ => {}
@@ -311,7 +379,7 @@ fn dirac_items(
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
             fn holonomic<__D: __dirac::Scalar>(
                 &self,
-                __q: &__dirac::nalgebra::SVector<__D, #n>,
+                __q: &#point,
                 __b: usize,
             ) -> __D {
                 #positions
@@ -332,14 +400,14 @@ fn dirac_items(
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
             fn force<__D: __dirac::Scalar>(
                 &self,
-                __q: &__dirac::nalgebra::SVector<__D, #n>,
-                __v: &__dirac::nalgebra::SVector<__D, #n>,
+                __q: &#point,
+                __v: &#tangent,
                 t: f64,
                 __inputs: &[__D],
-            ) -> __dirac::nalgebra::SVector<__D, #n> {
+            ) -> #tangent {
                 #state
                 #inputs
-                let mut __f = __dirac::nalgebra::SVector::<__D, #n>::from_element(#zero);
+                let mut __f = #zero_tangent;
                 #sum
                 __f
             }
@@ -370,14 +438,15 @@ fn dirac_items(
 /// After an error: an implementation with the right dimension, so that the user's code using
 /// the system reports no second wave of errors. It is never run: compilation has failed.
 fn stub(item: &syn::ItemStruct, coordinates: &[Coordinate]) -> TokenStream {
-    let n = dimension(coordinates);
-    let header = header(item, &n);
+    let space = Space::of(coordinates);
+    let header = header(item, &space);
+    let (point, tangent) = (&space.point, &space.tangent);
     quote! {
         #header {
             fn lagrangian<__D: __dirac::Scalar>(
                 &self,
-                _: &__dirac::nalgebra::SVector<__D, #n>,
-                _: &__dirac::nalgebra::SVector<__D, #n>,
+                _: &#point,
+                _: &#tangent,
             ) -> __D {
                 ::core::unreachable!("#[dirac_system] reported a compile error")
             }

@@ -79,6 +79,9 @@ pub struct Scope<'a> {
     pub context: Context,
     /// The model's hoisted parts of long chains, shared by every expression of the model.
     pub parts: &'a RefCell<Vec<Part>>,
+    /// Whether the expression was lowered from vectors and matrices (a model on rotations and
+    /// unit vectors), so that its atoms are bound scalars (see `vector_algebra`).
+    pub atoms: bool,
 }
 
 /// The generated method an expression is emitted into, which fixes what its hoisted parts are
@@ -703,6 +706,9 @@ impl<'a> Rewriter<'a> {
         let Some(ident) = p.path.get_ident() else {
             return Piece::atom(tokens, Class::Constant, span);
         };
+        if self.scope.atoms && crate::vector_algebra::is_atom(ident) {
+            return Piece::atom(tokens, Class::Dual, span);
+        }
         if is_reserved(ident) && !self.scope.fields.contains(ident) {
             return self.error(ident.span(), reserved_message(ident));
         }
@@ -727,6 +733,21 @@ impl<'a> Rewriter<'a> {
 
     /// `theta[i]` of a coordinate array is a dual number, `m[i]` of a parameter array a constant.
     fn index_expr(&mut self, ix: &syn::ExprIndex, expr: &Expr) -> Piece {
+        // `J[i][j]` of a parameter `[[f64; C]; R]`: a constant.
+        if let Expr::Index(inner) = &*ix.expr
+            && let Expr::Path(p) = &*inner.expr
+            && p.path
+                .get_ident()
+                .is_some_and(|i| self.scope.fields.contains(i))
+        {
+            let message = "an index is an integer constant: a literal or a `const`, e.g. j[0][1]";
+            if !self.integer_constant(&inner.index, message)
+                || !self.integer_constant(&ix.index, message)
+            {
+                return Piece::invalid(bounds(expr).0);
+            }
+            return Piece::atom(ix.to_token_stream(), Class::Constant, bounds(expr).0);
+        }
         let Expr::Path(p) = &*ix.expr else {
             return self.unsupported(expr);
         };
@@ -905,31 +926,90 @@ impl Rewriter<'_> {
     }
 }
 
-/// Binds a coordinate's position and velocity (`__D`, or `[__D; K]` for an array) from `__q`, `__v`.
-/// Without `velocities` only the position is bound (for one-forms and holonomic constraints).
+/// Binds a coordinate's position and velocity (`__D`, or `[__D; K]` for an array) from `__q`, `__v`
+/// (on a product, their vector parts); a rotation or unit vector binds its entries as the atoms of
+/// `vector_algebra`. Without `velocities` only the position is bound (for one-forms and
+/// holonomic constraints).
 pub fn bind_coordinate(
     coordinate: &Coordinate,
     offset: &TokenStream,
     velocities: bool,
+    product: bool,
 ) -> TokenStream {
     let name = &coordinate.name;
     let velocity = velocity_ident(name);
     let span = name.span();
+    let (q, v) = match product {
+        true => (
+            quote_spanned!(span=> __q.vector),
+            quote_spanned!(span=> __v.vector),
+        ),
+        false => (quote_spanned!(span=> __q), quote_spanned!(span=> __v)),
+    };
+    if coordinate.is_group() {
+        return bind_group(coordinate, offset, velocities);
+    }
     match (&coordinate.length, velocities) {
         (None, true) => quote_spanned! {span=>
-            let #name: __D = __q[#offset];
-            let #velocity: __D = __v[#offset];
+            let #name: __D = #q[#offset];
+            let #velocity: __D = #v[#offset];
         },
-        (None, false) => quote_spanned!(span=> let #name: __D = __q[#offset];),
+        (None, false) => quote_spanned!(span=> let #name: __D = #q[#offset];),
         (Some(length), velocities) => {
             let length = length.tokens();
-            let velocity = velocities.then(|| quote_spanned! {span=>
-                let #velocity: [__D; #length] = ::core::array::from_fn(|__i| __v[#offset + __i]);
+            let velocity = velocities.then(|| {
+                quote_spanned! {span=>
+                    let #velocity: [__D; #length] = ::core::array::from_fn(|__i| #v[#offset + __i]);
+                }
             });
             quote_spanned! {span=>
-                let #name: [__D; #length] = ::core::array::from_fn(|__i| __q[#offset + __i]);
+                let #name: [__D; #length] = ::core::array::from_fn(|__i| #q[#offset + __i]);
                 #velocity
             }
         }
     }
+}
+
+/// The atoms of a rotation (its matrix's entries and body angular velocity) or of a unit vector
+/// (its components and velocity), for each element of an array (lengths are literals here).
+fn bind_group(coordinate: &Coordinate, offset: &TokenStream, velocities: bool) -> TokenStream {
+    use crate::ast::Kind;
+    use crate::vector_algebra::atom;
+    let name = &coordinate.name;
+    let elements: Vec<Option<usize>> = match &coordinate.length {
+        Some(Length::Literal(n, _)) => (0..*n).map(Some).collect(),
+        _ => vec![None],
+    };
+    let mut out = TokenStream::new();
+    for element in elements {
+        let at = match element {
+            None => offset.clone(),
+            Some(e) => quote!(#offset + #e),
+        };
+        match coordinate.kind {
+            Kind::Rotation => {
+                for r in 0..3usize {
+                    for c in 0..3usize {
+                        let entry = atom("R", name, element, &[r, c]);
+                        out.extend(quote!(let #entry: __D = __q.rotation[#at][(#r, #c)];));
+                    }
+                }
+                for c in (0..3usize).filter(|_| velocities) {
+                    let rate = atom("W", name, element, &[c]);
+                    out.extend(quote!(let #rate: __D = __v.rotation[#at][#c];));
+                }
+            }
+            _ => {
+                for c in 0..3usize {
+                    let entry = atom("S", name, element, &[c]);
+                    out.extend(quote!(let #entry: __D = __q.direction[#at][#c];));
+                }
+                for c in (0..3usize).filter(|_| velocities) {
+                    let rate = atom("V", name, element, &[c]);
+                    out.extend(quote!(let #rate: __D = __v.direction[#at][#c];));
+                }
+            }
+        }
+    }
+    out
 }

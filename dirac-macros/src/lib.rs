@@ -13,6 +13,7 @@ mod one_form;
 mod quadrature;
 mod symbolic;
 mod validate;
+mod vector_algebra;
 
 /// Turns a struct of parameters into a `dirac::DiracSystem`.
 ///

@@ -9,6 +9,7 @@ use syn::{BinOp, Expr, ExprIndex, UnOp};
 
 use crate::ast::{Coordinate, Length, Term, offsets};
 use crate::expression::{Family, Piece, Rewriter, bounds, spine, subexpressions};
+use crate::vector_algebra::differential_index;
 
 /// Splits `form` into terms `coefficient · d(coordinate)`; errors go into the rewriter's context.
 pub fn terms(form: &Expr, rewriter: &mut Rewriter) -> Vec<Term> {
@@ -60,9 +61,19 @@ fn collected(parts: Vec<Part>, rewriter: &Rewriter) -> Vec<Part> {
         .collect()
 }
 
-/// Whether the differential of one of `coordinates` occurs in `expr`.
+/// Whether the differential of one of `coordinates` occurs in `expr` (or a lowered differential
+/// of a rotation or unit vector).
 pub fn has_differential(expr: &Expr, coordinates: &[Coordinate]) -> bool {
-    subexpressions(expr).any(|e| differential(coordinates, e).is_some())
+    subexpressions(expr).any(|e| differential(coordinates, e).is_some() || lowered(e).is_some())
+}
+
+/// The index among a tangent vector's numbers of a lowered differential `dR`, `dn` (see
+/// `vector_algebra`).
+fn lowered(expr: &Expr) -> Option<usize> {
+    match expr {
+        Expr::Path(p) => differential_index(p.path.get_ident()?),
+        _ => None,
+    }
 }
 
 /// `dx` or `dtheta[i]`: the coordinate's position and the indexing, not yet checked.
@@ -199,6 +210,10 @@ impl Splitter<'_, '_> {
         }
         if let Some((k, index)) = differential(self.coordinates(), expr) {
             return self.differential(k, index, expr);
+        }
+        if let Some(index) = lowered(expr) {
+            let span = bounds(expr).0;
+            return vec![(quote_spanned!(span=> #index), Piece::one(span))];
         }
         match expr {
             Expr::Paren(p) => self.split(&p.expr, depth + 1),

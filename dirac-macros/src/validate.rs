@@ -1,5 +1,6 @@
 //! Checks the attribute and the struct, collecting every error with the span of the user's tokens.
 
+use std::borrow::Cow;
 use std::cell::RefCell;
 use std::collections::HashSet;
 
@@ -9,9 +10,10 @@ use syn::punctuated::Punctuated;
 use syn::spanned::Spanned;
 use syn::{Expr, Fields, GenericParam, Ident, Meta, Token, Type};
 
-use crate::ast::{Arguments, Coordinate, Lagrangian, Length, Model, Parameter};
+use crate::ast::{Arguments, Coordinate, Lagrangian, Length, Model, Parameter, Shape};
 use crate::expression::{Context, Part, Rewriter, Scope, bounds, is_reserved, reserved_message};
 use crate::symbolic;
+use crate::vector_algebra::{self, Algebra};
 use crate::{expression, one_form, quadrature};
 
 const KEYS: &str = "`coordinates(...)`, `lagrangian = ...`, `quadrature = ...`, \
@@ -191,6 +193,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     let coordinates = match e.coordinates {
         Some((_, Some(list))) => {
             check_coordinates(&list, &parameters, &item, &mut errors);
+            check_product(&list, e.holonomic.as_deref(), &mut errors);
             Some(list)
         }
         Some((_, None)) => None,
@@ -216,7 +219,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
             None
         }
         (Some(expr), Some(coordinates)) => {
-            let n = literal_dimension(coordinates);
+            let n = literal_dimension(coordinates).filter(|_| !is_product(coordinates));
             let closed = n.and_then(|n| symbolic::closed_form(&expr, coordinates, n));
             let lagrangian = lagrangian_of(expr, coordinates, &parameters, &parts, &mut errors);
             // A function path has no expression to differentiate.
@@ -256,22 +259,41 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     let fields: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
     let (one_forms, holonomic, forces) = match &coordinates {
         Some(coordinates) => {
+            let product = is_product(coordinates);
+            const NO_VELOCITIES: &str =
+                "constraints depend on positions only: dot(...) cannot appear here";
             let positions = Scope {
                 coordinates,
                 inputs: &[],
                 fields: &fields,
-                no_velocities: Some(
-                    "constraints depend on positions only: dot(...) cannot appear here",
-                ),
+                no_velocities: Some(NO_VELOCITIES),
                 elsewhere: "",
                 context: Context::Positions,
                 parts: &parts,
+                atoms: product,
             };
+            // On rotations and unit vectors, one-forms and forces are lowered to scalars first.
+            let algebra = |no_velocities| {
+                product.then_some(Algebra {
+                    coordinates,
+                    parameters: &parameters,
+                    no_velocities,
+                    differentials: true,
+                })
+            };
+            let (positions_algebra, state_algebra) = (algebra(Some(NO_VELOCITIES)), algebra(None));
             let one_forms = e
                 .constraints
                 .unwrap_or_default()
                 .iter()
-                .map(|form| one_form::terms(form, &mut Rewriter::new(&positions, &mut errors)))
+                .map(
+                    |form| match lowered(form, positions_algebra.as_ref(), &mut errors) {
+                        Some(form) => {
+                            one_form::terms(&form, &mut Rewriter::new(&positions, &mut errors))
+                        }
+                        None => Vec::new(),
+                    },
+                )
                 .collect();
             let holonomic = e
                 .holonomic
@@ -287,12 +309,20 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 elsewhere: "",
                 context: Context::Force,
                 parts: &parts,
+                atoms: product,
             };
             let forces = e
                 .forces
                 .unwrap_or_default()
                 .iter()
-                .flat_map(|form| one_form::terms(form, &mut Rewriter::new(&state, &mut errors)))
+                .flat_map(
+                    |form| match lowered(form, state_algebra.as_ref(), &mut errors) {
+                        Some(form) => {
+                            one_form::terms(&form, &mut Rewriter::new(&state, &mut errors))
+                        }
+                        None => Vec::new(),
+                    },
+                )
                 .collect();
             (one_forms, holonomic, forces)
         }
@@ -410,6 +440,7 @@ fn lagrangian_of(
         }
     }
     let fields: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
+    let product = is_product(coordinates);
     let scope = Scope {
         coordinates,
         inputs: &[],
@@ -419,8 +450,63 @@ fn lagrangian_of(
                     `lagrangian = path::to::function`",
         context: Context::Lagrangian,
         parts,
+        atoms: product,
+    };
+    let expr = match product {
+        false => expr,
+        true => {
+            let algebra = Algebra {
+                coordinates,
+                parameters,
+                no_velocities: None,
+                differentials: false,
+            };
+            vector_algebra::lower(&expr, &algebra, errors)?
+        }
     };
     expression::rewrite(&expr, &scope, errors).map(Lagrangian::Expression)
+}
+
+/// `form` lowered from vectors and matrices (a model on rotations and unit vectors, `algebra`
+/// given), or `form` itself (borrowed: cloning a long chain would recurse as deep as it is long).
+fn lowered<'f>(
+    form: &'f Expr,
+    algebra: Option<&Algebra>,
+    errors: &mut Errors,
+) -> Option<Cow<'f, Expr>> {
+    match algebra {
+        None => Some(Cow::Borrowed(form)),
+        Some(algebra) => vector_algebra::lower(form, algebra, errors).map(Cow::Owned),
+    }
+}
+
+/// Whether the model has rotations or unit vectors (its manifold is a `Product`).
+pub fn is_product(coordinates: &[Coordinate]) -> bool {
+    coordinates.iter().any(Coordinate::is_group)
+}
+
+/// A model on rotations and unit vectors sizes its product space by literals and has no
+/// holonomic constraints.
+fn check_product(coordinates: &[Coordinate], holonomic: Option<&[Expr]>, errors: &mut Errors) {
+    if !is_product(coordinates) {
+        return;
+    }
+    for c in coordinates {
+        if let Some(Length::Named(n)) = &c.length {
+            errors.push(
+                n.span(),
+                "a model with rotations or unit vectors sizes its arrays by integer literals",
+            );
+        }
+    }
+    if let Some(first) = holonomic.and_then(|h| h.first()) {
+        let (start, _) = bounds(first);
+        errors.push(
+            start,
+            "holonomic constraints are not offered with rotations or unit vectors: write their \
+             differentials as one-forms in constraints(...)",
+        );
+    }
 }
 
 fn check_coordinates(
@@ -501,6 +587,13 @@ fn parameters(item: &syn::ItemStruct, errors: &mut Errors) -> Vec<Parameter> {
     };
     let is_f64 =
         |ty: &Type| matches!(ty, Type::Path(p) if p.qself.is_none() && p.path.is_ident("f64"));
+    let literal = |len: &Expr| match len {
+        Expr::Lit(syn::ExprLit {
+            lit: syn::Lit::Int(i),
+            ..
+        }) => i.base10_parse::<usize>().ok(),
+        _ => None,
+    };
     fields
         .iter()
         .filter_map(|field| {
@@ -508,13 +601,26 @@ fn parameters(item: &syn::ItemStruct, errors: &mut Errors) -> Vec<Parameter> {
             if is_reserved(&name) {
                 errors.push(name.span(), reserved_message(&name));
             }
-            match &field.ty {
-                ty if is_f64(ty) => Some(Parameter { name, array: false }),
-                Type::Array(a) if is_f64(&a.elem) => Some(Parameter { name, array: true }),
-                other => {
+            let shape = match &field.ty {
+                ty if is_f64(ty) => Some(Shape::Scalar),
+                Type::Array(a) if is_f64(&a.elem) => Some(Shape::Array(literal(&a.len))),
+                Type::Array(outer) => match &*outer.elem {
+                    Type::Array(inner) if is_f64(&inner.elem) => {
+                        Some(Shape::Matrix(literal(&outer.len).zip(literal(&inner.len))))
+                    }
+                    _ => None,
+                },
+                _ => None,
+            };
+            match shape {
+                Some(shape) => Some(Parameter { name, shape }),
+                None => {
                     errors.push(
-                        other.span(),
-                        format!("parameter `{name}` must be `f64` or `[f64; K]`: parameters are real numbers"),
+                        field.ty.span(),
+                        format!(
+                            "parameter `{name}` must be `f64`, `[f64; K]` or `[[f64; C]; R]`: \
+                             parameters are real numbers"
+                        ),
                     );
                     None
                 }

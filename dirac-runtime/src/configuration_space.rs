@@ -232,7 +232,10 @@ fn tangent_map<C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>(
 }
 
 /// [`ConfigurationSpace::chart_rate`] of a space of vectors from its tangent map.
-pub(crate) fn chart_rate_by_tangent_map<C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>(
+pub(crate) fn chart_rate_by_tangent_map<
+    C: ConfigurationSpace<N, Manifold = Vectors>,
+    const N: usize,
+>(
     space: &C,
     q: &SVector<f64, N>,
     xi: &SVector<f64, N>,
@@ -242,7 +245,10 @@ pub(crate) fn chart_rate_by_tangent_map<C: ConfigurationSpace<N, Manifold = Vect
 }
 
 /// [`ConfigurationSpace::push_covector`] of a space of vectors from its tangent map.
-pub(crate) fn covector_by_tangent_map<C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>(
+pub(crate) fn covector_by_tangent_map<
+    C: ConfigurationSpace<N, Manifold = Vectors>,
+    const N: usize,
+>(
     space: &C,
     q: &SVector<f64, N>,
     xi: &SVector<f64, N>,

@@ -23,10 +23,10 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors};
-use crate::manifold::Vectors;
 pub use crate::constraint_point::ConstraintPoint;
 use crate::derivatives::{gradient, lift};
 use crate::layout::Layout;
+use crate::manifold::Vectors;
 use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
 
@@ -334,7 +334,11 @@ pub(crate) fn holonomic_forms<
 
 /// The largest constraint violation of a step `ξ` from `q0` to `q1`: `|Ã(ξ_c) ξ|` over the
 /// one-forms (on `Rⁿ`, `|A(q_c)(q1 − q0)|`) and `|g(q1)|` over the holonomic constraints.
-pub(crate) fn violation<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>(
+pub(crate) fn violation<
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+    const N: usize,
+>(
     system: &S,
     space: &C,
     point: ConstraintPoint,

@@ -151,9 +151,8 @@ where
         blocks: Vec::new(),
     };
     if !mixed {
-        let eta = SVector::<Dual<N>, N>::from_fn(|i, _| {
-            Dual::<N>::new(0.0, Derivative::some(unit(i)))
-        });
+        let eta =
+            SVector::<Dual<N>, N>::from_fn(|i, _| Dual::<N>::new(0.0, Derivative::some(unit(i))));
         let lifted: Vec<SVector<Dual<N>, N>> =
             points.iter().map(|x| x.map(Dual::<N>::from)).collect();
         moving_action(system, space, base, quadrature, h, &eta, &lifted, |term| {
@@ -166,15 +165,27 @@ where
     type H<const N: usize> = HyperDualSVec64<N, N>;
     for m in 0..points.len() {
         let eta = SVector::<H<N>, N>::from_fn(|i, _| {
-            H::<N>::new(0.0, Derivative::some(unit(i)), Derivative::none(), Derivative::none())
+            H::<N>::new(
+                0.0,
+                Derivative::some(unit(i)),
+                Derivative::none(),
+                Derivative::none(),
+            )
         });
         let seeded: Vec<SVector<H<N>, N>> = points
             .iter()
             .enumerate()
             .map(|(j, x)| {
                 SVector::from_fn(|c, _| {
-                    let eps2 = (j == m).then(|| SMatrix::<f64, 1, N>::from_fn(|_, i| if i == c { 1.0 } else { 0.0 }));
-                    H::<N>::new(x[c], Derivative::none(), Derivative::new(eps2), Derivative::none())
+                    let eps2 = (j == m).then(|| {
+                        SMatrix::<f64, 1, N>::from_fn(|_, i| if i == c { 1.0 } else { 0.0 })
+                    });
+                    H::<N>::new(
+                        x[c],
+                        Derivative::none(),
+                        Derivative::new(eps2),
+                        Derivative::none(),
+                    )
                 })
             })
             .collect();

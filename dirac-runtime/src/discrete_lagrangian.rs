@@ -21,8 +21,8 @@ use crate::derivatives::{
     InChart, PhaseFunction, Seed, directional_gradient, gradients, hessian, moving_row, seeded,
     third_derivative,
 };
-use crate::manifold::Vectors;
 use crate::error::DiracError;
+use crate::manifold::Vectors;
 use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
 

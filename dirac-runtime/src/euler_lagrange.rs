@@ -272,7 +272,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         Ok(())
     }
 
-
     fn constrained() -> bool {
         S::ONE_FORMS + S::HOLONOMIC > 0
     }
@@ -786,8 +785,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         } else {
             SVector::zeros()
         };
-        let internal = (1..self.layout.points())
-            .map(|j| x.fixed_rows::<N>(self.layout.point(j)) + shift);
+        let internal =
+            (1..self.layout.points()).map(|j| x.fixed_rows::<N>(self.layout.point(j)) + shift);
         let (quadrature, h) = (self.discrete.quadrature(), self.discrete.h());
         let ChartPath { xi, xi_dot, .. } = chart_path(space, quadrature, h, ends, internal, theta)?;
         let q = space.retract(&a.q, &xi);

@@ -74,9 +74,9 @@
 use nalgebra::{DMatrix, DVector, SVector};
 
 use crate::configuration_space::ConfigurationSpace;
-use crate::manifold::Vectors;
 use crate::derivatives::{Seed, degenerate, seeded};
 use crate::discrete_lagrangian::DiscreteLagrangian;
+use crate::manifold::Vectors;
 use crate::quadrature::{Quadrature, Rule};
 use crate::system::DiracSystem;
 
@@ -122,7 +122,11 @@ pub(crate) fn refusal(quadrature: &Quadrature) -> Option<String> {
 /// `∂ρ/∂q̇ = ∂²L/∂q∂v − (∂²L/∂q∂v)ᵀ`; `∂ρ_r/∂q_m = ∂²L/∂q_r∂q_m − Σ_j ∂³L/∂q_m∂q_j∂v_r q̇_j`,
 /// whose last term is `(∇²ϑ_r q̇)_m` with `∇²ϑ_r = ∂²L/∂q²(q, e_r) − ∂²L/∂q²(q, 0)` (`L` is
 /// linear in `v_r`, and `∂²L/∂v∂v_r = 0`).
-pub(crate) fn collocation<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>(
+pub(crate) fn collocation<
+    S: DiracSystem<N>,
+    C: ConfigurationSpace<N, Manifold = Vectors>,
+    const N: usize,
+>(
     discrete: &DiscreteLagrangian<S, N, C>,
     base: &SVector<f64, N>,
     increments: &[SVector<f64, N>],
@@ -204,7 +208,11 @@ pub(crate) fn projected_increment<const N: usize>(
 ///
 /// `L` is linear in `v`, so `∂²L/∂v² = 0`, `∇ϑᵀ = ∂²L/∂q∂v` and
 /// `Σ_c σ_c ∇²ϑ_c = ∂²L/∂q²(q, σ) − ∂²L/∂q²(q, 0)`.
-pub(crate) fn symmetric_projection<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>(
+pub(crate) fn symmetric_projection<
+    S: DiracSystem<N>,
+    C: ConfigurationSpace<N, Manifold = Vectors>,
+    const N: usize,
+>(
     discrete: &DiscreteLagrangian<S, N, C>,
     q: &SVector<f64, N>,
     p: &SVector<f64, N>,

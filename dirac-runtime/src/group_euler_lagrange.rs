@@ -282,8 +282,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
     /// one-forms satisfied.
     fn check_start(&self, state: &State<N, C::Manifold>, tolerance: f64) -> Result<(), DiracError> {
         let (q, p, v) = (&state.q, &state.p, &state.velocity);
-        if S::ONE_FORMS > 0 && self.point != ConstraintPoint::Midpoint && self.layout.points() > 1
-        {
+        if S::ONE_FORMS > 0 && self.point != ConstraintPoint::Midpoint && self.layout.points() > 1 {
             return Err(DiracError::InvalidQuadrature(
                 "one-forms on these spaces are held on degree-1 steps only".into(),
             ));
@@ -551,12 +550,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
     }
 
     /// `⟨∂L/∂v, v⟩ − L(q, v)`, read in the chart at `q`.
-    fn energy(
-        &self,
-        q: &Point<C, N, f64>,
-        _p: &Tangent<C, N, f64>,
-        v: &Tangent<C, N, f64>,
-    ) -> f64 {
+    fn energy(&self, q: &Point<C, N, f64>, _p: &Tangent<C, N, f64>, v: &Tangent<C, N, f64>) -> f64 {
         let Some(xi_dot) = self.discrete.space().chart_velocity(q, v) else {
             return f64::NAN;
         };
@@ -579,15 +573,17 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
         let (quadrature, h) = (self.discrete.quadrature(), self.discrete.h());
         let internal =
             (1..self.layout.points()).map(|j| x.fixed_rows::<N>(self.layout.point(j)).into_owned());
-        let ChartPath { xi, xi_dot, end } = chart_path(space, quadrature, h, ends, internal, theta)?;
+        let ChartPath { xi, xi_dot, end } =
+            chart_path(space, quadrature, h, ends, internal, theta)?;
         let zero = SVector::zeros();
         let start_rate = space.chart_velocity(&a.q, &a.v)?;
         let end_rate = space.chart_rate(&a.q, &end, &b.v)?;
-        let defect_a = space.pull_back(&a.q, &zero, &a.p) - self.chart_momentum(&a.q, &zero, &start_rate);
-        let defect_b = space.pull_back(&a.q, &end, &b.p) - self.chart_momentum(&a.q, &end, &end_rate);
-        let pi = self.chart_momentum(&a.q, &xi, &xi_dot)
-            + defect_a * (1.0 - theta)
-            + defect_b * theta;
+        let defect_a =
+            space.pull_back(&a.q, &zero, &a.p) - self.chart_momentum(&a.q, &zero, &start_rate);
+        let defect_b =
+            space.pull_back(&a.q, &end, &b.p) - self.chart_momentum(&a.q, &end, &end_rate);
+        let pi =
+            self.chart_momentum(&a.q, &xi, &xi_dot) + defect_a * (1.0 - theta) + defect_b * theta;
         Some(Sample {
             t: a.t + theta * h,
             q: space.retract(&a.q, &xi),

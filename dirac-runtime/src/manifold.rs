@@ -111,7 +111,11 @@ impl<const N: usize> Manifold<N> for Vectors {
         SVector::zeros()
     }
 
-    fn extrapolate(last: &SVector<f64, N>, before: &SVector<f64, N>, fraction: f64) -> SVector<f64, N> {
+    fn extrapolate(
+        last: &SVector<f64, N>,
+        before: &SVector<f64, N>,
+        fraction: f64,
+    ) -> SVector<f64, N> {
         last + (last - before) * fraction
     }
 

@@ -17,6 +17,8 @@
 //! Lagrangian in its first point through that moving chart (see
 //! [`GroupEulerLagrange`](crate::group_euler_lagrange::GroupEulerLagrange)).
 
+use std::ops::{Index, IndexMut};
+
 use nalgebra::{Matrix3, SVector, Vector2, Vector3};
 
 use crate::configuration_space::{ConfigurationSpace, sealed};
@@ -81,6 +83,40 @@ impl<D: Scalar, const K: usize, const A: usize, const B: usize> Rates<D, K, A, B
             vector: SVector::from_element(zero),
             rotation: [Vector3::from_element(zero); A],
             direction: [Vector3::from_element(zero); B],
+        }
+    }
+}
+
+/// The numbers of a tangent vector in one row: the `K` velocities, then three per rotation
+/// (`Ω_x, Ω_y, Ω_z`), then three per unit vector; the order of
+/// [`Manifold::tangent_components`] (generated one-forms and forces write their terms this way).
+///
+/// ```
+/// use dirac_runtime::product::Rates;
+/// let mut rates = Rates::<f64, 1, 1, 1>::zero();
+/// rates[0] = 1.0; // the coordinate's velocity
+/// rates[3] = 2.0; // Ω_z
+/// rates[6] = 3.0; // the unit vector's z velocity
+/// assert_eq!((rates.vector[0], rates.rotation[0][2], rates.direction[0][2]), (1.0, 2.0, 3.0));
+/// ```
+impl<D, const K: usize, const A: usize, const B: usize> Index<usize> for Rates<D, K, A, B> {
+    type Output = D;
+
+    fn index(&self, i: usize) -> &D {
+        match i {
+            i if i < K => &self.vector[i],
+            i if i < K + 3 * A => &self.rotation[(i - K) / 3][(i - K) % 3],
+            i => &self.direction[(i - K - 3 * A) / 3][(i - K - 3 * A) % 3],
+        }
+    }
+}
+
+impl<D, const K: usize, const A: usize, const B: usize> IndexMut<usize> for Rates<D, K, A, B> {
+    fn index_mut(&mut self, i: usize) -> &mut D {
+        match i {
+            i if i < K => &mut self.vector[i],
+            i if i < K + 3 * A => &mut self.rotation[(i - K) / 3][(i - K) % 3],
+            i => &mut self.direction[(i - K - 3 * A) / 3][(i - K - 3 * A) % 3],
         }
     }
 }
@@ -264,7 +300,9 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Manifold<N>
             if defect > tolerance {
                 return Some((
                     K + a,
-                    format!("is not a rotation: |RᵀR − I| = {defect:.3e} (tolerance {tolerance:.0e})"),
+                    format!(
+                        "is not a rotation: |RᵀR − I| = {defect:.3e} (tolerance {tolerance:.0e})"
+                    ),
                 ));
             }
             if r.determinant() < 0.0 {
@@ -273,7 +311,7 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Manifold<N>
         }
         for (b, q) in point.direction.iter().enumerate() {
             let defect = (q.norm() - 1.0).abs();
-            if !(defect <= tolerance) {
+            if defect.is_nan() || defect > tolerance {
                 return Some((
                     K + A + b,
                     format!(
@@ -314,7 +352,6 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Manifold<N>
         None
     }
 }
-
 
 impl<const K: usize, const A: usize, const B: usize> Product<K, A, B> {
     /// `R_{R_q(η)}(ζ)`, or `R_q(ζ)` without `η`.

@@ -291,7 +291,10 @@ mod tests {
                 assert!((f.transpose() * f - Matrix3::identity()).amax() < 1e-15);
                 assert!((f.determinant() - 1.0).abs() < 1e-15);
                 let back = retraction.inverse(&f).unwrap();
-                assert!((back - xi).amax() < 1e-14 * (1.0 + xi.amax()), "{back} {xi}");
+                assert!(
+                    (back - xi).amax() < 1e-14 * (1.0 + xi.amax()),
+                    "{back} {xi}"
+                );
             }
         }
         // The exponential of a rotation vector is the rotation about it by its length.

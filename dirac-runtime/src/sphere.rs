@@ -73,7 +73,11 @@ pub fn retract<D: Scalar>(retraction: Retraction, q: &Vector3<f64>, w: &Vector3<
 
 /// `R_q⁻¹(y)`: the tangent vector at `q` that the retraction takes to the unit vector `y`, `None`
 /// at the antipode (outside the chart).
-pub fn local<D: Scalar>(retraction: Retraction, q: &Vector3<f64>, y: &Vector3<D>) -> Option<Vector3<D>> {
+pub fn local<D: Scalar>(
+    retraction: Retraction,
+    q: &Vector3<f64>,
+    y: &Vector3<D>,
+) -> Option<Vector3<D>> {
     let q = lift(q);
     let c = y.dot(&q);
     let tangent = y - q * c;
@@ -129,7 +133,9 @@ pub fn push_covector(
 ) -> Option<Vector3<f64>> {
     let m = velocity_map(retraction, q, b, zeta);
     let radius = retract(retraction, q, &(b * zeta)).norm();
-    (m.transpose() * m).try_inverse().map(|g| m * g * end * radius)
+    (m.transpose() * m)
+        .try_inverse()
+        .map(|g| m * g * end * radius)
 }
 
 /// `M`: the velocities of the chart's two coordinate directions at `ζ`.
@@ -198,7 +204,11 @@ mod tests {
             assert!((f * q - retract(retraction, &q, &w)).amax() < 1e-15);
             assert!((f.transpose() * f - Matrix3::identity()).amax() < 1e-15);
         }
-        for q in [vector![0.0, 0.0, -1.0], vector![1.0, 0.0, 0.0], vector![0.0, 0.0, 1.0]] {
+        for q in [
+            vector![0.0, 0.0, -1.0],
+            vector![1.0, 0.0, 0.0],
+            vector![0.0, 0.0, 1.0],
+        ] {
             let b = frame(&q);
             assert!((b.column(0).cross(&b.column(1)) - q).amax() < 1e-15);
         }

@@ -17,8 +17,7 @@ use crate::newton::{Newton, NewtonFailure};
 use crate::step_derivatives::StepDerivatives;
 
 /// The point type of the step equations `E` (on `Rⁿ`, `SVector<f64, N>`).
-pub type Point<E, const N: usize> =
-    <<E as StepEquations<N>>::Manifold as Manifold<N>>::Point<f64>;
+pub type Point<E, const N: usize> = <<E as StepEquations<N>>::Manifold as Manifold<N>>::Point<f64>;
 
 /// The tangent vector (and covector) type of the step equations `E`.
 pub type Tangent<E, const N: usize> =
@@ -141,7 +140,11 @@ pub trait StepEquations<const N: usize> {
     /// Checks that `state` is a valid initial state (finite, in the model's domain, consistent
     /// with its constraints to the relative `tolerance`, which the stepper scales to its solver
     /// tolerance): the error says what is violated.
-    fn check_start(&self, state: &State<N, Self::Manifold>, tolerance: f64) -> Result<(), DiracError>;
+    fn check_start(
+        &self,
+        state: &State<N, Self::Manifold>,
+        tolerance: f64,
+    ) -> Result<(), DiracError>;
 
     /// Called once a checked `state` becomes the start of a run, before its first step: what the
     /// equations find out about the model there (e.g. which coordinates carry no kinetic
@@ -154,7 +157,12 @@ pub trait StepEquations<const N: usize> {
     /// stepper's prediction from the accepted steps, when there is one: the last solution, or
     /// the last two or three extrapolated (the line `2 x_k − x_{k−1}`, the parabola
     /// `3 x_k − 3 x_{k−1} + x_{k−2}`; not across a start or a change of inputs).
-    fn predict(&mut self, state: &State<N, Self::Manifold>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>);
+    fn predict(
+        &mut self,
+        state: &State<N, Self::Manifold>,
+        previous: Option<&DVector<f64>>,
+        x: &mut DVector<f64>,
+    );
 
     /// Writes the residual `F(x)` and, when one is asked for, adds its Jacobian into
     /// `jacobian` (zeroed by the caller; Newton asks only when a Jacobian is due, see
@@ -277,7 +285,12 @@ pub trait StepEquations<const N: usize> {
     /// state it started from and the one it reached, with their exact velocities) solved by `x`
     /// (see [`dense_output`](crate::dense_output)). `None` where the equations have no path to
     /// interpolate (the default): the stepper then refuses dense output with `Unsupported`.
-    fn dense(&self, ends: [&Sample<N, Self::Manifold>; 2], x: &DVector<f64>, theta: f64) -> Option<Sample<N, Self::Manifold>> {
+    fn dense(
+        &self,
+        ends: [&Sample<N, Self::Manifold>; 2],
+        x: &DVector<f64>,
+        theta: f64,
+    ) -> Option<Sample<N, Self::Manifold>> {
         let _ = (ends, x, theta);
         None
     }

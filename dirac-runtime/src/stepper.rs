@@ -26,11 +26,11 @@ use crate::group_euler_lagrange::GroupEulerLagrange;
 use crate::holonomic_scheme::HolonomicScheme;
 use crate::input::Input;
 use crate::legendre;
+use crate::manifold::{Manifold, Vectors};
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 use crate::predictor::Predictor;
 use crate::quadrature::Quadrature;
 use crate::step_derivatives::{StepDerivatives, StepHessians};
-use crate::manifold::{Manifold, Vectors};
 use crate::step_equations::{Point, State, StepEquations, Tangent};
 use crate::system::DiracSystem;
 use crate::trajectory::{Metadata, Trajectory};
@@ -734,8 +734,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             .find(|&i| self.equations.input_name(i) == name)
             .map(Input::new)
             .ok_or_else(|| {
-                let names: Vec<String> =
-                    (0..count).map(|i| self.equations.input_name(i)).collect();
+                let names: Vec<String> = (0..count).map(|i| self.equations.input_name(i)).collect();
                 DiracError::UnknownInput(format!(
                     "no input called `{name}`; the inputs are {names:?}"
                 ))

@@ -36,7 +36,10 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert!((trajectory.q()[10][0] - 1.0).abs() < 1e-15);
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn run(&mut self, steps: u64) -> Result<Trajectory<N, E::Manifold>, Box<Interrupted<N, E::Manifold>>> {
+    pub fn run(
+        &mut self,
+        steps: u64,
+    ) -> Result<Trajectory<N, E::Manifold>, Box<Interrupted<N, E::Manifold>>> {
         self.solve(Run::steps(steps))
             .map(|solution| solution.trajectory)
     }
@@ -61,7 +64,10 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// assert!((stepper.t() - 1.1).abs() < 1e-15);
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
-    pub fn run_until(&mut self, t_end: f64) -> Result<Trajectory<N, E::Manifold>, Box<Interrupted<N, E::Manifold>>> {
+    pub fn run_until(
+        &mut self,
+        t_end: f64,
+    ) -> Result<Trajectory<N, E::Manifold>, Box<Interrupted<N, E::Manifold>>> {
         self.solve(Run::until(t_end))
             .map(|solution| solution.trajectory)
     }
