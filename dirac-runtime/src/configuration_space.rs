@@ -176,6 +176,10 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
     }
 
     /// `R_{R_q(η)}(ζ)`: the point at `ζ` of the chart centred at `R_q(η)`.
+    ///
+    /// The three moving-chart maps are only differentiated once in `η`, at `η = 0` (the step's
+    /// first point moved infinitesimally): a space may give them to first order in `η` (with
+    /// dual numbers, whose `η`-parts square to zero, that is exact).
     fn retract_moved<D: Scalar>(
         &self,
         q: &Point<Self, N, f64>,
@@ -197,7 +201,10 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
     }
 
     /// `R_{R_q(η)}⁻¹(R_q(ξ))`: the point at `ξ` of the chart at `q` read in the chart centred at
-    /// `R_q(η)` (for the `η` and `ξ` of one step, inside both charts).
+    /// `R_q(η)` (for the `η` and `ξ` of one step, inside both charts; to first order in `η`).
+    /// Its value at `η = 0` must be `ξ` itself, not its round trip through the retraction: the
+    /// step's first derivative is then taken at the very points whose end covector advances the
+    /// momentum (a round trip's round-off makes the momentum maps drift).
     fn transition<D: Scalar>(
         &self,
         q: &Point<Self, N, f64>,

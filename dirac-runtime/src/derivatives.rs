@@ -222,23 +222,20 @@ fn moving_action<S, C, D, const N: usize>(
     C: ConfigurationSpace<N>,
     D: Scalar,
 {
-    // At η = 0 the transition is the identity: the round-off of its round trip through the
-    // retraction is taken out of the values (not the derivatives), so that D1 L_d is taken at the
-    // very points whose end covector advances the momentum.
     let moved: Vec<SVector<D, N>> = points
         .iter()
-        .map(|xi| {
-            let z = space.transition(base, eta, xi);
-            z.zip_map(xi, |z, x| z + (x.re() - z.re()))
-        })
+        .map(|xi| space.transition(base, eta, xi))
         .collect();
     let zero = D::from(0.0);
     for (i, &b) in quadrature.weights().iter().enumerate() {
         let mut zeta = SVector::<D, N>::from_element(zero);
         let mut rate = SVector::<D, N>::from_element(zero);
         for (j, z) in moved.iter().enumerate() {
-            zeta += z * D::from(quadrature.ell(i, j + 1));
-            rate += z * D::from(quadrature.ell_prime(i, j + 1) / h);
+            let (a, d) = (quadrature.ell(i, j + 1), quadrature.ell_prime(i, j + 1) / h);
+            for k in 0..N {
+                zeta[k] += z[k] * a;
+                rate[k] += z[k] * d;
+            }
         }
         let q = space.retract_moved(base, eta, &zeta);
         let v = space.push_forward_moved(base, eta, &zeta, &rate);

@@ -52,17 +52,15 @@ pub enum Retraction {
 impl Retraction {
     /// `τ(ξ)`.
     pub fn map<D: Scalar>(self, xi: &Vector3<D>) -> Matrix3<D> {
-        let k = hat(xi);
-        let k2 = k * k;
         let x = xi.dot(xi);
-        let (a, b) = match self {
+        let one = D::from(1.0);
+        match self {
             Retraction::Cayley => {
                 let alpha = (x + 4.0).recip() * 4.0;
-                (alpha, alpha * 0.5)
+                combination(xi, one, alpha, alpha * 0.5)
             }
-            Retraction::Exp => (sine_ratio(x), versine_ratio(x)),
-        };
-        Matrix3::identity() + k * a + k2 * b
+            Retraction::Exp => combination(xi, one, sine_ratio(x), versine_ratio(x)),
+        }
     }
 
     /// `τ⁻¹(F)` for a rotation `F` within the chart (rotation angle below π), `None` outside it.
@@ -84,28 +82,63 @@ impl Retraction {
 
     /// The left-trivialised differential `dτ_ξ`: `Ω = dτ_ξ ξ̇` along a path `ξ(t)`.
     pub fn differential<D: Scalar>(self, xi: &Vector3<D>) -> Matrix3<D> {
-        let k = hat(xi);
         let x = xi.dot(xi);
         match self {
             Retraction::Cayley => {
                 let alpha = (x + 4.0).recip() * 4.0;
-                (Matrix3::identity() - k * D::from(0.5)) * alpha
+                combination(xi, alpha, alpha * -0.5, D::from(0.0))
             }
             Retraction::Exp => {
-                Matrix3::identity() - k * versine_ratio(x) + k * k * sine_defect_ratio(x)
+                combination(xi, D::from(1.0), -versine_ratio(x), sine_defect_ratio(x))
             }
         }
     }
 
     /// `dτ_ξ⁻¹`: the chart velocity `ξ̇` of the angular velocity `Ω`.
     pub fn differential_inverse<D: Scalar>(self, xi: &Vector3<D>) -> Matrix3<D> {
-        let k = hat(xi);
-        let half = Matrix3::identity() + k * D::from(0.5);
+        let x = xi.dot(xi);
+        let half = D::from(0.5);
         match self {
-            Retraction::Cayley => half + xi * xi.transpose() * D::from(0.25),
-            Retraction::Exp => half + k * k * cotangent_defect_ratio(xi.dot(xi)),
+            // I + ξ̂/2 + ξξᵀ/4, with ξξᵀ = ξ̂² + |ξ|² I.
+            Retraction::Cayley => combination(xi, x * 0.25 + 1.0, half, D::from(0.25)),
+            Retraction::Exp => combination(xi, D::from(1.0), half, cotangent_defect_ratio(x)),
         }
     }
+}
+
+/// `c₀ I + c₁ ξ̂ + c₂ ξ̂²` entry by entry (`ξ̂² = ξξᵀ − |ξ|² I`), without matrix products: the
+/// maps above are all of this form.
+fn combination<D: Scalar>(xi: &Vector3<D>, c0: D, c1: D, c2: D) -> Matrix3<D> {
+    let x = xi.dot(xi);
+    let diagonal = c0 - c2 * x;
+    let (a, b, c) = (xi[0] * c1, xi[1] * c1, xi[2] * c1);
+    let (ab, ac, bc) = (xi[0] * xi[1] * c2, xi[0] * xi[2] * c2, xi[1] * xi[2] * c2);
+    Matrix3::new(
+        diagonal + xi[0] * xi[0] * c2,
+        ab - c,
+        ac + b,
+        ab + c,
+        diagonal + xi[1] * xi[1] * c2,
+        bc - a,
+        ac - b,
+        bc + a,
+        diagonal + xi[2] * xi[2] * c2,
+    )
+}
+
+/// `a b` entry by entry (nalgebra's generic product clones every dual number several times).
+pub(crate) fn product<D: Scalar>(a: &Matrix3<D>, b: &Matrix3<D>) -> Matrix3<D> {
+    Matrix3::from_fn(|i, j| a[(i, 0)] * b[(0, j)] + a[(i, 1)] * b[(1, j)] + a[(i, 2)] * b[(2, j)])
+}
+
+/// `a b` for a rotation `a` known in `f64`.
+pub(crate) fn product_known<D: Scalar>(a: &Matrix3<f64>, b: &Matrix3<D>) -> Matrix3<D> {
+    Matrix3::from_fn(|i, j| b[(0, j)] * a[(i, 0)] + b[(1, j)] * a[(i, 1)] + b[(2, j)] * a[(i, 2)])
+}
+
+/// `a v` entry by entry.
+pub(crate) fn apply<D: Scalar>(a: &Matrix3<D>, v: &Vector3<D>) -> Vector3<D> {
+    Vector3::from_fn(|i, _| a[(i, 0)] * v[0] + a[(i, 1)] * v[1] + a[(i, 2)] * v[2])
 }
 
 /// `ξ̂`, the skew matrix with `ξ̂ y = ξ × y`.

@@ -50,6 +50,12 @@ pub fn carrier<D: Scalar>(retraction: Retraction, q: &Vector3<f64>, w: &Vector3<
     retraction.map(&lift(q).cross(w))
 }
 
+/// The infinitesimal rotation `ω = q × w` that moves `q` along `w` (the carrier to first order:
+/// `τ(ω) ≈ I + ω̂`).
+pub fn turn<D: Scalar>(q: &Vector3<f64>, w: &Vector3<D>) -> Vector3<D> {
+    lift(q).cross(w)
+}
+
 /// `R_q(w)` for a tangent vector `w` at `q`.
 ///
 /// ```
