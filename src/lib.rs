@@ -45,12 +45,13 @@ macro_rules! vector {
 pub mod prelude {
     pub use crate::vector;
     pub use dirac_macros::dirac_system;
-    pub use dirac_runtime::nalgebra::{SMatrix, SVector};
+    pub use dirac_runtime::nalgebra::{Matrix3, SMatrix, SVector, Vector3};
     pub use dirac_runtime::{
-        ConfigurationSpace, ConstraintPoint, Crossing, DiracError, DiracSystem, Direction,
-        DiscreteLagrangian, DualNum, Euclidean, Event, FirstOrderScheme, HolonomicScheme, Input,
-        NewtonOptions, Positive, Progress, Quadrature, Rule, Run, Sample, Scalar, Solution, Status,
-        Stepper, Trajectory,
+        Configuration, ConfigurationSpace, ConstraintPoint, Crossing, DiracError, DiracSystem,
+        Direction, DiscreteLagrangian, DualNum, Euclidean, Event, FirstOrderScheme,
+        HolonomicScheme, Input, ManifoldStepper, NewtonOptions, Positive, Product, Progress,
+        Quadrature, Rates, Retraction, Rule, Run, Sample, Scalar, Solution, Status, Stepper,
+        Trajectory,
     };
 }
 

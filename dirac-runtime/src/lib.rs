@@ -71,7 +71,7 @@ pub use run::{Progress, Run, Solution, Status};
 pub use scalar::Scalar;
 pub use step_derivatives::{StepDerivatives, StepHessians};
 pub use step_equations::{State, StepEquations};
-pub use stepper::Stepper;
+pub use stepper::{ManifoldStepper, Stepper};
 pub use system::DiracSystem;
 pub use trajectory::{Interrupted, Metadata, Trajectory};
 pub use work_precision::{Measurement, Study, WorkPrecision};

@@ -121,6 +121,70 @@ impl<D, const K: usize, const A: usize, const B: usize> IndexMut<usize> for Rate
     }
 }
 
+impl<D: Scalar, const K: usize, const A: usize, const B: usize> Configuration<D, K, A, B> {
+    /// The point with these parts.
+    pub fn new(
+        vector: SVector<D, K>,
+        rotation: [Matrix3<D>; A],
+        direction: [Vector3<D>; B],
+    ) -> Self {
+        Self {
+            vector,
+            rotation,
+            direction,
+        }
+    }
+}
+
+impl<D: Scalar> Configuration<D, 0, 1, 0> {
+    /// A rigid body's attitude `R` as a point of `SO(3)`.
+    ///
+    /// ```
+    /// use dirac_runtime::product::Configuration;
+    /// use nalgebra::Matrix3;
+    /// assert_eq!(Configuration::of_rotation(Matrix3::<f64>::identity()).rotation[0], Matrix3::identity());
+    /// ```
+    pub fn of_rotation(r: Matrix3<D>) -> Self {
+        Self::new(SVector::from_element(D::from(0.0)), [r], [])
+    }
+}
+
+impl<D: Scalar> Configuration<D, 0, 0, 1> {
+    /// A unit vector `q` as a point of `S²`.
+    pub fn of_direction(q: Vector3<D>) -> Self {
+        Self::new(SVector::from_element(D::from(0.0)), [], [q])
+    }
+}
+
+impl<D: Scalar, const K: usize, const A: usize, const B: usize> Rates<D, K, A, B> {
+    /// The tangent vector with these parts.
+    pub fn new(
+        vector: SVector<D, K>,
+        rotation: [Vector3<D>; A],
+        direction: [Vector3<D>; B],
+    ) -> Self {
+        Self {
+            vector,
+            rotation,
+            direction,
+        }
+    }
+}
+
+impl<D: Scalar> Rates<D, 0, 1, 0> {
+    /// A rigid body's body angular velocity `Ω` (or momentum `Π`).
+    pub fn of_rotation(omega: Vector3<D>) -> Self {
+        Self::new(SVector::from_element(D::from(0.0)), [omega], [])
+    }
+}
+
+impl<D: Scalar> Rates<D, 0, 0, 1> {
+    /// A unit vector's velocity `q̇` (or momentum).
+    pub fn of_direction(v: Vector3<D>) -> Self {
+        Self::new(SVector::from_element(D::from(0.0)), [], [v])
+    }
+}
+
 impl<const K: usize, const A: usize, const B: usize> Configuration<f64, K, A, B> {
     /// Body `a`'s angular momentum in space axes, `R_a Π_a`, from the body momenta `p`
     /// (conserved for a body free of torques about it).

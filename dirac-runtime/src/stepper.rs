@@ -417,6 +417,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     }
 }
 
+/// A [`Stepper`] of a model on rotations and unit vectors whose steps work in the charts of `C`
+/// (see [`Stepper::on_manifold`]).
+pub type ManifoldStepper<S, const N: usize, C> = Stepper<S, N, GroupEulerLagrange<S, N, C>>;
+
 impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     Stepper<S, N, GroupEulerLagrange<S, N, C>>
 {

@@ -19,7 +19,11 @@ pub mod peers;
 pub mod pendulum;
 pub mod port;
 pub mod progress;
+pub mod rigid_body;
+pub mod rolling_ball;
 pub mod rolling_disk;
+pub mod satellite;
+pub mod spherical_pendulum;
 pub mod study;
 
 use std::time::{Duration, Instant};
@@ -41,11 +45,11 @@ pub struct Report {
 }
 
 /// Runs `stepper` to `t_end`, recording every `every`-th state, with a progress bar, and times it.
-pub fn timed<S: DiracSystem<N>, const N: usize>(
-    stepper: &mut Stepper<S, N>,
+pub fn timed<E: dirac::StepEquations<N>, const N: usize>(
+    stepper: &mut Stepper<E::System, N, E>,
     t_end: f64,
     every: usize,
-) -> Result<(Trajectory<N>, Duration), DiracError> {
+) -> Result<(Trajectory<N, E::Manifold>, Duration), DiracError> {
     let bar = progress::bar(stepper.t(), t_end, stepper.h());
     let start = Instant::now();
     let run = Run::until(t_end)

@@ -18,9 +18,9 @@ pub fn bar(t: f64, t_end: f64, h: f64) -> ProgressBar {
 }
 
 /// An observer that moves `bar` every 1 000 steps (and at the end).
-pub fn observer<const N: usize>(
+pub fn observer<const N: usize, M: dirac::Manifold<N>>(
     bar: &ProgressBar,
-) -> impl FnMut(&Progress<'_, N>) -> ControlFlow<()> + '_ {
+) -> impl FnMut(&Progress<'_, N, M>) -> ControlFlow<()> + '_ {
     move |progress| {
         if progress.steps % 1000 == 0 || progress.steps == progress.total {
             bar.set_length(progress.total);

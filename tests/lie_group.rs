@@ -1,0 +1,487 @@
+//! Models on rotations and unit vectors (`R: SO3`, `n: S2`): the Lie group variational
+//! integrators' invariants (orthogonality, discrete Noether, bounded energy), their orders against
+//! closed forms and against an independent Dop853 reference, one-forms at the three constraint
+//! points, torque inputs, hand-written models, and the errors a bad start gets.
+
+#[path = "../examples/scenes/mod.rs"]
+mod scenes;
+
+use dirac::prelude::*;
+use dirac::product::Product;
+use scenes::{rigid_body, rolling_ball, satellite, spherical_pendulum};
+use support::assert_order;
+
+mod support;
+
+/// Asserts the order of `(h, error)` pairs (see `support::assert_order`).
+fn order_of(what: &str, errors: &[(f64, f64)], expected: f64) {
+    let (hs, errors): (Vec<f64>, Vec<f64>) = errors.iter().copied().unzip();
+    assert_order(what, &hs, &errors, expected);
+}
+
+/// The largest `|RᵀR − I|` entry.
+fn orthogonality(r: &Matrix3<f64>) -> f64 {
+    (r.transpose() * r - Matrix3::identity()).amax()
+}
+
+/// A free asymmetric body over 10⁶ steps of h = 0.01 (Cayley, midpoint): `RᵀR = I` to round-off
+/// at every step, the spatial angular momentum `R Π` to round-off (discrete Noether: the
+/// discrete Lagrangian is invariant under `R ↦ Q R`), and the energy error bounded, as large in
+/// the last tenth of the run as in the first.
+#[test]
+fn a_free_body_keeps_its_attitude_orthogonal_and_its_momentum_over_a_million_steps() {
+    let mut stepper = rigid_body::started(
+        rigid_body::ASYMMETRIC,
+        Product::cayley(),
+        Quadrature::midpoint(),
+        0.01,
+        rigid_body::free_start(),
+    )
+    .unwrap();
+    let pi0 = stepper.q().spatial(&stepper.p(), 0);
+    let e0 = stepper.energy().unwrap();
+    let steps = 1_000_000;
+    let (mut worst_orthogonality, mut worst_momentum) = (0.0_f64, 0.0_f64);
+    let (mut early, mut late) = (0.0_f64, 0.0_f64);
+    for k in 1..=steps {
+        stepper.step().unwrap();
+        let q = stepper.q();
+        worst_orthogonality = worst_orthogonality.max(orthogonality(&q.rotation[0]));
+        worst_momentum = worst_momentum.max((q.spatial(&stepper.p(), 0) - pi0).amax());
+        if k % 100 == 0 && (k <= steps / 10 || k > steps - steps / 10) {
+            let error = (stepper.energy().unwrap() - e0).abs();
+            if k <= steps / 10 {
+                early = early.max(error);
+            } else {
+                late = late.max(error);
+            }
+        }
+    }
+    assert!(
+        worst_orthogonality <= 1e-13,
+        "|RᵀR − I| = {worst_orthogonality:e}"
+    );
+    assert!(
+        worst_momentum <= 1e-12 * pi0.norm(),
+        "|ΔRΠ| = {worst_momentum:e}"
+    );
+    // Bounded, not drifting: the error of the last 10⁵ steps is that of the first.
+    assert!(
+        early > 1e-7 && late < 2.0 * early,
+        "early {early:e}, late {late:e}"
+    );
+}
+
+/// The heavy top's vertical angular momentum `e₃ · R Π` is conserved to round-off (the potential
+/// is symmetric about the vertical), with both retractions and with `galerkin(2)`; its energy
+/// error stays bounded.
+#[test]
+fn the_heavy_top_keeps_its_vertical_momentum() {
+    for (space, quadrature) in [
+        (Product::cayley(), Quadrature::midpoint()),
+        (Product::exp(), Quadrature::midpoint()),
+        (Product::cayley(), Quadrature::galerkin(2).unwrap()),
+    ] {
+        let name = format!("{:?} {}", space.retraction(), quadrature.name());
+        let mut stepper = rigid_body::started(
+            rigid_body::TOP,
+            space,
+            quadrature,
+            0.01,
+            rigid_body::top_start(),
+        )
+        .unwrap();
+        let lz0 = rigid_body::vertical_momentum(&stepper.q(), &stepper.p());
+        let trajectory = stepper.run(20_000).unwrap();
+        let drift = trajectory
+            .q()
+            .iter()
+            .zip(trajectory.p())
+            .map(|(q, p)| (rigid_body::vertical_momentum(q, p) - lz0).abs())
+            .fold(0.0, f64::max);
+        assert!(drift <= 1e-12 * lz0.abs(), "{name}: |ΔL_z| = {drift:e}");
+        assert!(trajectory.max_energy_error() < 1e-3, "{name}");
+        // The top precesses: it turns about the vertical by much more than its nutation.
+        let axis = trajectory.q().last().unwrap().rotation[0] * Vector3::z();
+        assert!(axis[2] > 0.85 && axis.xy().norm() > 0.3, "{name}: {axis}");
+    }
+}
+
+/// A symmetric free body against its closed form: orders 2, 2, 4 and 6 for the midpoint rule,
+/// the trapezoid, `galerkin(2)` and `galerkin(3)` in the chart, with the Cayley and the
+/// exponential retraction.
+#[test]
+fn the_symmetric_body_converges_at_the_quadratures_orders() {
+    let (r0, omega0) = rigid_body::free_start();
+    let t_end = 2.0;
+    let exact = rigid_body::symmetric(&rigid_body::SYMMETRIC, &r0, &omega0, t_end);
+    for space in [Product::cayley(), Product::exp()] {
+        for (quadrature, order, steps) in [
+            (Quadrature::midpoint(), 2.0, [20, 40, 80, 160]),
+            (Quadrature::trapezoid(), 2.0, [20, 40, 80, 160]),
+            (Quadrature::galerkin(2).unwrap(), 4.0, [10, 20, 40, 80]),
+            (Quadrature::galerkin(3).unwrap(), 6.0, [5, 10, 15, 20]),
+        ] {
+            let name = format!("{:?} {}", space.retraction(), quadrature.name());
+            let errors: Vec<(f64, f64)> = steps
+                .iter()
+                .map(|&n| {
+                    let h = t_end / n as f64;
+                    let mut stepper = rigid_body::started(
+                        rigid_body::SYMMETRIC,
+                        space,
+                        quadrature.clone(),
+                        h,
+                        (r0, omega0),
+                    )
+                    .unwrap();
+                    stepper.run(n).unwrap();
+                    (h, (stepper.q().rotation[0] - exact).amax())
+                })
+                .collect();
+            order_of(&name, &errors, order);
+        }
+    }
+}
+
+/// The 3D pendulum (an asymmetric body hanging off its centre of mass) against Dop853 on the
+/// quaternion ODE at tolerance 1e-13: order 2 with both retractions, 4 with `galerkin(2)`.
+#[test]
+fn the_3d_pendulum_converges_against_a_quaternion_reference() {
+    let t_end = 1.0;
+    let (r0, omega0) = rigid_body::pendulum_start();
+    let (r_ref, pi_ref) =
+        rigid_body::reference(&rigid_body::PENDULUM, &r0, &omega0, t_end, 1e-13).unwrap();
+    for (space, quadrature, order, steps) in [
+        (
+            Product::cayley(),
+            Quadrature::midpoint(),
+            2.0,
+            [20, 40, 80, 160],
+        ),
+        (
+            Product::exp(),
+            Quadrature::midpoint(),
+            2.0,
+            [20, 40, 80, 160],
+        ),
+        (
+            Product::cayley(),
+            Quadrature::galerkin(2).unwrap(),
+            4.0,
+            [10, 20, 40, 80],
+        ),
+    ] {
+        let name = format!("{:?} {}", space.retraction(), quadrature.name());
+        let errors: Vec<(f64, f64)> = steps
+            .iter()
+            .map(|&n| {
+                let h = t_end / n as f64;
+                let mut stepper = rigid_body::started(
+                    rigid_body::PENDULUM,
+                    space,
+                    quadrature.clone(),
+                    h,
+                    (r0, omega0),
+                )
+                .unwrap();
+                stepper.run(n).unwrap();
+                let q_error = (stepper.q().rotation[0] - r_ref).amax();
+                let p_error = (stepper.p().rotation[0] - pi_ref).amax();
+                (h, q_error.max(p_error))
+            })
+            .collect();
+        order_of(&name, &errors, order);
+    }
+}
+
+/// The macro's top and the top written against the traits by hand step alike.
+#[test]
+fn a_hand_written_top_steps_like_the_generated_one() {
+    let run = |by_hand: bool| {
+        let (space, quadrature, h) = (Product::cayley(), Quadrature::midpoint(), 0.01);
+        let start = rigid_body::top_start();
+        let (q, p) = if by_hand {
+            let top = rigid_body::HeavyTopByHand(rigid_body::TOP);
+            let mut stepper = rigid_body::started(top, space, quadrature, h, start).unwrap();
+            stepper.run(500).unwrap();
+            (stepper.q(), stepper.p())
+        } else {
+            let mut stepper =
+                rigid_body::started(rigid_body::TOP, space, quadrature, h, start).unwrap();
+            stepper.run(500).unwrap();
+            (stepper.q(), stepper.p())
+        };
+        (q.rotation[0], p.rotation[0])
+    };
+    let (generated, by_hand) = (run(false), run(true));
+    assert!((generated.0 - by_hand.0).amax() < 1e-13);
+    assert!((generated.1 - by_hand.1).amax() < 1e-12);
+}
+
+/// The pendulum on `S²` against the Cartesian pendulum held on the sphere by SHAKE and against
+/// Dop853 on the constrained ODE: order 2 (both retractions), the two discretisations agreeing
+/// to their own error, and the vertical angular momentum conserved by both.
+#[test]
+fn the_spherical_pendulum_matches_the_cartesian_one() {
+    let t_end = 2.0;
+    let (x_ref, v_ref) = spherical_pendulum::reference(t_end, 1e-13).unwrap();
+    let l = spherical_pendulum::SCENE.l;
+    for space in [Product::cayley(), Product::exp()] {
+        let errors: Vec<(f64, f64)> = [40, 80, 160, 320]
+            .iter()
+            .map(|&n| {
+                let h = t_end / n as f64;
+                let mut stepper =
+                    spherical_pendulum::on_sphere(space, Quadrature::midpoint(), h).unwrap();
+                stepper.run(n).unwrap();
+                let x = stepper.q().direction[0] * l;
+                let v = stepper.v().unwrap().direction[0] * l;
+                (h, (x - x_ref).amax().max((v - v_ref).amax()))
+            })
+            .collect();
+        order_of(&format!("{:?}", space.retraction()), &errors, 2.0);
+    }
+    // At one step size the two discretisations differ by about their own errors.
+    let h = 0.005;
+    let n = (t_end / h).round() as u64;
+    let mut sphere =
+        spherical_pendulum::on_sphere(Product::exp(), Quadrature::midpoint(), h).unwrap();
+    let mut cartesian = spherical_pendulum::cartesian(Quadrature::midpoint(), h).unwrap();
+    let lz_sphere = |s: &ManifoldStepper<_, 2, Product<0, 0, 1>>| {
+        spherical_pendulum::vertical_momentum(&(s.q().direction[0] * l), &(s.p().direction[0] / l))
+    };
+    let lz_cartesian = |s: &Stepper<_, 3>| spherical_pendulum::vertical_momentum(&s.q(), &s.p());
+    let (l_sphere, l_cartesian) = (lz_sphere(&sphere), lz_cartesian(&cartesian));
+    assert!(
+        (l_sphere - l_cartesian).abs() < 1e-14,
+        "{l_sphere} {l_cartesian}"
+    );
+    sphere.run(n).unwrap();
+    cartesian.run(n).unwrap();
+    let x_sphere = sphere.q().direction[0] * l;
+    let (e_sphere, e_cartesian) = ((x_sphere - x_ref).amax(), (cartesian.q() - x_ref).amax());
+    let between = (x_sphere - cartesian.q()).amax();
+    assert!(
+        between < 2.0 * e_sphere.max(e_cartesian),
+        "{between:e} {e_sphere:e} {e_cartesian:e}"
+    );
+    assert!((lz_sphere(&sphere) - l_sphere).abs() < 1e-12);
+    assert!((lz_cartesian(&cartesian) - l_cartesian).abs() < 1e-12);
+}
+
+/// The rolling ball against its closed form with the one-forms at the start, the midpoint and
+/// the end of each step: order 2 at the midpoint, the one-forms held to round-off at every
+/// point, and the energy conserved to round-off at the start point.
+#[test]
+fn the_rolling_ball_follows_its_closed_form_at_every_constraint_point() {
+    let t_end = 2.0;
+    let (x_exact, r_exact) = rolling_ball::exact(t_end);
+    for (point, order) in [
+        (ConstraintPoint::Start, None),
+        (ConstraintPoint::Midpoint, Some(2.0)),
+        (ConstraintPoint::End, None),
+    ] {
+        let errors: Vec<(f64, f64)> = [20, 40, 80, 160]
+            .iter()
+            .map(|&n| {
+                let h = t_end / n as f64;
+                let mut stepper = rolling_ball::started(Quadrature::midpoint(), h, point).unwrap();
+                let trajectory = stepper.run(n).unwrap();
+                assert!(
+                    trajectory.max_constraint_violation() < 1e-14,
+                    "{point:?}: {}",
+                    trajectory.max_constraint_violation()
+                );
+                let q = stepper.q();
+                let error = (q.vector - x_exact)
+                    .amax()
+                    .max((q.rotation[0] - r_exact).amax());
+                (h, error)
+            })
+            .collect();
+        if let Some(order) = order {
+            order_of(&format!("{point:?}"), &errors, order);
+        }
+        // Every point converges.
+        assert!(errors[3].1 < errors[0].1 / 3.0, "{point:?}: {errors:?}");
+    }
+}
+
+/// A constant torque about a principal axis from rest turns the satellite about that axis by
+/// `τ t²/(2I)`: the inputs reach the steps as body torques, at order 2.
+#[test]
+fn torque_inputs_turn_the_satellite() {
+    let (t_end, tau) = (2.0, 0.3);
+    for axis in 0..3 {
+        let errors: Vec<(f64, f64)> = [10, 20, 40, 80]
+            .iter()
+            .map(|&n| {
+                let h = t_end / n as f64;
+                let mut stepper = Stepper::on_manifold(
+                    satellite::SCENE,
+                    Product::cayley(),
+                    Quadrature::midpoint(),
+                    h,
+                )
+                .unwrap();
+                stepper
+                    .start_from_velocity(
+                        Configuration::of_rotation(Matrix3::identity()),
+                        Rates::of_rotation(Vector3::zeros()),
+                    )
+                    .unwrap();
+                stepper
+                    .set_input(["tau_x", "tau_y", "tau_z"][axis], tau)
+                    .unwrap();
+                stepper.run(n).unwrap();
+                let exact = satellite::spun_up(axis, tau, t_end);
+                (h, (stepper.q().rotation[0] - exact).amax())
+            })
+            .collect();
+        order_of(&format!("axis {axis}"), &errors, 2.0);
+    }
+    // A PD slew reaches its target attitude.
+    let target = Retraction::Exp.map(&Vector3::new(0.5, -0.8, 1.2));
+    let (_, errors) = satellite::slew(&target, 0.01, 12.0).unwrap();
+    assert!(
+        errors[0] > 1.0 && *errors.last().unwrap() < 1e-3,
+        "{:?}",
+        errors.last()
+    );
+}
+
+/// A start off the manifold is refused, naming the variable: a matrix that is not a rotation,
+/// a vector that is not of unit length, a velocity that leaves the sphere; the stepper keeps no
+/// state.
+#[test]
+fn a_start_off_the_manifold_is_refused_naming_the_variable() {
+    let mut top = Stepper::on_manifold(
+        rigid_body::TOP,
+        Product::cayley(),
+        Quadrature::midpoint(),
+        0.01,
+    )
+    .unwrap();
+    let skewed = Matrix3::new(1.0, 0.01, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+    let error = top
+        .start_from_velocity(
+            Configuration::of_rotation(skewed),
+            Rates::of_rotation(Vector3::z()),
+        )
+        .unwrap_err();
+    assert!(
+        matches!(&error, DiracError::InconsistentInitialState(m) if m.contains("of R") && m.contains("not a rotation")),
+        "{error}"
+    );
+    let reflection = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
+    let error = top
+        .start_from_velocity(
+            Configuration::of_rotation(reflection),
+            Rates::of_rotation(Vector3::z()),
+        )
+        .unwrap_err();
+    assert!(error.to_string().contains("reflection"), "{error}");
+    assert!(top.state().is_none());
+    let mut pendulum =
+        spherical_pendulum::on_sphere(Product::cayley(), Quadrature::midpoint(), 0.01).unwrap();
+    let before = *pendulum.state().unwrap();
+    let error = pendulum
+        .start_from_velocity(
+            Configuration::of_direction(Vector3::new(0.0, 0.0, -1.1)),
+            Rates::of_direction(Vector3::x()),
+        )
+        .unwrap_err();
+    assert!(
+        matches!(&error, DiracError::InconsistentInitialState(m) if m.contains("of n") && m.contains("unit vector")),
+        "{error}"
+    );
+    let error = pendulum
+        .start_from_velocity(
+            Configuration::of_direction(-Vector3::z()),
+            Rates::of_direction(Vector3::new(1.0, 0.0, 0.5)),
+        )
+        .unwrap_err();
+    assert!(error.to_string().contains("leaves the sphere"), "{error}");
+    // A refused start leaves the running state as it was.
+    assert_eq!(*pendulum.state().unwrap(), before);
+}
+
+/// A step that cannot converge (a step far too large for the spin) is an error that leaves the
+/// state as it was, and the next, smaller steps go on from it.
+#[test]
+fn a_failed_step_on_the_group_changes_nothing() {
+    let (r0, _) = rigid_body::top_start();
+    let mut stepper = rigid_body::started(
+        rigid_body::TOP,
+        Product::cayley(),
+        Quadrature::midpoint(),
+        0.5,
+        (r0, Vector3::new(3.0, -2.0, 400.0)),
+    )
+    .unwrap();
+    let before = *stepper.state().unwrap();
+    let error = stepper.step().unwrap_err();
+    assert!(
+        matches!(
+            error,
+            DiracError::NoConvergence { .. }
+                | DiracError::UntrustedStep { .. }
+                | DiracError::SingularJacobian { .. }
+                | DiracError::NonFinite { .. }
+        ),
+        "{error}"
+    );
+    assert_eq!(*stepper.state().unwrap(), before);
+    assert_eq!(stepper.steps(), 0);
+}
+
+/// The moving-chart equations on `Rⁿ`, where the chart transitions are translations, are the
+/// fixed-chart ones: the double pendulum steps alike through both.
+#[test]
+fn the_moving_chart_reduces_to_the_fixed_one_on_vectors() {
+    use scenes::double_pendulum;
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let (q0, v0) = (vector![0.7, -0.3], vector![0.2, 0.5]);
+        let mut fixed = Stepper::new(double_pendulum::SCENE, quadrature.clone(), 0.01).unwrap();
+        let mut moving =
+            Stepper::on_manifold(double_pendulum::SCENE, Euclidean, quadrature, 0.01).unwrap();
+        fixed.start_from_velocity(q0, v0).unwrap();
+        moving.start_from_velocity(q0, v0).unwrap();
+        fixed.run(300).unwrap();
+        moving.run(300).unwrap();
+        assert!((fixed.q() - moving.q()).amax() < 1e-12);
+        assert!((fixed.p() - moving.p()).amax() < 1e-12);
+    }
+}
+
+/// Runs on the group record attitudes, velocities and momenta with the product's column names,
+/// and the dense output passes through the step's ends on the manifold.
+#[test]
+fn runs_record_attitudes_and_interpolate_on_the_group() {
+    let mut stepper = rigid_body::started(
+        rigid_body::TOP,
+        Product::cayley(),
+        Quadrature::galerkin(2).unwrap(),
+        0.02,
+        rigid_body::top_start(),
+    )
+    .unwrap();
+    let solution = stepper
+        .solve(Run::until(0.2).saveat([0.0, 0.05, 0.1]))
+        .unwrap();
+    let names = solution.trajectory.column_names();
+    assert_eq!(&names[..4], ["t", "R_11", "R_12", "R_13"]);
+    assert!(names.contains(&"v_R_z".to_string()) && names.contains(&"p_R_x".to_string()));
+    let mut csv = Vec::new();
+    solution.trajectory.write_csv(&mut csv).unwrap();
+    assert_eq!(String::from_utf8(csv).unwrap().lines().count(), 4);
+    for q in solution.trajectory.q() {
+        assert!(orthogonality(&q.rotation[0]) < 1e-13);
+    }
+    // The dense output at the end of the last step is its end state.
+    let end = stepper.interpolate(stepper.t()).unwrap();
+    assert!((end.q.rotation[0] - stepper.q().rotation[0]).amax() < 1e-13);
+    let inside = stepper.interpolate(stepper.t() - 0.01).unwrap();
+    assert!(orthogonality(&inside.q.rotation[0]) < 1e-13);
+}
