@@ -19,7 +19,13 @@ mod vector_algebra;
 ///
 /// Arguments, in any order:
 /// - `coordinates(x, y, theta[8])`: the coordinates, single or arrays (an array length is a
-///   literal, a constant, or the struct's const parameter);
+///   literal, a constant, or the struct's const parameter); `R: SO3` is a rotation and `n: S2` a
+///   unit vector (arrays of them too, `links[3]: SO3`, with literal lengths): the model is then
+///   on a `Product` of vectors, rotations and unit vectors, and its expressions may use 3-vectors
+///   and 3×3 matrices (`R`, `omega(R)` the body angular velocity, `dot(R)`, `n`, `dot(n)`,
+///   `omega(n)`, parameters `[f64; 3]` and `[[f64; 3]; 3]`, `[a, b, c]`, `+ - * /`, `dot`,
+///   `cross`, `transpose`, `trace`, `norm`, `v[i]`, `M[i][j]`), and one-forms and forces the
+///   differentials `dR` (paired with `Ω`) and `dn`;
 /// - `lagrangian = EXPR`: the Lagrangian in the coordinates, their velocities `dot(x)`,
 ///   `dot(theta[i])`, and the fields (parameters, `f64` or `[f64; K]`), with `+ - * /`, numeric
 ///   literals, `sin cos tan asin acos atan sinh cosh tanh asinh acosh atanh exp exp2 exp_m1 ln
@@ -53,6 +59,25 @@ mod vector_algebra;
 /// assert_eq!(model.coordinate_name(1), "theta2");
 /// let mut stepper = Stepper::from_system(model, 0.01)?;
 /// stepper.start_from_velocity(vector![0.5, 0.0], vector![0.0, 0.0])?;
+/// stepper.run(100)?;
+/// # Ok::<(), DiracError>(())
+/// ```
+/// A rotation works the same way:
+///
+/// ```
+/// use dirac::prelude::*;
+///
+/// /// A heavy top: L = ½ Ωᵀ J Ω − m g e₃ᵀ R ρ.
+/// #[dirac_system(
+///     coordinates(R: SO3),
+///     lagrangian = 0.5 * dot(omega(R), j * omega(R)) - m * g * dot([0.0, 0.0, 1.0], R * rho),
+/// )]
+/// struct Top { j: [[f64; 3]; 3], m: f64, g: f64, rho: [f64; 3] }
+///
+/// let top = Top { j: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.5]], m: 1.0, g: 9.81, rho: [0.0, 0.0, 0.3] };
+/// let mut stepper = Stepper::on_manifold(top, Product::cayley(), Quadrature::midpoint(), 0.01)?;
+/// let tilted = Retraction::Exp.map(&Vector3::new(0.4, 0.0, 0.0));
+/// stepper.start_from_velocity(Configuration::of_rotation(tilted), Rates::of_rotation(Vector3::new(0.0, 0.0, 20.0)))?;
 /// stepper.run(100)?;
 /// # Ok::<(), DiracError>(())
 /// ```

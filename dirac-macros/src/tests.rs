@@ -88,6 +88,65 @@ fn expression(one_form: bool) -> impl Strategy<Value = String> {
         })
 }
 
+/// Expressions of numbers, vectors and matrices on a model with a rotation `R`, a unit vector
+/// `n` and a real `x`: well and badly shaped alike.
+fn group_expression(one_form: bool) -> impl Strategy<Value = String> {
+    let mut leaves = vec![
+        "x",
+        "R",
+        "n",
+        "rho",
+        "j",
+        "m",
+        "[1.0, x, 2.0]",
+        "0.5",
+        "R[1][2]",
+        "n[0]",
+        "rho[2]",
+        "j[0][1]",
+        "bodies[1]",
+        "bodies[2]",
+        "R[3]",
+    ];
+    leaves.extend(match one_form {
+        true => ["dR", "dn", "dx", "dbodies[0]"],
+        false => ["omega(R)", "dot(n)", "dot(R)", "omega(n)"],
+    });
+    select(leaves)
+        .prop_map(String::from)
+        .prop_recursive(5, 40, 3, move |inner| {
+            prop_oneof![
+                (
+                    inner.clone(),
+                    select(vec!["+", "-", "*", "/"]),
+                    inner.clone()
+                )
+                    .prop_map(|(a, op, b)| format!("{a} {op} {b}")),
+                inner.clone().prop_map(|a| format!("-({a})")),
+                (
+                    select(vec![
+                        "dot",
+                        "cross",
+                        "transpose",
+                        "trace",
+                        "norm",
+                        "sin",
+                        "omega"
+                    ]),
+                    inner.clone(),
+                    inner.clone(),
+                    0..3usize
+                )
+                    .prop_map(|(f, a, b, arity)| match arity {
+                        0 => format!("{f}({a})"),
+                        1 => format!("{f}({a}, {b})"),
+                        _ => format!("({a}).{f}({b})"),
+                    }),
+                (inner.clone(), 0..4usize).prop_map(|(a, i)| format!("({a})[{i}]")),
+            ]
+        })
+}
+
 /// Balanced token soup: names, keywords, operators and literals, grouped at random.
 fn tokens() -> impl Strategy<Value = String> {
     let vocabulary = vec![
@@ -177,6 +236,24 @@ proptest! {
     }
 
     #[test]
+    fn random_vector_expressions_never_panic(
+        expr in group_expression(false),
+        form in group_expression(true),
+    ) {
+        let item = "struct S { m: f64, rho: [f64; 3], j: [[f64; 3]; 3] }";
+        for args in [
+            format!("coordinates(x, R: SO3, n: S2, bodies[2]: SO3), lagrangian = {expr}"),
+            format!(
+                "coordinates(x, R: SO3, n: S2, bodies[2]: SO3), lagrangian = dot(x) * dot(x), \
+                 constraints({form}), forces({form})"
+            ),
+        ] {
+            let output = expand(&args, item).expect("tokenises");
+            prop_assert!(parses(&output), "{args}\n{output}");
+        }
+    }
+
+    #[test]
     fn random_tokens_never_panic(soup in tokens()) {
         for args in [
             soup.clone(),
@@ -216,6 +293,22 @@ fn ten_thousand_terms_expand() {
         force.join(" - "),
     );
     let output = expand(&args, ITEM).expect("tokenises");
+    assert!(!is_error(&output));
+    assert!(parses(&output));
+}
+
+/// A long sum of vector expressions on a rotation is lowered along its spine, without deep
+/// recursion.
+#[test]
+fn long_vector_sums_expand() {
+    let sum: Vec<String> = (0..5_000)
+        .map(|i| format!("{}.5 * dot(omega(R), R * rho)", i % 7))
+        .collect();
+    let args = format!(
+        "coordinates(R: SO3), lagrangian = 1.0 - {}",
+        sum.join(" + ")
+    );
+    let output = expand(&args, "struct S { rho: [f64; 3] }").expect("tokenises");
     assert!(!is_error(&output));
     assert!(parses(&output));
 }

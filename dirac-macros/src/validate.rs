@@ -260,8 +260,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     let (one_forms, holonomic, forces) = match &coordinates {
         Some(coordinates) => {
             let product = is_product(coordinates);
-            const NO_VELOCITIES: &str =
-                "constraints depend on positions only: dot(...) cannot appear here";
+            const NO_VELOCITIES: &str = "constraints depend on positions only: velocities (dot(...), omega(...)) cannot appear here";
             let positions = Scope {
                 coordinates,
                 inputs: &[],
@@ -295,12 +294,16 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                     },
                 )
                 .collect();
-            let holonomic = e
-                .holonomic
-                .unwrap_or_default()
-                .iter()
-                .filter_map(|g| holonomic_of(g, &positions, &mut errors))
-                .collect();
+            // (Refused with rotations or unit vectors, in `check_product`.)
+            let holonomic = match product {
+                true => Vec::new(),
+                false => e
+                    .holonomic
+                    .unwrap_or_default()
+                    .iter()
+                    .filter_map(|g| holonomic_of(g, &positions, &mut errors))
+                    .collect(),
+            };
             let state = Scope {
                 coordinates,
                 inputs: &inputs,

@@ -49,6 +49,8 @@ enum Value {
     Scalar(Expr),
     Vector([Expr; 3]),
     Matrix([[Expr; 3]; 3]),
+    /// A subexpression with an error, already reported: what contains it reports nothing more.
+    Invalid,
 }
 
 impl Value {
@@ -57,6 +59,7 @@ impl Value {
             Value::Scalar(_) => "a number",
             Value::Vector(_) => "a 3-vector",
             Value::Matrix(_) => "a 3×3 matrix",
+            Value::Invalid => "invalid",
         }
     }
 }
@@ -85,6 +88,7 @@ pub fn lower(expr: &Expr, algebra: &Algebra, errors: &mut Errors) -> Option<Expr
     }
     match value {
         Value::Scalar(e) => Some(e),
+        Value::Invalid => None,
         other => {
             let (start, end) = bounds(expr);
             errors.push_range(
@@ -242,13 +246,13 @@ fn path_ident(e: &Expr) -> Option<&Ident> {
 impl Lowering<'_, '_> {
     fn error(&mut self, span: Span, message: impl std::fmt::Display) -> Value {
         self.errors.push(span, message);
-        Value::Scalar(zero(span))
+        Value::Invalid
     }
 
     fn error_on(&mut self, expr: &Expr, message: impl std::fmt::Display) -> Value {
         let (start, end) = bounds(expr);
         self.errors.push_range(start, end, message);
-        Value::Scalar(zero(start))
+        Value::Invalid
     }
 
     fn coordinate(&self, ident: &Ident) -> Option<&Coordinate> {
@@ -381,7 +385,7 @@ impl Lowering<'_, '_> {
                     ),
                 );
             }
-            return Value::Scalar(zero(Span::call_site()));
+            return Value::Invalid;
         }
         match expr {
             Expr::Paren(p) => match self.value(&p.expr, depth + 1) {
@@ -397,6 +401,7 @@ impl Lowering<'_, '_> {
                     .collect();
                 match <[Expr; 3]>::try_from(items) {
                     Ok(v) if a.elems.len() == 3 => Value::Vector(v),
+                    _ if a.elems.len() == 3 => Value::Invalid,
                     _ => self.error_on(expr, "a vector [a, b, c] has three numbers"),
                 }
             }
@@ -412,6 +417,7 @@ impl Lowering<'_, '_> {
                     Value::Scalar(e) => Value::Scalar(negated(&e, span)),
                     Value::Vector(v) => Value::Vector(v.map(|e| negated(&e, span))),
                     Value::Matrix(m) => Value::Matrix(m.map(|r| r.map(|e| negated(&e, span)))),
+                    Value::Invalid => Value::Invalid,
                 }
             }
             Expr::Binary(b) => self.binary(b, depth),
@@ -426,6 +432,7 @@ impl Lowering<'_, '_> {
     fn scalar(&mut self, expr: &Expr, depth: usize, what: &str) -> Option<Expr> {
         match self.value(expr, depth) {
             Value::Scalar(e) => Some(e),
+            Value::Invalid => None,
             other => {
                 self.error_on(
                     expr,
@@ -439,6 +446,7 @@ impl Lowering<'_, '_> {
     fn vector(&mut self, expr: &Expr, depth: usize, what: &str) -> Option<[Expr; 3]> {
         match self.value(expr, depth) {
             Value::Vector(v) => Some(v),
+            Value::Invalid => None,
             other => {
                 self.error_on(
                     expr,
@@ -452,6 +460,7 @@ impl Lowering<'_, '_> {
     fn matrix(&mut self, expr: &Expr, depth: usize, what: &str) -> Option<[[Expr; 3]; 3]> {
         match self.value(expr, depth) {
             Value::Matrix(m) => Some(m),
+            Value::Invalid => None,
             other => {
                 self.error_on(
                     expr,
@@ -472,7 +481,7 @@ impl Lowering<'_, '_> {
         if let Some(element) = self.group_element(expr) {
             return match element {
                 Ok((c, element, _)) => self.position(&c, element, ident.span()),
-                Err(()) => Value::Scalar(zero(ident.span())),
+                Err(()) => Value::Invalid,
             };
         }
         if let Some(value) = self.differential_of(expr, ident, None) {
@@ -515,7 +524,7 @@ impl Lowering<'_, '_> {
         }
         Some(match element {
             Ok((c, _, index)) => self.differential(&c, index, ident.span()),
-            Err(()) => Value::Scalar(zero(ident.span())),
+            Err(()) => Value::Invalid,
         })
     }
 
@@ -525,7 +534,7 @@ impl Lowering<'_, '_> {
             if let Some(element) = self.group_element(expr) {
                 return match element {
                     Ok((c, element, _)) => self.position(&c, element, base.span()),
-                    Err(()) => Value::Scalar(zero(base.span())),
+                    Err(()) => Value::Invalid,
                 };
             }
             if let Some(value) = self.differential_of(expr, base, Some(&ix.index)) {
@@ -567,6 +576,7 @@ impl Lowering<'_, '_> {
         match self.value(&ix.expr, depth + 1) {
             Value::Vector(v) => Value::Scalar(v[i].clone()),
             Value::Matrix(m) => Value::Vector(m[i].clone()),
+            Value::Invalid => Value::Invalid,
             Value::Scalar(_) => self.error(
                 span,
                 "this indexes a number; only vectors and matrices have components",
@@ -584,6 +594,7 @@ impl Lowering<'_, '_> {
             );
             return match (left, right) {
                 (Value::Scalar(x), Value::Scalar(y)) => Value::Scalar(binary(x, b.op, y)),
+                (Value::Invalid, _) | (_, Value::Invalid) => Value::Invalid,
                 (l, r) => self.error(
                     b.op.span(),
                     format!(
@@ -609,6 +620,7 @@ impl Lowering<'_, '_> {
         use Value::{Matrix, Scalar, Vector};
         match (op, left, right) {
             (_, Scalar(x), Scalar(y)) => Scalar(binary(x, op, y)),
+            (_, Value::Invalid, _) | (_, _, Value::Invalid) => Value::Invalid,
             (BinOp::Add(_) | BinOp::Sub(_), l, r) => {
                 let minus = matches!(op, BinOp::Sub(_));
                 let pair = |x: &Expr, y: &Expr| sum([(false, x.clone()), (minus, y.clone())], span);
@@ -638,7 +650,10 @@ impl Lowering<'_, '_> {
                 (Vector(_), Matrix(_)) => {
                     self.error(span, "a vector times a matrix: write transpose(M) * v")
                 }
-                (Scalar(_), Scalar(_)) => unreachable!("numbers are multiplied above"),
+                (l, r) => self.error(
+                    span,
+                    format!("cannot multiply {} by {}", l.shape(), r.shape()),
+                ),
             },
             (_, l, r) => match (l, r) {
                 (Vector(v), Scalar(s)) => Vector(v.map(|e| quotient(&e, &s, span))),
@@ -737,7 +752,7 @@ impl Lowering<'_, '_> {
                 );
                 match (u, v) {
                     (Some(u), Some(v)) => Value::Scalar(operand(dot(&u, &v, span))),
-                    _ => Value::Scalar(zero(span)),
+                    _ => Value::Invalid,
                 }
             }
             ("cross", Some(v)) => {
@@ -747,20 +762,20 @@ impl Lowering<'_, '_> {
                 );
                 match (u, v) {
                     (Some(u), Some(v)) => Value::Vector(cross(&u, &v, span)),
-                    _ => Value::Scalar(zero(span)),
+                    _ => Value::Invalid,
                 }
             }
             ("transpose", None) => match self.matrix(u, depth + 1, "the argument of transpose") {
                 Some(m) => Value::Matrix(std::array::from_fn(|i| {
                     std::array::from_fn(|j| m[j][i].clone())
                 })),
-                None => Value::Scalar(zero(span)),
+                None => Value::Invalid,
             },
             ("trace", None) => match self.matrix(u, depth + 1, "the argument of trace") {
                 Some(m) => {
                     Value::Scalar(operand(sum((0..3).map(|i| (false, m[i][i].clone())), span)))
                 }
-                None => Value::Scalar(zero(span)),
+                None => Value::Invalid,
             },
             (f @ ("norm" | "norm_squared"), None) => {
                 match self.vector(u, depth + 1, "the argument of norm") {
@@ -771,10 +786,10 @@ impl Lowering<'_, '_> {
                             _ => Value::Scalar(squared),
                         }
                     }
-                    None => Value::Scalar(zero(span)),
+                    None => Value::Invalid,
                 }
             }
-            _ => Value::Scalar(zero(span)),
+            _ => Value::Invalid,
         }
     }
 
@@ -783,10 +798,10 @@ impl Lowering<'_, '_> {
     fn velocity(&mut self, x: &Expr, expr: &Expr) -> Value {
         match self.group_element(x) {
             None => Value::Scalar(expr.clone()),
-            Some(Err(())) => Value::Scalar(zero(x.span())),
+            Some(Err(())) => Value::Invalid,
             Some(Ok((c, element, _))) => {
                 if !self.velocities_allowed(expr) {
-                    return Value::Scalar(zero(x.span()));
+                    return Value::Invalid;
                 }
                 let span = x.span();
                 let rate = self.rate(&c, element, span);
@@ -805,10 +820,10 @@ impl Lowering<'_, '_> {
     fn angular_velocity(&mut self, x: &Expr, expr: &Expr) -> Value {
         match self.group_element(x) {
             None => self.error_on(x, "omega(...) takes a rotation or a unit vector"),
-            Some(Err(())) => Value::Scalar(zero(x.span())),
+            Some(Err(())) => Value::Invalid,
             Some(Ok((c, element, _))) => {
                 if !self.velocities_allowed(expr) {
-                    return Value::Scalar(zero(x.span()));
+                    return Value::Invalid;
                 }
                 let span = x.span();
                 let rate = self.rate(&c, element, span);
