@@ -485,3 +485,27 @@ fn runs_record_attitudes_and_interpolate_on_the_group() {
     let inside = stepper.interpolate(stepper.t() - 0.01).unwrap();
     assert!(orthogonality(&inside.q.rotation[0]) < 1e-13);
 }
+
+/// The hand-written Lie group variational integrator of the bench (Lee, Leok and McClamroch's,
+/// Newton on the Cayley parameter) converges at order 2 to the same reference as the generated
+/// steppers: the bench compares two correct second-order schemes.
+#[test]
+fn the_hand_written_lgvi_of_the_bench_converges_at_order_two() {
+    use scenes::hand_written_lgvi::HandLgvi;
+    let t_end = 1.0;
+    let (r0, omega0) = rigid_body::pendulum_start();
+    let (r_ref, pi_ref) =
+        rigid_body::reference(&rigid_body::PENDULUM, &r0, &omega0, t_end, 1e-13).unwrap();
+    let errors: Vec<(f64, f64)> = [20, 40, 80, 160]
+        .iter()
+        .map(|&n| {
+            let h = t_end / n as f64;
+            let mut hand = HandLgvi::new(&rigid_body::PENDULUM, h, r0, omega0);
+            for _ in 0..n {
+                hand.step().unwrap();
+            }
+            (h, (hand.r - r_ref).amax().max((hand.pi - pi_ref).amax()))
+        })
+        .collect();
+    order_of("hand-written LGVI", &errors, 2.0);
+}

@@ -11,6 +11,7 @@ pub mod ensemble;
 pub mod figures;
 pub mod first_order;
 pub mod hand_written;
+pub mod hand_written_lgvi;
 pub mod kepler;
 pub mod knife_edge;
 pub mod lotka_volterra;
