@@ -267,9 +267,14 @@ fn lie_group(c: &mut Criterion) {
     let (r0, omega0) = rigid_body::pendulum_start();
     for quadrature in [Quadrature::midpoint(), Quadrature::trapezoid()] {
         let name = format!("generated_{}", quadrature.name());
-        let started =
-            rigid_body::started(rigid_body::PENDULUM, Product::cayley(), quadrature, h, (r0, omega0))
-                .expect("valid scene");
+        let started = rigid_body::started(
+            rigid_body::PENDULUM,
+            Product::cayley(),
+            quadrature,
+            h,
+            (r0, omega0),
+        )
+        .expect("valid scene");
         let mut stepper = started.clone();
         group.bench_function(name, |b| {
             b.iter(|| {

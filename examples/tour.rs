@@ -5,14 +5,17 @@
 //! in the velocities) and the rolling disk with the Gauss rules; and the trapezoid rule's
 //! refusal of the ill-posed LC circuit is shown. Pictures: `output/convergence.png`,
 //! `output/energy_error.png`, `output/knife_edge.png`, `output/lc_circuit.png`,
-//! `output/cart_pole_lqr.png`, `output/long_horizon_energy.png`.
+//! `output/cart_pole_lqr.png`, `output/long_horizon_energy.png`, `output/heavy_top.png`,
+//! `output/heavy_top_invariants.png`. Models on rotations and unit vectors: the heavy top (both
+//! retractions), the 3D pendulum against a quaternion reference, the spherical pendulum on `S²`
+//! beside the Cartesian one, the rolling ball at each constraint point and a satellite's slew.
 //!
 //! `cargo run --release --example tour`
 
 mod scenes;
 
-use dirac::{ConstraintPoint, DiracError, Quadrature};
-use scenes::{Report, circuit, knife_edge};
+use dirac::{ConstraintPoint, DiracError, Product, Quadrature};
+use scenes::{Report, circuit, knife_edge, rigid_body, rolling_ball};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     type Scene = fn(Quadrature) -> Result<Report, DiracError>;
@@ -59,6 +62,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     ] {
         reports.push(knife_edge::report_point(point)?);
     }
+    // Rotations and unit vectors.
+    for space in [Product::cayley(), Product::exp()] {
+        reports.push(rigid_body::report(space)?);
+    }
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2)?] {
+        reports.push(rigid_body::pendulum_report(quadrature)?);
+    }
+    reports.extend(scenes::spherical_pendulum::reports()?);
+    for point in [
+        ConstraintPoint::Start,
+        ConstraintPoint::Midpoint,
+        ConstraintPoint::End,
+    ] {
+        reports.push(rolling_ball::report(point)?);
+    }
+    reports.push(scenes::satellite::report()?);
     scenes::print_table(&reports);
     scenes::save_table(&reports, "output/tour.csv")?;
     match circuit::lc_at_10(Quadrature::trapezoid(), 0.01) {

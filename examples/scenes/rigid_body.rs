@@ -266,6 +266,72 @@ pub fn vertical_momentum(q: &Configuration<f64, 0, 1, 0>, p: &Rates<f64, 0, 1, 0
     q.spatial(p, 0)[2]
 }
 
+/// The 3D pendulum to T = 5 with `quadrature` (Cayley, h = 0.01) against the quaternion reference
+/// (Dop853 at 1e-13).
+pub fn pendulum_report(quadrature: Quadrature) -> Result<Report, Box<dyn std::error::Error>> {
+    let (h, t_end) = (0.01, 5.0);
+    let name = quadrature.name();
+    let start = pendulum_start();
+    let mut stepper = started(PENDULUM, Product::cayley(), quadrature, h, start)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
+    let (r_ref, pi_ref) = reference(&PENDULUM, &start.0, &start.1, t_end, 1e-13)?;
+    let error = (stepper.q().rotation[0] - r_ref)
+        .amax()
+        .max((stepper.p().rotation[0] - pi_ref).amax());
+    trajectory.save_csv(format!("output/pendulum_3d_{name}.csv"))?;
+    Ok(Report {
+        scene: "3D pendulum",
+        quadrature: format!("{name}, Cayley"),
+        h,
+        steps: stepper.steps(),
+        max_energy_error: Some(trajectory.max_energy_error()),
+        wall,
+        check: format!("|(R, Π)(5) − Dop853| = {error:.1e}"),
+    })
+}
+
+/// The axis of the top's symmetry in space, `R e₃`, at every `every`-th step of `steps`.
+pub fn top_axis(
+    space: Product<0, 1, 0>,
+    h: f64,
+    steps: u64,
+    every: usize,
+) -> Result<Vec<(f64, Vector3<f64>)>, DiracError> {
+    let mut stepper = started(TOP, space, Quadrature::midpoint(), h, top_start())?;
+    let trajectory = stepper.solve(Run::steps(steps).every(every))?.trajectory;
+    Ok(trajectory
+        .t()
+        .iter()
+        .zip(trajectory.q())
+        .map(|(t, q)| (*t, q.rotation[0] * Vector3::z()))
+        .collect())
+}
+
+/// The top's energy error and vertical momentum drift every 1 000 steps of a run of `steps`
+/// (h = 0.01): `(t, |E − E₀|, |ΔL_z|)`.
+pub fn top_invariants(
+    space: Product<0, 1, 0>,
+    steps: u64,
+) -> Result<Vec<(f64, f64, f64)>, DiracError> {
+    let mut stepper = started(TOP, space, Quadrature::midpoint(), 0.01, top_start())?;
+    let solution = stepper.solve(Run::steps(steps).every(1000))?;
+    let trajectory = solution.trajectory;
+    let (e0, lz0) = (
+        trajectory.energy()[0],
+        vertical_momentum(&trajectory.q()[0], &trajectory.p()[0]),
+    );
+    Ok((0..trajectory.len())
+        .map(|k| {
+            let sample = trajectory.sample(k).expect("in range");
+            (
+                sample.t,
+                (trajectory.energy()[k] - e0).abs(),
+                (vertical_momentum(&sample.q, &sample.p) - lz0).abs(),
+            )
+        })
+        .collect())
+}
+
 /// The tour's rows: the top over 10 s with both retractions, its vertical momentum and
 /// `RᵀR − I` checked.
 pub fn report(space: Product<0, 1, 0>) -> Result<Report, DiracError> {

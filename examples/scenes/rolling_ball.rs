@@ -6,6 +6,8 @@
 
 use dirac::prelude::*;
 
+use super::{Report, timed};
+
 /// A ball of mass `m`, radius `r` and moment of inertia `i` about any axis through its centre.
 #[dirac_system(
     coordinates(x, y, R: SO3),
@@ -61,4 +63,26 @@ pub fn started(
     );
     stepper.start_from_velocity(start, rates)?;
     Ok(stepper)
+}
+
+/// The tour's row: rolling for 10 s (midpoint, h = 0.01) with the one-forms at `point`.
+pub fn report(point: ConstraintPoint) -> Result<Report, DiracError> {
+    let (h, t_end) = (0.01, 10.0);
+    let mut stepper = started(Quadrature::midpoint(), h, point)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
+    let (x, r) = exact(stepper.t());
+    let q = stepper.q();
+    let error = (q.vector - x).amax().max((q.rotation[0] - r).amax());
+    Ok(Report {
+        scene: "rolling ball",
+        quadrature: format!("midpoint, one-forms at {point:?}"),
+        h,
+        steps: stepper.steps(),
+        max_energy_error: Some(trajectory.max_energy_error()),
+        wall,
+        check: format!(
+            "|q(10) − exact| = {error:.1e}, violation {:.1e}",
+            trajectory.max_constraint_violation()
+        ),
+    })
 }

@@ -6,6 +6,8 @@
 
 use dirac::prelude::*;
 
+use super::Report;
+
 /// A rigid satellite with principal moments of inertia `j`, torques `tau_x, tau_y, tau_z` about
 /// its body axes.
 #[dirac_system(
@@ -55,4 +57,29 @@ pub fn slew(target: &Matrix3<f64>, h: f64, t_end: f64) -> Result<(Vec<f64>, Vec<
         stepper.step()?;
     }
     Ok((times, errors))
+}
+
+/// The tour's row: the slew to a target 1.5 rad away (midpoint, h = 0.01, 12 s).
+pub fn report() -> Result<Report, DiracError> {
+    let h = 0.01;
+    let start = std::time::Instant::now();
+    let (times, errors) = slew(&target(), h, 12.0)?;
+    Ok(Report {
+        scene: "satellite slew",
+        quadrature: "midpoint, Cayley".into(),
+        h,
+        steps: times.len() as u64,
+        max_energy_error: None,
+        wall: start.elapsed(),
+        check: format!(
+            "attitude error {:.2} → {:.1e} rad",
+            errors.first().copied().unwrap_or_default(),
+            errors.last().copied().unwrap_or_default()
+        ),
+    })
+}
+
+/// The slew's target attitude.
+pub fn target() -> Matrix3<f64> {
+    Retraction::Exp.map(&Vector3::new(0.5, -0.8, 1.2))
 }

@@ -6,6 +6,8 @@
 use dirac::prelude::*;
 use ode_solvers::{Dop853, OutputType, System};
 
+use super::{Report, timed};
+
 /// A bob of mass `m` on a massless rod of length `l` from a fixed point, `n` the rod's direction,
 /// gravity `g` along `−e₃`.
 #[dirac_system(
@@ -144,4 +146,51 @@ pub fn reference(t_end: f64, tolerance: f64) -> Result<(Vector3<f64>, Vector3<f6
         Vector3::new(end[0], end[1], end[2]),
         Vector3::new(end[3], end[4], end[5]),
     ))
+}
+
+/// The tour's rows: the pendulum on `S²` (both retractions) and the Cartesian one (SHAKE), to
+/// T = 10 with the midpoint rule at h = 0.01, against Dop853 at 1e-13.
+pub fn reports() -> Result<Vec<Report>, Box<dyn std::error::Error>> {
+    let (h, t_end) = (0.01, 10.0);
+    let (x_ref, _) = reference(t_end, 1e-13)?;
+    let l = SCENE.l;
+    let mut reports = Vec::new();
+    for space in [Product::cayley(), Product::exp()] {
+        let mut stepper = on_sphere(space, Quadrature::midpoint(), h)?;
+        let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
+        let error = (stepper.q().direction[0] * l - x_ref).amax();
+        let drift = trajectory
+            .q()
+            .iter()
+            .zip(trajectory.p())
+            .map(|(q, p)| vertical_momentum(&q.direction[0], &p.direction[0]))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), l| {
+                (lo.min(l), hi.max(l))
+            });
+        reports.push(Report {
+            scene: "spherical pend.",
+            quadrature: format!("midpoint on S², {:?}", space.retraction()),
+            h,
+            steps: stepper.steps(),
+            max_energy_error: Some(trajectory.max_energy_error()),
+            wall,
+            check: format!(
+                "|x(10) − Dop853| = {error:.1e}, |ΔL_z| = {:.1e}",
+                drift.1 - drift.0
+            ),
+        });
+    }
+    let mut stepper = cartesian(Quadrature::midpoint(), h)?;
+    let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
+    let error = (stepper.q() - x_ref).amax();
+    reports.push(Report {
+        scene: "spherical pend.",
+        quadrature: "midpoint, Cartesian + SHAKE".into(),
+        h,
+        steps: stepper.steps(),
+        max_energy_error: Some(trajectory.max_energy_error()),
+        wall,
+        check: format!("|x(10) − Dop853| = {error:.1e}"),
+    });
+    Ok(reports)
 }
