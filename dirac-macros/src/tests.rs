@@ -107,6 +107,11 @@ fn group_expression(one_form: bool) -> impl Strategy<Value = String> {
         "bodies[1]",
         "bodies[2]",
         "R[3]",
+        // Names that start with `d` but are no differentials: a parameter, `d` alone, `d2`.
+        "dm",
+        "d",
+        "d2",
+        "d[1]",
     ];
     leaves.extend(match one_form {
         true => ["dR", "dn", "dx", "dbodies[0]"],
@@ -240,7 +245,7 @@ proptest! {
         expr in group_expression(false),
         form in group_expression(true),
     ) {
-        let item = "struct S { m: f64, rho: [f64; 3], j: [[f64; 3]; 3] }";
+        let item = "struct S { m: f64, rho: [f64; 3], j: [[f64; 3]; 3], dm: f64, d: [f64; 3] }";
         for args in [
             format!("coordinates(x, R: SO3, n: S2, bodies[2]: SO3), lagrangian = {expr}"),
             format!(

@@ -35,10 +35,19 @@ pub const DIFFERENTIAL: &str = "__gd_";
 pub fn atom(what: &str, name: &Ident, element: Option<usize>, indices: &[usize]) -> Ident {
     let element = element.map_or(String::new(), |e| format!("_{e}"));
     let indices: String = indices.iter().map(|i| format!("_{i}")).collect();
-    Ident::new(
-        &format!("{ATOM}{what}_{name}{element}{indices}"),
-        name.span(),
+    // `format_ident!` writes a raw identifier (`r#type`) without its `r#`.
+    quote::format_ident!(
+        "{ATOM}{what}_{}{element}{indices}",
+        name,
+        span = name.span()
     )
+}
+
+/// `name` pointing at `span`.
+fn respanned(name: &Ident, span: Span) -> Ident {
+    let mut name = name.clone();
+    name.set_span(span);
+    name
 }
 
 /// A value of an expression: a number, a 3-vector or a 3×3 matrix, each entry a scalar
@@ -318,7 +327,7 @@ impl Lowering<'_, '_> {
 
     /// The position of a group coordinate's element: a rotation's matrix or a unit vector.
     fn position(&self, c: &Coordinate, element: Option<usize>, span: Span) -> Value {
-        let name = Ident::new(&c.name.to_string(), span);
+        let name = respanned(&c.name, span);
         match c.kind {
             Kind::Rotation => Value::Matrix(std::array::from_fn(|r| {
                 std::array::from_fn(|k| leaf(atom("R", &name, element, &[r, k])))
@@ -331,7 +340,7 @@ impl Lowering<'_, '_> {
 
     /// A rotation's body angular velocity, or a unit vector's velocity.
     fn rate(&self, c: &Coordinate, element: Option<usize>, span: Span) -> [Expr; 3] {
-        let name = Ident::new(&c.name.to_string(), span);
+        let name = respanned(&c.name, span);
         let what = if c.kind == Kind::Rotation { "W" } else { "V" };
         std::array::from_fn(|k| leaf(atom(what, &name, element, &[k])))
     }
@@ -509,8 +518,9 @@ impl Lowering<'_, '_> {
         index: Option<&Expr>,
     ) -> Option<Value> {
         let name = ident.to_string();
-        let rest = name.strip_prefix('d')?;
-        let target = Ident::new(rest, ident.span());
+        // `d` alone, or `d` before what is no identifier (`d2`), names no coordinate.
+        let mut target: Ident = syn::parse_str(name.strip_prefix('d')?).ok()?;
+        target.set_span(ident.span());
         let named: Expr = match index {
             None => parse_quote_spanned!(ident.span()=> #target),
             Some(i) => parse_quote_spanned!(ident.span()=> #target[#i]),

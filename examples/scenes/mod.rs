@@ -21,6 +21,7 @@ pub mod pendulum;
 pub mod port;
 pub mod progress;
 pub mod rigid_body;
+pub mod rigid_chain;
 pub mod rolling_ball;
 pub mod rolling_disk;
 pub mod satellite;

@@ -4,11 +4,11 @@ use dirac::prelude::*;
 
 #[dirac_system(
     coordinates(x, links[2]: SO3, n: S2),
-    lagrangian = 0.5 * m * dot(x).powi(2)
+    lagrangian = 0.5 * m * dot(x).powi(2) + d2 * dot(x)
         + 0.5 * dot(omega(links[0]), j * omega(links[0]))
         + 0.5 * dot(omega(links[1]), omega(links[1]))
         + 0.5 * dot(dot(n), dot(n))
-        - g * (links[0] * rho)[2] - g * n[2] - 0.5 * k * x * x,
+        - g * (links[0] * rho)[2] - g * n[2] - 0.5 * k * x * x + dot(d, omega(links[1])),
     constraints(dx - dot(rho, dlinks[1])),
     forces(u * dn[0] - c * dot(x) * dx),
     inputs(u),
@@ -20,6 +20,9 @@ struct Mixed {
     g: f64,
     j: [[f64; 3]; 3],
     rho: [f64; 3],
+    // Parameters whose names start with `d` are not differentials.
+    d: [f64; 3],
+    d2: f64,
 }
 
 fn main() {
@@ -30,6 +33,8 @@ fn main() {
         g: 9.81,
         j: [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 3.0]],
         rho: [0.0, 0.0, 0.5],
+        d: [0.1, 0.0, 0.0],
+        d2: 0.3,
     };
     assert_eq!(model.coordinate_name(1), "links[0]");
     assert_eq!(model.coordinate_name(3), "n");
