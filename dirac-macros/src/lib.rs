@@ -32,7 +32,8 @@ mod vector_algebra;
 ///   ln_1p log2 log10 sqrt cbrt recip abs` of one argument, `powi(x, n)`, `powf(x, c)`,
 ///   `pow(x, y)`, `atan2(y, x)`, and methods of the same names (`dot(x).powi(2)`);
 ///   or `lagrangian = path::to::function`, a generic
-///   `fn<D: Scalar>(&Model, &SVector<D, N>, &SVector<D, N>) -> D` for big models;
+///   `fn<D: Scalar>(&Model, &SVector<D, N>, &SVector<D, N>) -> D` for big models (with rotations
+///   or unit vectors `fn<D: Scalar>(&Model, &Configuration<D, K, A, B>, &Rates<D, K, A, B>) -> D`);
 /// - `quadrature = midpoint | trapezoid | galerkin(s) | galerkin(s, gauss_legendre(r)) |
 ///   galerkin(s, gauss_lobatto(r))`: the default quadrature (`midpoint` if omitted);
 /// - `crate = path`: where the generated code finds the runtime (`::dirac` by default;
