@@ -10,9 +10,8 @@
 //! body torques and forces on the unit vectors.
 //!
 //! A step works in `N = K + 3A + 2B` chart coordinates, in that order: `x + ξ` for the vectors,
-//! `R τ(ξ)` for each rotation and `τ(q × B(q)ξ) q` for each unit vector (see
-//! [`rotation`](crate::rotation) and [`sphere`](crate::sphere)), with `τ` the chosen
-//! [`Retraction`]. The charts of a rotation at `R` and at `R τ(η)` differ by the non-affine
+//! `R τ(ξ)` for each rotation and `τ(q × B(q)ξ) q` for each unit vector (see [`rotation`] and
+//! [`sphere`]), with `τ` the chosen [`Retraction`]. The charts of a rotation at `R` and at `R τ(η)` differ by the non-affine
 //! transition `ξ ↦ τ⁻¹(τ(η)⁻¹ τ(ξ))`: the step equations take the derivative of the discrete
 //! Lagrangian in its first point through that moving chart (see
 //! [`GroupEulerLagrange`](crate::group_euler_lagrange::GroupEulerLagrange)).
