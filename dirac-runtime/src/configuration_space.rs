@@ -40,6 +40,23 @@ pub struct StepCovectors<const N: usize> {
     pub end: SVector<f64, N>,
 }
 
+impl<const N: usize> StepCovectors<N> {
+    /// No impulse and no end covector.
+    pub fn zero() -> Self {
+        Self {
+            impulse: SVector::zeros(),
+            end: SVector::zeros(),
+        }
+    }
+}
+
+impl<const N: usize> std::ops::AddAssign for StepCovectors<N> {
+    fn add_assign(&mut self, other: Self) {
+        self.impulse += other.impulse;
+        self.end += other.end;
+    }
+}
+
 /// The point of a configuration space `C` over the scalar `D`.
 pub type Point<C, const N: usize, D> =
     <<C as ConfigurationSpace<N>>::Manifold as Manifold<N>>::Point<D>;

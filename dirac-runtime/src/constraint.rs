@@ -332,8 +332,10 @@ pub(crate) fn holonomic_forms<
     }
 }
 
-/// The largest constraint violation of a step `ξ` from `q0` to `q1`: `|Ã(ξ_c) ξ|` over the
-/// one-forms (on `Rⁿ`, `|A(q_c)(q1 − q0)|`) and `|g(q1)|` over the holonomic constraints.
+/// The largest constraint violation of the step from `q0` to the stored `q1`: `|Ã(ξ_c) ξ|` over
+/// the one-forms (on `Rⁿ`, `|A(q_c)(q1 − q0)|`) and `|g(q1)|` over the holonomic constraints,
+/// with `ξ` read back from the stored points as a user reading the trajectory would (the step's
+/// own `solved` increment where the chart does not reach `q1`).
 pub(crate) fn violation<
     S: DiracSystem<N, C::Manifold>,
     C: ConfigurationSpace<N>,
@@ -343,9 +345,10 @@ pub(crate) fn violation<
     space: &C,
     point: ConstraintPoint,
     q0: &Point<C, N, f64>,
-    xi: &SVector<f64, N>,
     q1: &Point<C, N, f64>,
+    solved: &SVector<f64, N>,
 ) -> f64 {
+    let xi = &space.local(q0, q1).unwrap_or(*solved);
     let xi_c = xi * point.theta();
     let forms = (0..S::ONE_FORMS).map(|a| {
         let row = space.pull_back(q0, &xi_c, &system.one_form(&space.retract(q0, &xi_c), a));

@@ -16,7 +16,7 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::closed_form::LagrangianHessian;
-use crate::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors};
+use crate::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors, Tangent};
 use crate::derivatives::{
     InChart, PhaseFunction, Seed, directional_gradient, gradients, hessian, moving_row, seeded,
     third_derivative,
@@ -24,6 +24,7 @@ use crate::derivatives::{
 use crate::error::DiracError;
 use crate::manifold::Vectors;
 use crate::quadrature::Quadrature;
+use crate::step_equations::State;
 use crate::system::DiracSystem;
 
 /// The discrete Lagrangian of `system` under `quadrature` with step `h`, on the configuration
@@ -90,6 +91,56 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             }),
             None => Ok(()),
         }
+    }
+
+    /// The state after a step from `state` to `R_{q_k}(ξ)`: the position advanced through the
+    /// chart, the momentum from the step's `covectors` (to which the discrete Lagrangian's own are
+    /// added here when the residual left them `pending`), the velocity not yet set. `step`
+    /// counts the steps before, for the error where the chart's tangent map is singular.
+    pub(crate) fn advanced(
+        &self,
+        state: &State<N, C::Manifold>,
+        xi: &SVector<f64, N>,
+        increments: &[SVector<f64, N>],
+        mut covectors: StepCovectors<N>,
+        pending: bool,
+        step: u64,
+    ) -> Result<State<N, C::Manifold>, DiracError> {
+        if pending {
+            covectors += self.slot_covectors(&state.q, increments);
+        }
+        let mut next = *state;
+        self.space.advance(&mut next.q, &mut next.q_carry, xi);
+        self.space
+            .advance_momentum(&state.q, xi, &mut next.p, &mut next.p_carry, &covectors)
+            .ok_or_else(|| {
+                DiracError::OutsideChart(format!(
+                    "step {step} reaches a point where the retraction's tangent map is singular"
+                ))
+            })?;
+        Ok(next)
+    }
+
+    /// Refuses the end of step `step` where `L(q, v)` is not finite. The quadrature may never
+    /// evaluate `L` at `q_{k+1}` (the midpoint rule does not): a step that leaves the
+    /// Lagrangian's domain is refused here, not found later as NaN energies.
+    pub(crate) fn check_end(
+        &self,
+        q: &Point<C, N, f64>,
+        v: &Tangent<C, N, f64>,
+        step: u64,
+    ) -> Result<(), DiracError> {
+        let lagrangian = self.system.lagrangian(q, v);
+        if lagrangian.is_finite() {
+            return Ok(());
+        }
+        Err(DiracError::NonFinite {
+            what: format!(
+                "the Lagrangian at the end of step {step} (the step leaves its domain or \
+                 overflows; try a smaller step)"
+            ),
+            value: lagrangian,
+        })
     }
 
     /// The continuous system.
@@ -386,10 +437,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     ) -> StepCovectors<N> {
         let (quad, h, s) = (&self.quadrature, self.h, self.quadrature.degree());
         let chart = self.in_chart(base);
-        let mut covectors = StepCovectors {
-            impulse: SVector::zeros(),
-            end: SVector::zeros(),
-        };
+        let mut covectors = StepCovectors::zero();
         for (i, &b) in quad.weights().iter().enumerate() {
             let (xi, xi_dot) = self.node(i, increments);
             let (lq, lv) = gradients(&chart, &xi, &xi_dot);

@@ -148,10 +148,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             momentum: SVector::zeros(),
             holonomic_forms: vec![SVector::zeros(); S::HOLONOMIC],
             increments: vec![SVector::zeros(); s],
-            covectors: StepCovectors {
-                impulse: SVector::zeros(),
-                end: SVector::zeros(),
-            },
+            covectors: StepCovectors::zero(),
             covectors_pending: false,
             scratch: DMatrix::zeros(0, 0),
             discrete,
@@ -704,10 +701,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         );
         // Left to `advance` where the residual did not need them.
         self.covectors_pending = lagrangian.is_none();
-        let mut covectors = lagrangian.unwrap_or(StepCovectors {
-            impulse: SVector::zeros(),
-            end: SVector::zeros(),
-        });
+        let mut covectors = lagrangian.unwrap_or_else(StepCovectors::zero);
         let jacobian = match jacobian {
             Some(jacobian) => jacobian,
             None => {
@@ -729,8 +723,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 residual,
                 jacobian,
             );
-            covectors.impulse += forces.impulse;
-            covectors.end += forces.end;
+            covectors += forces;
             scale = scale.max(size);
         }
         if Self::constrained() {
@@ -745,8 +738,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 h: discrete.h(),
             };
             let (impulses, size) = constraints.add(x, residual, jacobian);
-            covectors.impulse += impulses.impulse;
-            covectors.end += impulses.end;
+            covectors += impulses;
             scale = scale.max(size);
         }
         self.covectors = covectors;
@@ -1067,21 +1059,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             let shift = x.fixed_rows::<N>(self.layout.projection()).into_owned();
             xi = first_order::projected_increment(self.discrete.quadrature(), &xi, &shift);
         }
-        let mut covectors = self.covectors;
-        if self.covectors_pending {
-            let lagrangian = self.discrete.slot_covectors(&state.q, &self.increments);
-            covectors.impulse += lagrangian.impulse;
-            covectors.end += lagrangian.end;
-        }
-        let mut next = *state;
-        space.advance(&mut next.q, &mut next.q_carry, &xi);
-        space
-            .advance_momentum(&state.q, &xi, &mut next.p, &mut next.p_carry, &covectors)
-            .ok_or_else(|| {
-                DiracError::OutsideChart(format!(
-                    "step {step} reaches a point where the retraction's tangent map is singular"
-                ))
-            })?;
+        let mut next = self.discrete.advanced(
+            state,
+            &xi,
+            &self.increments,
+            self.covectors,
+            self.covectors_pending,
+            step,
+        )?;
         if !self.collocated.is_empty() {
             // The primary constraint p = ϑ(q) on the collocated coordinates.
             let theta = legendre::momentum(system, &next.q, &next.velocity);
@@ -1102,18 +1087,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         if S::HOLONOMIC > 0 && self.holonomic_scheme == HolonomicScheme::Rattle {
             self.project_momentum(&mut next, state.t + self.discrete.h(), step)?;
         }
-        // The quadrature may never evaluate L at q_{k+1} (the midpoint rule does not): a step
-        // that leaves the Lagrangian's domain is refused here, not found later as NaN energies.
-        let lagrangian = system.lagrangian(&next.q, &next.velocity);
-        if !lagrangian.is_finite() {
-            return Err(DiracError::NonFinite {
-                what: format!(
-                    "the Lagrangian at the end of step {step} (the step leaves its domain or \
-                     overflows; try a smaller step)"
-                ),
-                value: lagrangian,
-            });
-        }
+        self.discrete.check_end(&next.q, &next.velocity, step)?;
         let violation = if S::ONE_FORMS > 0 && self.layout.points() > 1 {
             // Measured with the stored end point (after any projection).
             let s = self.layout.points();
@@ -1126,9 +1100,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             let h = self.discrete.h();
             constraint::node_violation(system, self.discrete.quadrature(), h, &state.q, &increments)
         } else if Self::constrained() {
-            // Measured on the stored points, as a user reading the trajectory would.
-            let stored = space.local(&state.q, &next.q).unwrap_or(xi);
-            constraint::violation(system, space, self.point, &state.q, &stored, &next.q)
+            constraint::violation(system, space, self.point, &state.q, &next.q, &xi)
         } else {
             0.0
         };

@@ -123,10 +123,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             lifted_inputs: vec![Dual::from(0.0); S::INPUTS],
             momentum: SVector::zeros(),
             increments: vec![SVector::zeros(); s],
-            covectors: StepCovectors {
-                impulse: SVector::zeros(),
-                end: SVector::zeros(),
-            },
+            covectors: StepCovectors::zero(),
             covectors_pending: false,
             scratch: DMatrix::zeros(0, 0),
             discrete,
@@ -368,10 +365,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             jacobian.as_deref_mut(),
         );
         self.covectors_pending = lagrangian.is_none();
-        let mut covectors = lagrangian.unwrap_or(StepCovectors {
-            impulse: SVector::zeros(),
-            end: SVector::zeros(),
-        });
+        let mut covectors = lagrangian.unwrap_or_else(StepCovectors::zero);
         if !S::FORCES && S::ONE_FORMS == 0 {
             self.covectors = covectors;
             return scale;
@@ -396,8 +390,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
                 residual,
                 jacobian,
             );
-            covectors.impulse += forces.impulse;
-            covectors.end += forces.end;
+            covectors += forces;
             scale = scale.max(size);
         }
         if S::ONE_FORMS > 0 {
@@ -440,21 +433,14 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
     ) -> Result<(State<N, C::Manifold>, f64), DiracError> {
         let (space, system) = (self.discrete.space(), self.discrete.system());
         let xi = x.fixed_rows::<N>(self.layout.end_point()).into_owned();
-        let mut covectors = self.covectors;
-        if self.covectors_pending {
-            let lagrangian = self.discrete.slot_covectors(&state.q, &self.increments);
-            covectors.impulse += lagrangian.impulse;
-            covectors.end += lagrangian.end;
-        }
-        let mut next = *state;
-        space.advance(&mut next.q, &mut next.q_carry, &xi);
-        space
-            .advance_momentum(&state.q, &xi, &mut next.p, &mut next.p_carry, &covectors)
-            .ok_or_else(|| {
-                DiracError::OutsideChart(format!(
-                    "step {step} reaches a point where the retraction's tangent map is singular"
-                ))
-            })?;
+        let mut next = self.discrete.advanced(
+            state,
+            &xi,
+            &self.increments,
+            self.covectors,
+            self.covectors_pending,
+            step,
+        )?;
         let points = <C::Manifold as Manifold<N>>::point_components(&next.q);
         let momenta = <C::Manifold as Manifold<N>>::tangent_components(&next.p);
         if !finite(&points) || !finite(&momenta) {
@@ -464,20 +450,9 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             });
         }
         next.velocity = space.push_forward(&state.q, &xi, &(xi / self.discrete.h()));
-        let lagrangian = system.lagrangian(&next.q, &next.velocity);
-        if !lagrangian.is_finite() {
-            return Err(DiracError::NonFinite {
-                what: format!(
-                    "the Lagrangian at the end of step {step} (the step leaves its domain or \
-                     overflows; try a smaller step)"
-                ),
-                value: lagrangian,
-            });
-        }
+        self.discrete.check_end(&next.q, &next.velocity, step)?;
         let violation = if S::ONE_FORMS > 0 {
-            // Measured on the stored points, as a user reading the trajectory would.
-            let stored = space.local(&state.q, &next.q).unwrap_or(xi);
-            constraint::violation(system, space, self.point, &state.q, &stored, &next.q)
+            constraint::violation(system, space, self.point, &state.q, &next.q, &xi)
         } else {
             0.0
         };

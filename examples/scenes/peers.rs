@@ -163,6 +163,41 @@ fn integrate<F: FirstOrder<Y, N>, const Y: usize, const N: usize>(
     Ok((array(&y_out), steps as u64))
 }
 
+/// The end state of Dop853 on `system` from `y0` over `[0, t_end]` at relative and absolute
+/// tolerance `tolerance` (sparse output, the crate's default controller, no step limit): the
+/// references of scenes whose ODE is written directly (rigid bodies, the sphere).
+pub fn dop853_end<S: System<f64, ode_solvers::SVector<f64, Y>>, const Y: usize>(
+    system: S,
+    y0: ode_solvers::SVector<f64, Y>,
+    t_end: f64,
+    tolerance: f64,
+) -> Result<ode_solvers::SVector<f64, Y>, String> {
+    let mut solver = Dop853::from_param(
+        system,
+        0.0,
+        t_end,
+        0.0,
+        y0,
+        tolerance,
+        tolerance,
+        0.9,
+        0.0,
+        0.333,
+        6.0,
+        t_end,
+        0.0,
+        MAX_STEPS,
+        1000,
+        OutputType::Sparse,
+    );
+    solver.integrate().map_err(|e| format!("Dop853: {e}"))?;
+    solver
+        .y_out()
+        .last()
+        .copied()
+        .ok_or_else(|| "no output".into())
+}
+
 /// diffsol's BDF on `ode`, its algebraic rows given a zero row of the mass matrix. It stops at
 /// the stop time to within diffsol's 100 ε (|t| + |h|), and that state is taken as the end.
 /// The index-1 forms hold a constraint only in its differentiated form, so it may drift.

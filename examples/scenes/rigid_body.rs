@@ -8,7 +8,7 @@
 //! (an independent method for the convergence tests).
 
 use dirac::prelude::*;
-use ode_solvers::{Dop853, OutputType, System};
+use ode_solvers::System;
 
 use super::{Report, timed};
 
@@ -221,27 +221,7 @@ pub fn reference(
     let q0 = quaternion_of(r0);
     let y0 = Y::from([q0[0], q0[1], q0[2], q0[3], pi0[0], pi0[1], pi0[2]]);
     let ode = QuaternionOde { top: *top, inverse };
-    // Sparse output (the accepted steps themselves; see `peers`), the crate's default controller.
-    let mut solver = Dop853::from_param(
-        ode,
-        0.0,
-        t_end,
-        0.0,
-        y0,
-        tolerance,
-        tolerance,
-        0.9,
-        0.0,
-        0.333,
-        6.0,
-        t_end,
-        0.0,
-        1_000_000,
-        1000,
-        OutputType::Sparse,
-    );
-    solver.integrate().map_err(|e| e.to_string())?;
-    let end = solver.y_out().last().ok_or("no output")?;
+    let end = super::peers::dop853_end(ode, y0, t_end, tolerance)?;
     Ok((
         rotation_of(&[end[0], end[1], end[2], end[3]]),
         Vector3::new(end[4], end[5], end[6]),

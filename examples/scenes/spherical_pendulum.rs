@@ -4,7 +4,7 @@
 //! `reference` integrates the motion as an ODE with Dop853.
 
 use dirac::prelude::*;
-use ode_solvers::{Dop853, OutputType, System};
+use ode_solvers::System;
 
 use super::{Report, timed};
 
@@ -121,27 +121,7 @@ pub fn reference(t_end: f64, tolerance: f64) -> Result<(Vector3<f64>, Vector3<f6
         v0[2] * l,
     ]);
     let ode = Ode { g: SCENE.g };
-    // Sparse output (the accepted steps themselves; see `peers`), the crate's default controller.
-    let mut solver = Dop853::from_param(
-        ode,
-        0.0,
-        t_end,
-        0.0,
-        y0,
-        tolerance,
-        tolerance,
-        0.9,
-        0.0,
-        0.333,
-        6.0,
-        t_end,
-        0.0,
-        1_000_000,
-        1000,
-        OutputType::Sparse,
-    );
-    solver.integrate().map_err(|e| e.to_string())?;
-    let end = solver.y_out().last().ok_or("no output")?;
+    let end = super::peers::dop853_end(ode, y0, t_end, tolerance)?;
     Ok((
         Vector3::new(end[0], end[1], end[2]),
         Vector3::new(end[3], end[4], end[5]),
