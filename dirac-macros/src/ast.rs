@@ -236,6 +236,35 @@ pub fn offsets(coordinates: &[Coordinate]) -> Vec<TokenStream> {
         .collect()
 }
 
+/// Each coordinate's index among those of its kind (the first element's, for an array): where a
+/// rotation or unit vector sits in a product point. Named lengths count 0 (they are refused on
+/// products, and real coordinates do not use the index).
+pub fn kind_indices(coordinates: &[Coordinate]) -> Vec<usize> {
+    let mut next = [
+        (Kind::Real, 0usize),
+        (Kind::Rotation, 0),
+        (Kind::Direction, 0),
+    ];
+    coordinates
+        .iter()
+        .map(|c| {
+            let (_, index) = next
+                .iter_mut()
+                .find(|(k, _)| *k == c.kind)
+                .expect("every kind has a counter");
+            let this = *index;
+            // Saturating: real arrays may be as long as `usize` allows (rustc then refuses
+            // them), and their indices are not used.
+            *index = index.saturating_add(match c.length {
+                None => 1,
+                Some(Length::Literal(n, _)) => n,
+                Some(Length::Named(_)) => 0,
+            });
+            this
+        })
+        .collect()
+}
+
 /// The sizes `(K, A, B)` of a product model: its real coordinates, rotations and unit vectors
 /// (every length a literal: checked before).
 pub fn product_sizes(coordinates: &[Coordinate]) -> (usize, usize, usize) {
@@ -247,7 +276,7 @@ pub fn product_sizes(coordinates: &[Coordinate]) -> (usize, usize, usize) {
                 Some(Length::Literal(n, _)) => *n,
                 _ => 1,
             })
-            .sum::<usize>()
+            .fold(0, usize::saturating_add)
     };
     (
         count(Kind::Real),

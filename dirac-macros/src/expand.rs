@@ -7,7 +7,7 @@ use syn::spanned::Spanned;
 use crate::ast::{
     Arguments, Coordinate, Kind, Lagrangian, Model, Shape, dimension, offsets, product_sizes,
 };
-use crate::expression::{Context, bind_coordinate, part_ident};
+use crate::expression::{Context, MAX_NESTING, MAX_TOKEN_NESTING, bind_coordinate, part_ident};
 use crate::validate::{self, Outcome};
 
 /// Entry point: parse, validate, expand; on error the struct, the errors and a stub impl.
@@ -23,6 +23,10 @@ pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
             return quote!(#error #item);
         }
     };
+    if let Some(error) = too_deep(&args) {
+        let error = error.to_compile_error();
+        return quote!(#error #item);
+    }
     let arguments: Arguments = match syn::parse2(args) {
         Ok(arguments) => arguments,
         Err(error) => {
@@ -104,12 +108,39 @@ fn header(item: &syn::ItemStruct, space: &Space) -> TokenStream {
     quote!(impl #impl_generics #trait_ for #name #ty_generics #where_clause)
 }
 
+/// The first bracket nested deeper than [`MAX_TOKEN_NESTING`], as an error on its tokens.
+///
+/// Checked before parsing: the parser recurses once per bracket, so an absurdly deep input would
+/// exhaust the compiler's stack before the expression's own nesting check could report it.
+fn too_deep(args: &TokenStream) -> Option<syn::Error> {
+    let mut pending: Vec<(TokenStream, usize)> = vec![(args.clone(), 0)];
+    while let Some((stream, depth)) = pending.pop() {
+        for tree in stream {
+            if let proc_macro2::TokenTree::Group(group) = tree {
+                if depth + 1 > MAX_TOKEN_NESTING {
+                    return Some(syn::Error::new(
+                        group.span_open(),
+                        format!(
+                            "brackets nested more than {MAX_TOKEN_NESTING} deep; an expression \
+                             nests at most {MAX_NESTING} levels: write it as a generic function or name \
+                             parts of it as parameters"
+                        ),
+                    ));
+                }
+                pending.push((group.stream(), depth + 1));
+            }
+        }
+    }
+    None
+}
+
 fn expand(model: &Model) -> TokenStream {
     let item = &model.item;
     let n = dimension(&model.coordinates);
     let space = Space::of(&model.coordinates);
     let header = header(item, &space);
     let offsets = offsets(&model.coordinates);
+    let kind_indices = crate::ast::kind_indices(&model.coordinates);
     let bindings = |velocities: bool| {
         // Parameters stay f64: constant subexpressions cost no dual-number work.
         let parameters = model.parameters.iter().map(|p| {
@@ -120,7 +151,8 @@ fn expand(model: &Model) -> TokenStream {
             .coordinates
             .iter()
             .zip(&offsets)
-            .map(move |(c, o)| bind_coordinate(c, o, velocities, space.product));
+            .zip(&kind_indices)
+            .map(move |((c, o), &k)| bind_coordinate(c, o, k, velocities, space.product));
         quote!(#(#parameters)* #(#coordinates)*)
     };
     let body = match &model.lagrangian {

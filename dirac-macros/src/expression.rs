@@ -35,6 +35,10 @@ pub const BINARY: &[(&str, &str)] = &[
 /// any length is one level.
 pub const MAX_NESTING: usize = 64;
 
+/// Deepest nesting of brackets of any kind in the macro's arguments, checked before parsing: the
+/// expression's levels plus the argument lists and indices around it.
+pub const MAX_TOKEN_NESTING: usize = MAX_NESTING + 8;
+
 const SUPPORTED: &str = "numbers, parameters and constants, coordinates, dot(coordinate), \
      + - * /, unary minus, parentheses, and the functions sin cos tan asin acos atan sinh cosh \
      tanh asinh acosh atanh exp exp2 exp_m1 ln ln_1p log2 log10 sqrt cbrt recip abs powi powf \
@@ -933,6 +937,7 @@ impl Rewriter<'_> {
 pub fn bind_coordinate(
     coordinate: &Coordinate,
     offset: &TokenStream,
+    kind_index: usize,
     velocities: bool,
     product: bool,
 ) -> TokenStream {
@@ -947,7 +952,7 @@ pub fn bind_coordinate(
         false => (quote_spanned!(span=> __q), quote_spanned!(span=> __v)),
     };
     if coordinate.is_group() {
-        return bind_group(coordinate, offset, velocities);
+        return bind_group(coordinate, kind_index, velocities);
     }
     match (&coordinate.length, velocities) {
         (None, true) => quote_spanned! {span=>
@@ -971,41 +976,38 @@ pub fn bind_coordinate(
 }
 
 /// The atoms of a rotation (its matrix's entries and body angular velocity) or of a unit vector
-/// (its components and velocity), for each element of an array (lengths are literals here).
-fn bind_group(coordinate: &Coordinate, offset: &TokenStream, velocities: bool) -> TokenStream {
+/// (its components and velocity), for each element of an array (lengths are literals here);
+/// `first` is the coordinate's index among those of its kind.
+fn bind_group(coordinate: &Coordinate, first: usize, velocities: bool) -> TokenStream {
     use crate::ast::Kind;
     use crate::vector_algebra::atom;
-    let name = &coordinate.name;
-    let elements: Vec<Option<usize>> = match &coordinate.length {
-        Some(Length::Literal(n, _)) => (0..*n).map(Some).collect(),
-        _ => vec![None],
+    let span = coordinate.name.span();
+    let count = match &coordinate.length {
+        Some(Length::Literal(n, _)) => *n,
+        _ => 1,
     };
     let mut out = TokenStream::new();
-    for element in elements {
-        let at = match element {
-            None => offset.clone(),
-            Some(e) => quote!(#offset + #e),
-        };
+    for at in first..first.saturating_add(count) {
         match coordinate.kind {
             Kind::Rotation => {
                 for r in 0..3usize {
                     for c in 0..3usize {
-                        let entry = atom("R", name, element, &[r, c]);
+                        let entry = atom("R", at, &[r, c], span);
                         out.extend(quote!(let #entry: __D = __q.rotation[#at][(#r, #c)];));
                     }
                 }
                 for c in (0..3usize).filter(|_| velocities) {
-                    let rate = atom("W", name, element, &[c]);
+                    let rate = atom("W", at, &[c], span);
                     out.extend(quote!(let #rate: __D = __v.rotation[#at][#c];));
                 }
             }
             _ => {
                 for c in 0..3usize {
-                    let entry = atom("S", name, element, &[c]);
+                    let entry = atom("S", at, &[c], span);
                     out.extend(quote!(let #entry: __D = __q.direction[#at][#c];));
                 }
                 for c in (0..3usize).filter(|_| velocities) {
-                    let rate = atom("V", name, element, &[c]);
+                    let rate = atom("V", at, &[c], span);
                     out.extend(quote!(let #rate: __D = __v.direction[#at][#c];));
                 }
             }

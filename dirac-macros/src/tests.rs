@@ -321,9 +321,19 @@ fn long_vector_sums_expand() {
 /// Nesting beyond the limit is one error, not a crash.
 #[test]
 fn deep_nesting_is_one_error() {
-    let nested = format!("{}x{}", "(".repeat(300), ")".repeat(300));
-    let output = expand(&format!("coordinates(x), lagrangian = {nested}"), ITEM).unwrap();
-    assert_eq!(output.to_string().matches("compile_error").count(), 1);
+    // Just past the expression's limit: its own check reports it; far past (deeper than the
+    // parser could recurse on a small stack): the bracket check before parsing reports it.
+    for (depth, says) in [
+        (70, "nests more than"),
+        (300, "brackets nested"),
+        (100_000, "brackets nested"),
+    ] {
+        let nested = format!("{}x{}", "(".repeat(depth), ")".repeat(depth));
+        let output = expand(&format!("coordinates(x), lagrangian = {nested}"), ITEM).unwrap();
+        let text = output.to_string();
+        assert_eq!(text.matches("compile_error").count(), 1, "{depth}");
+        assert!(text.contains(says), "{depth}: {text:.300}");
+    }
 }
 
 /// Inputs that once reached arithmetic in the macro: an index into a zero-length array, array
@@ -337,6 +347,69 @@ fn edge_lengths_are_errors() {
         let output = expand(args, ITEM).unwrap();
         assert!(parses(&output), "{args}");
     }
+    // Arrays of rotations and unit vectors are written out element by element: a huge one is
+    // one error on its length, not a crash or a hang.
+    for args in [
+        "coordinates(links[18446744073709551615]: SO3), lagrangian = dot(omega(links[0]), omega(links[0]))",
+        "coordinates(x, links[100000000000]: SO3, n[18446744073709551615]: S2), \
+         lagrangian = dot(omega(links[3]), omega(links[0])) + n[5][2], forces(dlinks[2][0])",
+        "coordinates(links[1001]: SO3), lagrangian = dot(omega(links[1000]), omega(links[0]))",
+        "coordinates(a[18446744073709551615]: SO3, b[2]: SO3, c: S2), \
+         lagrangian = dot(omega(b[1]), omega(a[7])) + c[0], constraints(dc[0] + db[1][2])",
+    ] {
+        let output = expand(args, ITEM).unwrap();
+        assert!(is_error(&output) && parses(&output), "{args}");
+        assert!(output.to_string().contains("at most 1000"), "{args}");
+    }
+}
+
+/// Names that are no one's differential stay what they are; a parameter or input that reads as
+/// a coordinate's differential where differentials are read is one error naming both.
+#[test]
+fn names_like_differentials() {
+    let item = "struct S { d: [f64; 3], d2: f64, dx: f64, damp: f64 }";
+    // No differentials read: `dx` is the parameter.
+    let output = expand("coordinates(x), lagrangian = dx * dot(x) * dot(x)", item).unwrap();
+    assert!(!is_error(&output), "{output}");
+    // `d` and `d2` are nobody's differential, beside rotations too.
+    let output = expand(
+        "coordinates(R: SO3, x), lagrangian = d2 * dot(d, omega(R)) + dot(x), forces(d2 * dx)",
+        "struct S { d: [f64; 3], d2: f64 }",
+    )
+    .unwrap();
+    assert!(!is_error(&output), "{output}");
+    for (args, name) in [
+        (
+            "coordinates(x), lagrangian = dot(x) * dot(x), forces(-dx * dot(x) * dx)",
+            "`dx`",
+        ),
+        (
+            "coordinates(amp), lagrangian = dot(amp) * dot(amp), constraints(damp * damp)",
+            "`damp`",
+        ),
+        (
+            "coordinates(x), lagrangian = dot(x) * dot(x), forces(u * dx), inputs(dx)",
+            "`dx`",
+        ),
+    ] {
+        let output = expand(args, item).unwrap().to_string();
+        assert!(
+            output.contains("compile_error") && output.contains(name),
+            "{args}: {output}"
+        );
+        assert!(output.contains("reads as the differential"), "{args}");
+    }
+    // Beside a rotation `x`, a parameter `dx` is refused even without one-forms.
+    let output = expand(
+        "coordinates(x: SO3), lagrangian = dx * dot(omega(x), omega(x))",
+        item,
+    )
+    .unwrap()
+    .to_string();
+    assert!(
+        output.contains("reads as the differential of coordinate `x`"),
+        "{output}"
+    );
 }
 
 /// `crate = path` binds the runtime for every generated path; without it, `::dirac` does.

@@ -212,6 +212,13 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         &parameters,
         &mut errors,
     );
+    let one_forms = e.constraints.is_some() || e.holonomic.is_some() || e.forces.is_some();
+    check_differential_names(
+        coordinates.as_deref().unwrap_or_default(),
+        parameters.iter().map(|p| &p.name).chain(&inputs),
+        one_forms,
+        &mut errors,
+    );
     let mut closed_form = None;
     let lagrangian = match (e.lagrangian, &coordinates) {
         (None, _) => {
@@ -488,18 +495,60 @@ pub fn is_product(coordinates: &[Coordinate]) -> bool {
     coordinates.iter().any(Coordinate::is_group)
 }
 
-/// A model on rotations and unit vectors sizes its product space by literals and has no
-/// holonomic constraints.
+/// A parameter or input named `d` and a coordinate's name would read as that coordinate's
+/// differential wherever differentials are read: in constraints and forces, and in every
+/// expression of a model with rotations or unit vectors (`dR`). Refused there, naming both.
+fn check_differential_names<'a>(
+    coordinates: &[Coordinate],
+    names: impl Iterator<Item = &'a Ident>,
+    one_forms: bool,
+    errors: &mut Errors,
+) {
+    for name in names {
+        let text = name.to_string();
+        let Some(rest) = text.strip_prefix('d') else {
+            continue;
+        };
+        if let Some(c) = coordinates
+            .iter()
+            .find(|c| c.name == rest && (one_forms || c.is_group()))
+        {
+            errors.push(
+                name.span(),
+                format!(
+                    "`{name}` reads as the differential of coordinate `{}` in constraints(...), \
+                     forces(...) and expressions of rotations or unit vectors; rename it",
+                    c.name
+                ),
+            );
+        }
+    }
+}
+
+/// Arrays of rotations or unit vectors are at most this long: the macro writes out each
+/// element's entries.
+const MAX_GROUP_ARRAY: usize = 1000;
+
+/// A model on rotations and unit vectors sizes its product space by literals (arrays of at
+/// most [`MAX_GROUP_ARRAY`] rotations or unit vectors) and has no holonomic constraints.
 fn check_product(coordinates: &[Coordinate], holonomic: Option<&[Expr]>, errors: &mut Errors) {
     if !is_product(coordinates) {
         return;
     }
     for c in coordinates {
-        if let Some(Length::Named(n)) = &c.length {
-            errors.push(
+        match &c.length {
+            Some(Length::Named(n)) => errors.push(
                 n.span(),
                 "a model with rotations or unit vectors sizes its arrays by integer literals",
-            );
+            ),
+            Some(Length::Literal(n, span)) if c.is_group() && *n > MAX_GROUP_ARRAY => errors.push(
+                *span,
+                format!(
+                    "an array of rotations or unit vectors has at most {MAX_GROUP_ARRAY} \
+                         elements (each element's entries are written out)"
+                ),
+            ),
+            _ => {}
         }
     }
     if let Some(first) = holonomic.and_then(|h| h.first()) {

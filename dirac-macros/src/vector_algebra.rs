@@ -30,24 +30,12 @@ pub const ATOM: &str = "__g";
 pub const DIFFERENTIAL: &str = "__gd_";
 
 /// The name of an atom: `what` (`R` for a rotation's entry, `W` for its angular velocity, `S`
-/// for a unit vector's component, `V` for its velocity) of coordinate `name`, element `element`
-/// of an array, at `indices`.
-pub fn atom(what: &str, name: &Ident, element: Option<usize>, indices: &[usize]) -> Ident {
-    let element = element.map_or(String::new(), |e| format!("_{e}"));
+/// for a unit vector's component, `V` for its velocity) of the rotation or unit vector with
+/// index `element` among those of its kind, at `indices`. Numbers only after the prefix: no two
+/// coordinates' atoms can share a name, whatever the coordinates are called.
+pub fn atom(what: &str, element: usize, indices: &[usize], span: Span) -> Ident {
     let indices: String = indices.iter().map(|i| format!("_{i}")).collect();
-    // `format_ident!` writes a raw identifier (`r#type`) without its `r#`.
-    quote::format_ident!(
-        "{ATOM}{what}_{}{element}{indices}",
-        name,
-        span = name.span()
-    )
-}
-
-/// `name` pointing at `span`.
-fn respanned(name: &Ident, span: Span) -> Ident {
-    let mut name = name.clone();
-    name.set_span(span);
-    name
+    Ident::new(&format!("{ATOM}{what}{element}{indices}"), span)
 }
 
 /// A value of an expression: a number, a 3-vector or a 3×3 matrix, each entry a scalar
@@ -279,7 +267,7 @@ impl Lowering<'_, '_> {
             .take_while(|c| c.name != *ident)
             .filter(|c| c.kind == coordinate.kind)
             .map(length)
-            .sum();
+            .fold(0, usize::saturating_add);
         Some((coordinate, before))
     }
 
@@ -296,7 +284,7 @@ impl Lowering<'_, '_> {
         Some(match (&coordinate.length, index) {
             (None, None) => Ok((coordinate, None, first)),
             (Some(Length::Literal(n, _)), Some(index)) => match literal_index(index) {
-                Some(i) if i < *n => Ok((coordinate, Some(i), first + i)),
+                Some(i) if i < *n => Ok((coordinate, Some(i), first.saturating_add(i))),
                 Some(i) => {
                     let message = format!(
                         "index {i} is out of range: `{}` has {n} elements",
@@ -325,24 +313,21 @@ impl Lowering<'_, '_> {
         })
     }
 
-    /// The position of a group coordinate's element: a rotation's matrix or a unit vector.
-    fn position(&self, c: &Coordinate, element: Option<usize>, span: Span) -> Value {
-        let name = respanned(&c.name, span);
-        match c.kind {
+    /// The position of a group coordinate's element (`index` among those of its `kind`): a
+    /// rotation's matrix or a unit vector.
+    fn position(&self, kind: Kind, index: usize, span: Span) -> Value {
+        match kind {
             Kind::Rotation => Value::Matrix(std::array::from_fn(|r| {
-                std::array::from_fn(|k| leaf(atom("R", &name, element, &[r, k])))
+                std::array::from_fn(|k| leaf(atom("R", index, &[r, k], span)))
             })),
-            _ => Value::Vector(std::array::from_fn(|k| {
-                leaf(atom("S", &name, element, &[k]))
-            })),
+            _ => Value::Vector(std::array::from_fn(|k| leaf(atom("S", index, &[k], span)))),
         }
     }
 
     /// A rotation's body angular velocity, or a unit vector's velocity.
-    fn rate(&self, c: &Coordinate, element: Option<usize>, span: Span) -> [Expr; 3] {
-        let name = respanned(&c.name, span);
-        let what = if c.kind == Kind::Rotation { "W" } else { "V" };
-        std::array::from_fn(|k| leaf(atom(what, &name, element, &[k])))
+    fn rate(&self, kind: Kind, index: usize, span: Span) -> [Expr; 3] {
+        let what = if kind == Kind::Rotation { "W" } else { "V" };
+        std::array::from_fn(|k| leaf(atom(what, index, &[k], span)))
     }
 
     /// The differential of a group coordinate's element, paired with [`rate`](Self::rate): its
@@ -354,20 +339,27 @@ impl Lowering<'_, '_> {
             .iter()
             .filter(|c| c.kind == Kind::Real)
             .map(length)
-            .sum();
+            .fold(0, usize::saturating_add);
         let rotations: usize = self
             .algebra
             .coordinates
             .iter()
             .filter(|c| c.kind == Kind::Rotation)
             .map(length)
-            .sum();
+            .fold(0, usize::saturating_add);
+        // Saturating: an overlong array is refused elsewhere, and this must not overflow first.
+        let triple = |n: usize| n.saturating_mul(3);
         let first = match c.kind {
-            Kind::Rotation => reals + 3 * index,
-            _ => reals + 3 * rotations + 3 * index,
+            Kind::Rotation => reals.saturating_add(triple(index)),
+            _ => reals
+                .saturating_add(triple(rotations))
+                .saturating_add(triple(index)),
         };
         Value::Vector(std::array::from_fn(|k| {
-            leaf(Ident::new(&format!("{DIFFERENTIAL}{}", first + k), span))
+            leaf(Ident::new(
+                &format!("{DIFFERENTIAL}{}", first.saturating_add(k)),
+                span,
+            ))
         }))
     }
 
@@ -489,7 +481,7 @@ impl Lowering<'_, '_> {
         }
         if let Some(element) = self.group_element(expr) {
             return match element {
-                Ok((c, element, _)) => self.position(&c, element, ident.span()),
+                Ok((c, _, index)) => self.position(c.kind, index, ident.span()),
                 Err(()) => Value::Invalid,
             };
         }
@@ -543,7 +535,7 @@ impl Lowering<'_, '_> {
         if let Some(base) = path_ident(&ix.expr) {
             if let Some(element) = self.group_element(expr) {
                 return match element {
-                    Ok((c, element, _)) => self.position(&c, element, base.span()),
+                    Ok((c, _, index)) => self.position(c.kind, index, base.span()),
                     Err(()) => Value::Invalid,
                 };
             }
@@ -809,13 +801,13 @@ impl Lowering<'_, '_> {
         match self.group_element(x) {
             None => Value::Scalar(expr.clone()),
             Some(Err(())) => Value::Invalid,
-            Some(Ok((c, element, _))) => {
+            Some(Ok((c, _, index))) => {
                 if !self.velocities_allowed(expr) {
                     return Value::Invalid;
                 }
                 let span = x.span();
-                let rate = self.rate(&c, element, span);
-                match (c.kind, self.position(&c, element, span)) {
+                let rate = self.rate(c.kind, index, span);
+                match (c.kind, self.position(c.kind, index, span)) {
                     (Kind::Rotation, Value::Matrix(r)) => {
                         Value::Matrix(matrix_matrix(&r, &hat(&rate, span), span))
                     }
@@ -831,13 +823,13 @@ impl Lowering<'_, '_> {
         match self.group_element(x) {
             None => self.error_on(x, "omega(...) takes a rotation or a unit vector"),
             Some(Err(())) => Value::Invalid,
-            Some(Ok((c, element, _))) => {
+            Some(Ok((c, _, index))) => {
                 if !self.velocities_allowed(expr) {
                     return Value::Invalid;
                 }
                 let span = x.span();
-                let rate = self.rate(&c, element, span);
-                match (c.kind, self.position(&c, element, span)) {
+                let rate = self.rate(c.kind, index, span);
+                match (c.kind, self.position(c.kind, index, span)) {
                     (Kind::Direction, Value::Vector(n)) => Value::Vector(cross(&n, &rate, span)),
                     _ => Value::Vector(rate),
                 }

@@ -175,10 +175,11 @@ pub fn orthonormalised(r: &Matrix3<f64>) -> Matrix3<f64> {
     r * (Matrix3::identity() * 3.0 - r.transpose() * r) * 0.5
 }
 
-/// Where the series of a function of `θ²` takes over from its closed form: below it the series'
-/// first omitted term is below 1e-17 of the value, above it the closed form loses no more than
-/// a few ulps.
-const SERIES: f64 = 0.25;
+/// Where the series of a function of `θ²` takes over from its closed form. Below it the series'
+/// first omitted term is below 1e-19 of the value; above it the closed forms of
+/// `(θ − sin θ)/θ³` and `(1 − (θ/2) cot(θ/2))/θ²` cancel by factors of at most 6 and 12. Both
+/// are within 2e-15 (relative) of long series that do not cancel for `θ² ≤ 4` (`tests` below).
+const SERIES: f64 = 1.0;
 
 /// `Σ_k c_k x^k` by Horner's rule.
 fn series<D: Scalar>(x: D, coefficients: &[f64]) -> D {
@@ -202,6 +203,9 @@ pub(crate) fn sine_ratio<D: Scalar>(x: D) -> D {
                 1.0 / 362880.0,
                 -1.0 / 39916800.0,
                 1.0 / 6227020800.0,
+                -1.0 / 1307674368000.0,
+                1.0 / 355687428096000.0,
+                -1.0 / 121645100408832000.0,
             ],
         )
     } else {
@@ -230,6 +234,8 @@ fn sine_defect_ratio<D: Scalar>(x: D) -> D {
                 1.0 / 39916800.0,
                 -1.0 / 6227020800.0,
                 1.0 / 1307674368000.0,
+                -1.0 / 355687428096000.0,
+                1.0 / 121645100408832000.0,
             ],
         )
     } else {
@@ -241,7 +247,7 @@ fn sine_defect_ratio<D: Scalar>(x: D) -> D {
 /// `(1 − (θ/2) cot(θ/2))/θ²` as a function of `x = θ²`.
 fn cotangent_defect_ratio<D: Scalar>(x: D) -> D {
     if x.re() < SERIES {
-        // (−1)^(n+1) B_{2n} / (2n)! for n = 1, 2, ... (Bernoulli numbers).
+        // |B_{2n}| / (2n)! for n = 1, 2, ... (Bernoulli numbers).
         series(
             x,
             &[
@@ -252,6 +258,11 @@ fn cotangent_defect_ratio<D: Scalar>(x: D) -> D {
                 1.0 / 47900160.0,
                 691.0 / 1307674368000.0,
                 7.0 / 523069747200.0,
+                3617.0 / 10670622842880000.0,
+                43867.0 / 5109094217170944000.0,
+                174611.0 / 802857662698291200000.0,
+                77683.0 / 14101100039391805440000.0,
+                236364091.0 / 1693824136731743669452800000.0,
             ],
         )
     } else {
@@ -387,19 +398,65 @@ mod tests {
         }
     }
 
+    /// `Σ_k sign^k x^k / (2k + shift)!` over 40 terms: a reference without cancellation.
+    fn long_series(x: f64, shift: u32, sign: f64) -> f64 {
+        let factorial = |n: u32| (1..=n).map(f64::from).product::<f64>();
+        (0..40)
+            .map(|k: u32| (sign * x).powi(k as i32) / factorial(2 * k + shift))
+            .sum()
+    }
+
+    /// Both branches of each function of `θ²`, on both sides of the switch and on a grid to
+    /// `θ² = 4`, against long series that do not cancel: `sin θ/θ`, `(θ − sin θ)/θ³`, and
+    /// `(1 − (θ/2) cot(θ/2))/θ² = (sin η − η cos η)/(θ² sin η)` (`η = θ/2`) with
+    /// `sin η − η cos η = Σ_{k≥1} (−1)^{k+1} 2k η^{2k+1}/(2k+1)!`.
     #[test]
     fn the_series_meet_the_closed_forms() {
-        for x in [0.2499999, 0.2500001] {
-            let theta: f64 = f64::sqrt(x);
-            assert!((sine_ratio(x) - theta.sin() / theta).abs() < 1e-16);
-            assert!((sine_defect_ratio(x) - (theta - theta.sin()) / (x * theta)).abs() < 1e-15);
-            let cot = (1.0 - theta / 2.0 / (theta / 2.0).tan()) / x;
-            assert!((cotangent_defect_ratio(x) - cot).abs() < 1e-14);
+        let grid = (1..=400).map(|i| f64::from(i) * 0.01);
+        for x in grid.chain([1e-6, 0.9999999, 1.0000001]) {
+            let relative = |got: f64, want: f64| ((got - want) / want).abs();
+            let sine = long_series(x, 1, -1.0);
+            assert!(relative(sine_ratio(x), sine) < 2e-15, "sin θ/θ at {x}");
+            let defect = long_series(x, 3, -1.0);
+            assert!(
+                relative(sine_defect_ratio(x), defect) < 2e-15,
+                "(θ − sin θ)/θ³ at {x}"
+            );
+            let eta2 = x / 4.0;
+            let eta = eta2.sqrt();
+            let factorial = |n: u32| (1..=n).map(f64::from).product::<f64>();
+            let numerator: f64 = (1..40u32)
+                .map(|k| {
+                    let sign = if k % 2 == 1 { 1.0 } else { -1.0 };
+                    sign * f64::from(2 * k) * eta.powi(2 * k as i32 + 1) / factorial(2 * k + 1)
+                })
+                .sum();
+            let cot = numerator / (x * eta * long_series(eta2, 1, -1.0));
+            assert!(
+                relative(cotangent_defect_ratio(x), cot) < 2e-15,
+                "cot defect at {x}"
+            );
         }
-        for (s, c) in [(0.099, 0.995), (0.101, 0.995), (0.5, -0.8)] {
-            let expected = f64::atan2(s, c) / s;
-            assert!((angle_over_sine(s * s, c).unwrap() - expected).abs() < 1e-15);
+        // The angle's series (y = (s/c)² < 0.01) and closed form on both sides of its switch,
+        // against atan's own series Σ (−1)^k y^k/(2k + 1) summed over 200 terms.
+        for (s, c) in [
+            (0.099, 0.995),
+            (0.0997, 0.997),
+            (0.1001, 0.9999),
+            (0.101, 0.995),
+        ] {
+            let y: f64 = (s / c) * (s / c);
+            let atan_ratio: f64 = (0..200)
+                .map(|k: i32| (-y).powi(k) / f64::from(2 * k + 1))
+                .sum();
+            let expected = atan_ratio / c;
+            let got = angle_over_sine(s * s, c).unwrap();
+            assert!(((got - expected) / expected).abs() < 2e-15, "({s}, {c})");
         }
+        // Obtuse angles (the closed form alone) against θ = π − atan(s/|c|).
+        let (s, c) = (0.5_f64, -0.8_f64);
+        let expected = (std::f64::consts::PI - (s / -c).atan()) / s;
+        assert!((angle_over_sine(s * s, c).unwrap() - expected).abs() < 1e-15);
         assert_eq!(angle_over_sine(1e-12, -1.0), None);
     }
 
