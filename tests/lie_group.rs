@@ -57,6 +57,11 @@ fn a_free_body_keeps_its_attitude_orthogonal_and_its_momentum_over_a_million_ste
             }
         }
     }
+    println!(
+        "free body, 10⁶ steps: |RᵀR − I| ≤ {worst_orthogonality:.1e}, |ΔRΠ| ≤ {worst_momentum:.1e} \
+         (|RΠ| = {:.3}), energy error {early:.5e} in the first tenth, {late:.5e} in the last",
+        pi0.norm()
+    );
     assert!(
         worst_orthogonality <= 1e-13,
         "|RᵀR − I| = {worst_orthogonality:e}"
@@ -220,8 +225,9 @@ fn a_hand_written_top_steps_like_the_generated_one() {
 }
 
 /// The pendulum on `S²` against the Cartesian pendulum held on the sphere by SHAKE and against
-/// Dop853 on the constrained ODE: order 2 (both retractions), the two discretisations agreeing
-/// to their own error, and the vertical angular momentum conserved by both.
+/// Dop853 on the constrained ODE: order 2 for both (both retractions on the sphere), the two
+/// discretisations approaching each other at order 2, and the vertical angular momentum
+/// conserved by both.
 #[test]
 fn the_spherical_pendulum_matches_the_cartesian_one() {
     let t_end = 2.0;
@@ -242,7 +248,23 @@ fn the_spherical_pendulum_matches_the_cartesian_one() {
             .collect();
         order_of(&format!("{:?}", space.retraction()), &errors, 2.0);
     }
-    // At one step size the two discretisations differ by about their own errors.
+    let (cartesian_errors, gaps): (Vec<_>, Vec<_>) = [40, 80, 160, 320]
+        .iter()
+        .map(|&n| {
+            let h = t_end / n as f64;
+            let mut cartesian = spherical_pendulum::cartesian(Quadrature::midpoint(), h).unwrap();
+            let mut sphere =
+                spherical_pendulum::on_sphere(Product::exp(), Quadrature::midpoint(), h).unwrap();
+            cartesian.run(n).unwrap();
+            sphere.run(n).unwrap();
+            let x = cartesian.q();
+            let gap = (sphere.q().direction[0] * l - x).amax();
+            ((h, (x - x_ref).amax()), (h, gap))
+        })
+        .unzip();
+    order_of("Cartesian SHAKE", &cartesian_errors, 2.0);
+    order_of("sphere − Cartesian", &gaps, 2.0);
+    // The vertical angular momentum, equal at the start, is kept by both.
     let h = 0.005;
     let n = (t_end / h).round() as u64;
     let mut sphere =
@@ -259,20 +281,13 @@ fn the_spherical_pendulum_matches_the_cartesian_one() {
     );
     sphere.run(n).unwrap();
     cartesian.run(n).unwrap();
-    let x_sphere = sphere.q().direction[0] * l;
-    let (e_sphere, e_cartesian) = ((x_sphere - x_ref).amax(), (cartesian.q() - x_ref).amax());
-    let between = (x_sphere - cartesian.q()).amax();
-    assert!(
-        between < 2.0 * e_sphere.max(e_cartesian),
-        "{between:e} {e_sphere:e} {e_cartesian:e}"
-    );
     assert!((lz_sphere(&sphere) - l_sphere).abs() < 1e-12);
     assert!((lz_cartesian(&cartesian) - l_cartesian).abs() < 1e-12);
 }
 
 /// The rolling ball against its closed form with the one-forms at the start, the midpoint and
 /// the end of each step: order 2 at the midpoint, the one-forms held to round-off at every
-/// point, and the energy conserved to round-off at the start point.
+/// point, and every point converging.
 #[test]
 fn the_rolling_ball_follows_its_closed_form_at_every_constraint_point() {
     let t_end = 2.0;
@@ -408,7 +423,7 @@ fn a_start_off_the_manifold_is_refused_naming_the_variable() {
 }
 
 /// A step that cannot converge (a step far too large for the spin) is an error that leaves the
-/// state as it was, and the next, smaller steps go on from it.
+/// state as it was.
 #[test]
 fn a_failed_step_on_the_group_changes_nothing() {
     let (r0, _) = rigid_body::top_start();
@@ -436,10 +451,11 @@ fn a_failed_step_on_the_group_changes_nothing() {
     assert_eq!(stepper.steps(), 0);
 }
 
-/// The moving-chart equations on `Rⁿ`, where the chart transitions are translations, are the
-/// fixed-chart ones: the double pendulum steps alike through both.
+/// The group step equations on `Rⁿ` (`Stepper::on_manifold` with `Euclidean`) step like the
+/// vector ones: the double pendulum steps alike through both. (The moving chart's own rows are
+/// compared with the fixed chart's in the unit tests of `discrete_lagrangian`.)
 #[test]
-fn the_moving_chart_reduces_to_the_fixed_one_on_vectors() {
+fn the_group_step_equations_reduce_to_the_vector_ones_on_vectors() {
     use scenes::double_pendulum;
     for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
         let (q0, v0) = (vector![0.7, -0.3], vector![0.2, 0.5]);
@@ -538,6 +554,7 @@ fn a_chain_of_rigid_bodies_keeps_its_momentum_and_decouples_into_tops() {
     for a in 0..2 {
         let gap = (expression.q().rotation[a] - function.q().rotation[a]).amax()
             + (expression.p().rotation[a] - function.p().rotation[a]).amax();
+        println!("chain body {a}: expression and function differ by {gap:.1e} after 200 steps");
         assert!(
             gap < 1e-10,
             "body {a}: expression and function differ by {gap:e}"
@@ -564,8 +581,12 @@ fn a_chain_of_rigid_bodies_keeps_its_momentum_and_decouples_into_tops() {
         .zip(trajectory.p())
         .map(|(q, p)| (rigid_chain::vertical_momentum(q, p) - lz0).abs())
         .fold(0.0, f64::max);
-    assert!(drift <= 1e-12 * scale, "|ΔL_z| = {drift:e} of {scale:e}");
     let e0 = trajectory.energy()[0];
+    println!(
+        "chain, 2·10⁴ steps: |ΔL_z| ≤ {drift:.1e} of |RΠ| = {scale:.3}, energy error {:.1e} of {e0:.3}",
+        trajectory.max_energy_error()
+    );
+    assert!(drift <= 1e-12 * scale, "|ΔL_z| = {drift:e} of {scale:e}");
     assert!(
         trajectory.max_energy_error() < 1e-2 * e0.abs(),
         "energy error {:e} of {e0:e}",
@@ -609,6 +630,7 @@ fn a_chain_of_rigid_bodies_keeps_its_momentum_and_decouples_into_tops() {
         single.run(1000).unwrap();
         let gap = (chain.q().rotation[a] - single.q().rotation[0]).amax()
             + (chain.p().rotation[a] - single.p().rotation[0]).amax();
+        println!("decoupled chain body {a}: differs from its single top by {gap:.1e}");
         assert!(
             gap < 1e-10,
             "body {a}: chain and single top differ by {gap:e}"

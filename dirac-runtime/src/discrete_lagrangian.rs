@@ -505,6 +505,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
 mod tests {
     use super::*;
     use crate::configuration_space::Positive;
+    use crate::manifold::Manifold;
+    use crate::product::{Configuration, Product, Rates};
     use crate::scalar::Scalar;
     use nalgebra::vector;
 
@@ -629,6 +631,158 @@ mod tests {
         ] {
             check(Euclidean, quadrature.clone());
             check(Positive, quadrature);
+        }
+    }
+
+    /// A model on `R × SO(3) × S²` whose terms couple all three factors, in position and in
+    /// velocity.
+    struct Mixed;
+    impl DiracSystem<6, Product<1, 1, 1>> for Mixed {
+        fn lagrangian<D: Scalar>(&self, q: &Configuration<D, 1, 1, 1>, v: &Rates<D, 1, 1, 1>) -> D {
+            let (x, r, n) = (q.vector[0], q.rotation[0], q.direction[0]);
+            let (u, w, m) = (v.vector[0], v.rotation[0], v.direction[0]);
+            let kinetic = u * u * 0.5
+                + (w[0] * w[0] + w[1] * w[1] * 2.0 + w[2] * w[2] * 3.0) * 0.5
+                + (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) * 0.5;
+            let axis = r[(0, 2)] * n[0] + r[(1, 2)] * n[1] + r[(2, 2)] * n[2];
+            kinetic + w[0] * u * 0.3 + m[2] * w[1] * 0.2 + axis * (x + 1.5)
+                - r[(2, 2)]
+                - x * x * 0.4
+        }
+    }
+
+    /// On a space whose charts move with the base, `euler_lagrange` against differences of the
+    /// public `value` on the manifold's points: row 0 minus `π` is the derivative of
+    /// `L_d(R_{q_0}(η), Q_1, …, Q_s)` in `η`; the internal rows and the end covector are the
+    /// derivatives in `ξ_j` of `L_d(q_0, …, R_{q_0}(ξ_j), …)`; the Jacobian's columns are
+    /// differences of the residual.
+    fn check_moving(space: Product<1, 1, 1>, quadrature: Quadrature) {
+        let s = quadrature.degree();
+        let name = format!("{} {:?}", quadrature.name(), space.retraction());
+        let ld = DiscreteLagrangian::on_space(Mixed, space, quadrature, 0.1);
+        let base = space.retract(
+            &<Product<1, 1, 1> as Manifold<6>>::origin(),
+            &SVector::<f64, 6>::from_column_slice(&[0.2, 0.3, -0.5, 0.8, 0.4, -0.6]),
+        );
+        let increments: Vec<SVector<f64, 6>> = (1..=s)
+            .map(|j| {
+                let t = j as f64 / s as f64;
+                SVector::from_column_slice(&[0.07, 0.05, -0.03, 0.09, 0.04, 0.06]) * t
+                    + SVector::from_column_slice(&[0.0, 0.02, 0.01, 0.0, -0.03, 0.01]) * (t * t)
+            })
+            .collect();
+        let points = |base: &Configuration<f64, 1, 1, 1>, xis: &[SVector<f64, 6>]| {
+            std::iter::once(*base)
+                .chain(xis.iter().map(|xi| space.retract(base, xi)))
+                .collect::<Vec<_>>()
+        };
+        let p = SVector::<f64, 6>::from_column_slice(&[0.7, -0.4, 0.2, 0.1, -0.3, 0.5]);
+        let mut r = DVector::zeros(6 * s);
+        let mut jac = DMatrix::zeros(6 * s, 6 * s);
+        let (covectors, _) = ld.euler_lagrange(&base, &increments, &p, &mut r, Some(&mut jac));
+        let end = covectors
+            .expect("with a Jacobian the end covector comes along")
+            .end;
+        let mut alone = DVector::zeros(6 * s);
+        ld.euler_lagrange(&base, &increments, &p, &mut alone, None);
+        assert!((&alone - &r).amax() < 1e-14, "{name}: {alone} vs {r}");
+        assert!(
+            (ld.slot_covectors(&base, &increments).end - end).amax() < 1e-13,
+            "{name}"
+        );
+        let eps = 1e-6;
+        let unit = |c: usize| SVector::<f64, 6>::from_fn(|i, _| if i == c { eps } else { 0.0 });
+        let ends = points(&base, &increments);
+        for c in 0..6 {
+            // Row 0: the first point moves on the manifold, the others stay where they are.
+            let moved = |sign: f64| {
+                let mut pts = ends.clone();
+                pts[0] = space.retract(&base, &(unit(c) * sign));
+                ld.value(&pts).unwrap()
+            };
+            let d0 = (moved(1.0) - moved(-1.0)) / (2.0 * eps);
+            assert!(
+                (r[c] - p[c] - d0).abs() < 1e-8,
+                "{name}: row 0 [{c}] {} vs {d0}",
+                r[c] - p[c]
+            );
+            // Point j in the chart at q_0.
+            let slot = |j: usize| {
+                let shifted = |sign: f64| {
+                    let mut xis = increments.clone();
+                    xis[j - 1] += unit(c) * sign;
+                    ld.value(&points(&base, &xis)).unwrap()
+                };
+                (shifted(1.0) - shifted(-1.0)) / (2.0 * eps)
+            };
+            for j in 1..s {
+                assert!(
+                    (r[j * 6 + c] - slot(j)).abs() < 1e-8,
+                    "{name}: row {j} [{c}]"
+                );
+            }
+            assert!((end[c] - slot(s)).abs() < 1e-8, "{name}: end [{c}]");
+        }
+        for k in 0..s {
+            for c in 0..6 {
+                let residual = |sign: f64| {
+                    let mut xis = increments.clone();
+                    xis[k] += unit(c) * sign;
+                    let mut out = DVector::zeros(6 * s);
+                    let mut scratch = DMatrix::zeros(6 * s, 6 * s);
+                    ld.euler_lagrange(&base, &xis, &p, &mut out, Some(&mut scratch));
+                    out
+                };
+                let column = (residual(1.0) - residual(-1.0)) / (2.0 * eps);
+                let exact = jac.column(k * 6 + c);
+                assert!(
+                    (&column - exact).amax() < 1e-6,
+                    "{name}: column {k},{c}: {column} vs {exact}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn moving_chart_slot_derivatives_match_finite_differences() {
+        for quadrature in [
+            Quadrature::midpoint(),
+            Quadrature::trapezoid(),
+            Quadrature::galerkin(2).unwrap(),
+        ] {
+            check_moving(Product::cayley(), quadrature.clone());
+            check_moving(Product::exp(), quadrature);
+        }
+    }
+
+    /// On vectors the moving chart is the fixed one: the moving-chart rows, Jacobian and end
+    /// covector equal the fixed chart's.
+    #[test]
+    fn the_moving_chart_reduces_to_the_fixed_one_on_vectors() {
+        for quadrature in [
+            Quadrature::midpoint(),
+            Quadrature::trapezoid(),
+            Quadrature::galerkin(2).unwrap(),
+            Quadrature::galerkin(3).unwrap(),
+        ] {
+            let s = quadrature.degree();
+            let name = quadrature.name();
+            let ld = DiscreteLagrangian::on_space(Coupled, Euclidean, quadrature, 0.1);
+            let base = vector![0.3, 0.4];
+            let xis: Vec<_> = (1..=s)
+                .map(|j| vector![0.05 * j as f64, -0.1 + 0.03 * (j * j) as f64])
+                .collect();
+            let p = vector![0.7, -0.4];
+            let (mut r, mut rm) = (DVector::zeros(2 * s), DVector::zeros(2 * s));
+            let (mut jac, mut jm) = (DMatrix::zeros(2 * s, 2 * s), DMatrix::zeros(2 * s, 2 * s));
+            let (fixed, _) = ld.euler_lagrange(&base, &xis, &p, &mut r, Some(&mut jac));
+            let (moving, _) = ld.euler_lagrange_moving(&base, &xis, &p, &mut rm, Some(&mut jm));
+            assert!((&r - &rm).amax() < 1e-13, "{name}: {r} vs {rm}");
+            assert!((&jac - &jm).amax() < 1e-12, "{name}: {jac} vs {jm}");
+            assert!(
+                (fixed.unwrap().end - moving.unwrap().end).amax() < 1e-13,
+                "{name}"
+            );
         }
     }
 }

@@ -739,3 +739,44 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The chart maps of `R × SO(3) × S²` keep the pairing of momenta and velocities: a chart
+    /// covector pushed to the manifold pairs with the pushed velocity as it paired in the chart,
+    /// and `pull_back` is the adjoint of `push_forward`. Checked at a point and increment away
+    /// from the identity, for both retractions.
+    #[test]
+    fn chart_maps_keep_the_pairing() {
+        for space in [Product::<1, 1, 1>::cayley(), Product::<1, 1, 1>::exp()] {
+            let q = space.retract(
+                &<Product<1, 1, 1> as Manifold<6>>::origin(),
+                &SVector::<f64, 6>::from_column_slice(&[0.2, 0.3, -0.5, 0.8, 0.4, -0.6]),
+            );
+            let xi = SVector::<f64, 6>::from_column_slice(&[0.1, 0.4, 0.2, -0.3, 0.25, 0.35]);
+            let rate = SVector::<f64, 6>::from_column_slice(&[0.7, -0.2, 0.5, 0.3, -0.6, 0.4]);
+            let chart = SVector::<f64, 6>::from_column_slice(&[-0.3, 0.9, 0.1, -0.5, 0.2, 0.8]);
+            let velocity = space.push_forward(&q, &xi, &rate);
+            let momentum = space.push_covector(&q, &xi, &chart).unwrap();
+            let paired = <Product<1, 1, 1> as Manifold<6>>::pair(&momentum, &velocity);
+            let expected = chart.dot(&rate);
+            assert!((paired - expected).abs() < 1e-14, "{paired} vs {expected}");
+            let pulled = space.pull_back(&q, &xi, &momentum);
+            assert!((pulled - chart).amax() < 1e-14, "{pulled} vs {chart}");
+            // The adjoint on any covector, tangent or not.
+            let any = Rates {
+                vector: SVector::<f64, 1>::new(0.4),
+                rotation: [Vector3::new(-0.2, 0.6, 0.3)],
+                direction: [Vector3::new(0.5, -0.1, 0.9)],
+            };
+            let left = space.pull_back(&q, &xi, &any).dot(&rate);
+            let right = <Product<1, 1, 1> as Manifold<6>>::pair(&any, &velocity);
+            assert!((left - right).abs() < 1e-14, "{left} vs {right}");
+            // The velocity read back through the chart is the chart rate.
+            let back = space.chart_rate(&q, &xi, &velocity).unwrap();
+            assert!((back - rate).amax() < 1e-14, "{back} vs {rate}");
+        }
+    }
+}
