@@ -422,6 +422,49 @@ fn a_start_off_the_manifold_is_refused_naming_the_variable() {
     assert_eq!(*pendulum.state().unwrap(), before);
 }
 
+/// Spin about the symmetry axis of a symmetric body is a one-parameter subgroup, which the
+/// midpoint step in the exponential chart follows exactly at any angle per step, past π too
+/// (the chart is not inverted on the way). The Cayley chart cannot turn a body by 2 rad or more
+/// in one step here: such steps are errors that leave the state as it was, not an aliased turn.
+#[test]
+fn large_turns_per_step_are_exact_with_exp_and_refused_with_cayley() {
+    let h = 0.1;
+    for turn in [0.5, 3.0, 3.5, 6.0] {
+        let spin = Vector3::new(0.0, 0.0, turn / h);
+        let mut stepper = rigid_body::started(
+            rigid_body::SYMMETRIC,
+            Product::exp(),
+            Quadrature::midpoint(),
+            h,
+            (Matrix3::identity(), spin),
+        )
+        .unwrap();
+        let p0 = stepper.p().rotation[0];
+        stepper.run(3).unwrap();
+        let r = stepper.q().rotation[0];
+        let expected = Retraction::Exp.map(&(spin * (3.0 * h)));
+        assert!(
+            (r - expected).amax() < 1e-12,
+            "{turn} rad per step: {r} vs {expected}"
+        );
+        assert!(
+            (stepper.p().rotation[0] - p0).amax() < 1e-12 * p0.norm(),
+            "{turn}"
+        );
+    }
+    let mut cayley = rigid_body::started(
+        rigid_body::SYMMETRIC,
+        Product::cayley(),
+        Quadrature::midpoint(),
+        h,
+        (Matrix3::identity(), Vector3::new(0.0, 0.0, 3.0 / h)),
+    )
+    .unwrap();
+    let before = *cayley.state().unwrap();
+    assert!(cayley.step().is_err());
+    assert_eq!(*cayley.state().unwrap(), before);
+}
+
 /// A step that cannot converge (a step far too large for the spin) is an error that leaves the
 /// state as it was.
 #[test]
