@@ -285,6 +285,52 @@ fn the_spherical_pendulum_matches_the_cartesian_one() {
     assert!((lz_cartesian(&cartesian) - l_cartesian).abs() < 1e-12);
 }
 
+/// A pendulum looping over the top crosses the equator, where the frame of the sphere's chart
+/// changes branch (the chart at each step is its own; nothing carries chart coordinates across
+/// steps unchecked): order 2 against Dop853 with both retractions.
+#[test]
+fn a_looping_spherical_pendulum_crosses_the_equator_at_order_two() {
+    let theta: f64 = 1.2;
+    let n0 = Vector3::new(theta.sin(), 0.0, -theta.cos());
+    let up = Vector3::new(7.0 * theta.cos(), 1.0, 7.0 * theta.sin());
+    let start = (n0, up - n0 * n0.dot(&up));
+    let t_end = 4.0;
+    let (x_ref, _) = spherical_pendulum::reference_from(start, t_end, 1e-13).unwrap();
+    for space in [Product::cayley(), Product::exp()] {
+        let errors: Vec<(f64, f64)> = [200, 400, 800, 1600]
+            .iter()
+            .map(|&n| {
+                let h = t_end / n as f64;
+                let mut stepper = Stepper::on_manifold(
+                    spherical_pendulum::SCENE,
+                    space,
+                    Quadrature::midpoint(),
+                    h,
+                )
+                .unwrap();
+                stepper
+                    .start_from_velocity(
+                        Configuration::of_direction(start.0),
+                        Rates::of_direction(start.1),
+                    )
+                    .unwrap();
+                let trajectory = stepper.run(n).unwrap();
+                let crossings = trajectory
+                    .q()
+                    .windows(2)
+                    .filter(|w| w[0].direction[0][2].signum() != w[1].direction[0][2].signum())
+                    .count();
+                assert!(crossings >= 6, "{n}: {crossings} crossings");
+                (
+                    h,
+                    (stepper.q().direction[0] * spherical_pendulum::SCENE.l - x_ref).amax(),
+                )
+            })
+            .collect();
+        order_of(&format!("looping, {:?}", space.retraction()), &errors, 2.0);
+    }
+}
+
 /// The rolling ball against its closed form with the one-forms at the start, the midpoint and
 /// the end of each step: order 2 at the midpoint, the one-forms held to round-off at every
 /// point, and every point converging.

@@ -110,7 +110,16 @@ impl System<f64, Y> for Ode {
 /// The bob's position and velocity at `t_end` from [`start`] (scaled by `l`), by Dop853 at
 /// relative and absolute tolerance `tolerance`.
 pub fn reference(t_end: f64, tolerance: f64) -> Result<(Vector3<f64>, Vector3<f64>), String> {
-    let (n0, v0) = start();
+    reference_from(start(), t_end, tolerance)
+}
+
+/// The bob's position and velocity at `t_end` from the direction and velocity `(n0, v0)`
+/// (scaled by `l`), by Dop853 at relative and absolute tolerance `tolerance`.
+pub fn reference_from(
+    (n0, v0): (Vector3<f64>, Vector3<f64>),
+    t_end: f64,
+    tolerance: f64,
+) -> Result<(Vector3<f64>, Vector3<f64>), String> {
     let l = SCENE.l;
     let y0 = Y::from([
         n0[0] * l,
