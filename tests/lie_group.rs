@@ -328,6 +328,36 @@ fn a_looping_spherical_pendulum_crosses_the_equator_at_order_two() {
             })
             .collect();
         order_of(&format!("looping, {:?}", space.retraction()), &errors, 2.0);
+        // At coarse steps too (0.3 to 0.6 rad per step), where a first guess extrapolated across
+        // the change of branch made Newton's updates stop contracting: the run goes through,
+        // and it is the run turned by 90° about the vertical, turned back (the steps do not
+        // depend on the frames of the charts, which differ between the two).
+        let quarter = Matrix3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
+        for h in [0.04, 0.08] {
+            let n = (t_end / h).round() as u64;
+            let ends: Vec<Vector3<f64>> = [Matrix3::identity(), quarter]
+                .iter()
+                .map(|turn| {
+                    let mut stepper = Stepper::on_manifold(
+                        spherical_pendulum::SCENE,
+                        space,
+                        Quadrature::midpoint(),
+                        h,
+                    )
+                    .unwrap();
+                    stepper
+                        .start_from_velocity(
+                            Configuration::of_direction(turn * start.0),
+                            Rates::of_direction(turn * start.1),
+                        )
+                        .unwrap();
+                    stepper.run(n).unwrap();
+                    turn.transpose() * stepper.q().direction[0]
+                })
+                .collect();
+            let gap = (ends[0] - ends[1]).amax();
+            assert!(gap < 1e-9, "{:?}, h = {h}: {gap:e}", space.retraction());
+        }
     }
 }
 
@@ -413,8 +443,8 @@ fn torque_inputs_turn_the_satellite() {
 }
 
 /// A start off the manifold is refused, naming the variable: a matrix that is not a rotation,
-/// a vector that is not of unit length, a velocity that leaves the sphere; the stepper keeps no
-/// state.
+/// a vector that is not of unit length, a velocity or a momentum that leaves the sphere; the
+/// stepper keeps no state.
 #[test]
 fn a_start_off_the_manifold_is_refused_naming_the_variable() {
     let mut top = Stepper::on_manifold(
@@ -463,28 +493,51 @@ fn a_start_off_the_manifold_is_refused_naming_the_variable() {
             Rates::of_direction(Vector3::new(1.0, 0.0, 0.5)),
         )
         .unwrap_err();
-    assert!(error.to_string().contains("leaves the sphere"), "{error}");
+    assert!(
+        error
+            .to_string()
+            .contains("velocity of n leaves the sphere"),
+        "{error}"
+    );
+    // A momentum is a covector on the tangent plane: one with a normal part is refused too.
+    let error = pendulum
+        .start_from_momentum(
+            Configuration::of_direction(-Vector3::z()),
+            Rates::of_direction(Vector3::new(1.0, 0.0, 0.5)),
+        )
+        .unwrap_err();
+    assert!(
+        error
+            .to_string()
+            .contains("momentum of n leaves the sphere"),
+        "{error}"
+    );
     // A refused start leaves the running state as it was.
     assert_eq!(*pendulum.state().unwrap(), before);
 }
 
-/// Spin about the symmetry axis of a symmetric body is a one-parameter subgroup, which the
-/// midpoint step in the exponential chart follows exactly at any angle per step, past π too
-/// (the chart is not inverted on the way). The Cayley chart cannot turn a body by 2 rad or more
-/// in one step here: such steps are errors that leave the state as it was, not an aliased turn.
+/// Turns of up to π per step. Spin about the symmetry axis of a symmetric body is a
+/// one-parameter subgroup, which the midpoint step in the exponential chart follows exactly; an
+/// asymmetric body tumbling by 2.8 rad per step keeps its spatial momentum. A step past π, where
+/// the exponential chart ends (its equations would belong to another branch of the chart), is
+/// refused, as is one of 3 rad with the Cayley chart (whose step cannot turn that far here):
+/// errors that leave the state as it was.
 #[test]
-fn large_turns_per_step_are_exact_with_exp_and_refused_with_cayley() {
+fn large_turns_per_step_are_exact_below_pi_and_refused_past_it() {
     let h = 0.1;
-    for turn in [0.5, 3.0, 3.5, 6.0] {
-        let spin = Vector3::new(0.0, 0.0, turn / h);
-        let mut stepper = rigid_body::started(
-            rigid_body::SYMMETRIC,
-            Product::exp(),
+    let spun = |space: Product<0, 1, 0>, body, spin: Vector3<f64>| {
+        rigid_body::started(
+            body,
+            space,
             Quadrature::midpoint(),
             h,
             (Matrix3::identity(), spin),
         )
-        .unwrap();
+        .unwrap()
+    };
+    for turn in [0.5, 3.0] {
+        let spin = Vector3::new(0.0, 0.0, turn / h);
+        let mut stepper = spun(Product::exp(), rigid_body::SYMMETRIC, spin);
         let p0 = stepper.p().rotation[0];
         stepper.run(3).unwrap();
         let r = stepper.q().rotation[0];
@@ -498,17 +551,45 @@ fn large_turns_per_step_are_exact_with_exp_and_refused_with_cayley() {
             "{turn}"
         );
     }
-    let mut cayley = rigid_body::started(
-        rigid_body::SYMMETRIC,
-        Product::cayley(),
-        Quadrature::midpoint(),
-        h,
-        (Matrix3::identity(), Vector3::new(0.0, 0.0, 3.0 / h)),
-    )
-    .unwrap();
-    let before = *cayley.state().unwrap();
-    assert!(cayley.step().is_err());
-    assert_eq!(*cayley.state().unwrap(), before);
+    let tumbling = Vector3::new(3.0, -2.0, 28.0);
+    let mut stepper = spun(Product::exp(), rigid_body::ASYMMETRIC, tumbling);
+    let pi0 = stepper.q().spatial(&stepper.p(), 0);
+    stepper.run(5).unwrap();
+    let drift = (stepper.q().spatial(&stepper.p(), 0) - pi0).amax();
+    assert!(drift < 1e-12 * pi0.norm(), "|ΔRΠ| = {drift:e}");
+    // Past π about the symmetry axis the step's root lies outside the chart: refused as such.
+    // Tumbling past π, or turning 3 rad with Cayley, Newton finds no root it can trust.
+    let refusals = [
+        (
+            Product::exp(),
+            rigid_body::SYMMETRIC,
+            Vector3::new(0.0, 0.0, 35.0),
+            true,
+        ),
+        (
+            Product::exp(),
+            rigid_body::ASYMMETRIC,
+            Vector3::new(3.0, -2.0, 38.0),
+            false,
+        ),
+        (
+            Product::cayley(),
+            rigid_body::SYMMETRIC,
+            Vector3::new(0.0, 0.0, 30.0),
+            false,
+        ),
+    ];
+    for (space, body, spin, outside) in refusals {
+        let mut stepper = spun(space, body, spin);
+        let before = *stepper.state().unwrap();
+        let error = stepper.step().unwrap_err();
+        println!("{:?}, {:?}: {error}", space.retraction(), spin.as_slice());
+        assert!(
+            !outside || matches!(error, DiracError::OutsideChart(_)),
+            "{error}"
+        );
+        assert_eq!(*stepper.state().unwrap(), before);
+    }
 }
 
 /// A step that cannot converge (a step far too large for the spin) is an error that leaves the

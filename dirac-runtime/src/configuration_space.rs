@@ -123,6 +123,22 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
     /// the chart.
     fn local(&self, q: &Point<Self, N, f64>, q1: &Point<Self, N, f64>) -> Option<SVector<f64, N>>;
 
+    /// Where `ξ` lies outside the chart's domain, the region where `R_q` is one-to-one and
+    /// [`local`](Self::local) inverts it (the index of the variable and why); `None` inside. A
+    /// step whose points leave the domain is refused: past it the chart transitions, and so the
+    /// step's equations, belong to another branch. The default: the chart covers every `ξ`.
+    fn outside_chart(&self, _xi: &SVector<f64, N>) -> Option<(usize, String)> {
+        None
+    }
+
+    /// Whether the charts at `from` and at `to` are close to each other, so that chart
+    /// coordinates at one continue those at the other: the stepper extrapolates the last steps'
+    /// solutions (each in its own step's chart) into the next step's first guess only while
+    /// they do. By default always: the charts move with their centre continuously.
+    fn charts_continue(&self, _from: &Point<Self, N, f64>, _to: &Point<Self, N, f64>) -> bool {
+        true
+    }
+
     /// `(T_ξ R_q)ᵀ α`: the covector `α` at `R_q(ξ)` read in the chart.
     fn pull_back<D: Scalar>(
         &self,

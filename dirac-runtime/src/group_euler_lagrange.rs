@@ -301,11 +301,13 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
                 self.variable(variable)
             )));
         }
-        if !finite(&<C::Manifold as Manifold<N>>::tangent_components(p)) {
-            return Err(DiracError::NonFinite {
-                what: "initial momentum".into(),
-                value: f64::NAN,
-            });
+        if let Some((variable, why)) =
+            <C::Manifold as Manifold<N>>::tangent_violation(q, p, tolerance)
+        {
+            return Err(DiracError::InconsistentInitialState(format!(
+                "the initial momentum of {} {why}",
+                self.variable(variable)
+            )));
         }
         let lagrangian = self.discrete.system().lagrangian(q, v);
         if !lagrangian.is_finite() {
@@ -327,6 +329,10 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             .chart_velocity(q, v)
             .ok_or_else(|| DiracError::OutsideChart("the initial velocity".into()))?;
         self.check_one_forms(q, &xi_dot, tolerance)
+    }
+
+    fn charts_continue(&self, from: &Point<C, N, f64>, to: &Point<C, N, f64>) -> bool {
+        self.discrete.space().charts_continue(from, to)
     }
 
     fn predict(
@@ -432,6 +438,15 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
         step: u64,
     ) -> Result<(State<N, C::Manifold>, f64), DiracError> {
         let (space, system) = (self.discrete.space(), self.discrete.system());
+        for j in 1..=self.layout.points() {
+            let point = x.fixed_rows::<N>(self.layout.point(j)).into_owned();
+            if let Some((variable, why)) = space.outside_chart(&point) {
+                return Err(DiracError::OutsideChart(format!(
+                    "step {step}: {} {why}",
+                    self.variable(variable)
+                )));
+            }
+        }
         let xi = x.fixed_rows::<N>(self.layout.end_point()).into_owned();
         let mut next = self.discrete.advanced(
             state,

@@ -83,8 +83,9 @@ pub trait Manifold<const N: usize>:
     /// it must be, to the relative `tolerance`), else the variable that does not and why.
     fn violation(point: &Self::Point<f64>, tolerance: f64) -> Option<(usize, String)>;
 
-    /// `None` when `vector` is a finite tangent vector at `point` (tangent to the sphere where it
-    /// must be, to the relative `tolerance`), else the variable that is not and why.
+    /// `None` when `vector` is a finite tangent vector (a velocity or a momentum) at `point`
+    /// (tangent to the sphere where it must be, to the relative `tolerance`), else the variable
+    /// whose part is not and why.
     fn tangent_violation(
         point: &Self::Point<f64>,
         vector: &Self::Tangent<f64>,

@@ -397,18 +397,21 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Manifold<N>
         }
         for (a, w) in vector.rotation.iter().enumerate() {
             if !w.iter().all(|x| x.is_finite()) {
-                return Some((K + a, "has an angular velocity that is not finite".into()));
+                return Some((K + a, "is not finite".into()));
             }
         }
         for (b, (v, q)) in vector.direction.iter().zip(&point.direction).enumerate() {
             if !v.iter().all(|x| x.is_finite()) {
-                return Some((K + A + b, "has a velocity that is not finite".into()));
+                return Some((K + A + b, "is not finite".into()));
             }
             let radial = v.dot(q);
             if radial.abs() > tolerance * v.norm().max(f64::MIN_POSITIVE) {
                 return Some((
                     K + A + b,
-                    format!("has a velocity that leaves the sphere: q·q̇ = {radial:.3e}"),
+                    format!(
+                        "leaves the sphere: q·w = {radial:.3e} for w of norm {:.3e}",
+                        v.norm()
+                    ),
                 ));
             }
         }
@@ -551,6 +554,64 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
                 .copy_from(&(frame.transpose() * w));
         }
         Some(xi)
+    }
+
+    /// The exponential chart of a rotation or a unit vector is one-to-one for turns below π
+    /// (`|ξ| < π`); the Cayley chart covers every `ξ` (turns approach π as `|ξ| → ∞`).
+    ///
+    /// ```
+    /// use dirac_runtime::configuration_space::ConfigurationSpace;
+    /// use dirac_runtime::product::Product;
+    /// use nalgebra::vector;
+    /// let half_turn = vector![0.0, 0.0, 3.2];
+    /// assert!(ConfigurationSpace::<3>::outside_chart(&Product::<0, 1, 0>::exp(), &half_turn).is_some());
+    /// assert!(ConfigurationSpace::<3>::outside_chart(&Product::<0, 1, 0>::cayley(), &half_turn).is_none());
+    /// ```
+    fn outside_chart(&self, xi: &SVector<f64, N>) -> Option<(usize, String)> {
+        const { dimension::<N, K, A, B>() };
+        if self.retraction == Retraction::Cayley {
+            return None;
+        }
+        // A NaN turn is beyond too.
+        let beyond = |turn: f64| turn.is_nan() || turn >= std::f64::consts::PI;
+        for a in 0..A {
+            let turn = rows3(xi, Self::rotation_at(a)).norm();
+            if beyond(turn) {
+                return Some((
+                    K + a,
+                    format!(
+                        "turns by {turn:.3} rad in one step, past π, where the chart of the \
+                     exponential map ends"
+                    ),
+                ));
+            }
+        }
+        for b in 0..B {
+            let turn = rows2(xi, Self::direction_at(b)).norm();
+            if beyond(turn) {
+                return Some((
+                    K + A + b,
+                    format!(
+                        "turns by {turn:.3} rad in one step, past π, where the chart of the \
+                     exponential map ends"
+                    ),
+                ));
+            }
+        }
+        None
+    }
+
+    /// A unit vector's chart frame changes branch where its third component changes sign (see
+    /// [`sphere::frame`]): chart coordinates on either side do not continue each other there.
+    fn charts_continue(
+        &self,
+        from: &Configuration<f64, K, A, B>,
+        to: &Configuration<f64, K, A, B>,
+    ) -> bool {
+        from.direction
+            .iter()
+            .zip(&to.direction)
+            .all(|(a, b)| a[2].is_sign_negative() == b[2].is_sign_negative())
     }
 
     fn pull_back<D: Scalar>(

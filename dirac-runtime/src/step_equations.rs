@@ -153,6 +153,19 @@ pub trait StepEquations<const N: usize> {
         let _ = state;
     }
 
+    /// Whether the chart of a step from `to` continues that of a step from `from` (see
+    /// [`ConfigurationSpace::charts_continue`](crate::configuration_space::ConfigurationSpace::charts_continue)):
+    /// where it does not, the stepper predicts the next step afresh rather than from the last
+    /// solutions. Always, by default.
+    fn charts_continue(
+        &self,
+        from: &<Self::Manifold as Manifold<N>>::Point<f64>,
+        to: &<Self::Manifold as Manifold<N>>::Point<f64>,
+    ) -> bool {
+        let _ = (from, to);
+        true
+    }
+
     /// Prepares the step from `state` and writes the predictor into `x`. `previous` holds the
     /// stepper's prediction from the accepted steps, when there is one: the last solution, or
     /// the last two or three extrapolated (the line `2 x_k − x_{k−1}`, the parabola

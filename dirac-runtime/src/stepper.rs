@@ -1144,6 +1144,12 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         self.multipliers
             .copy_from_slice(&self.unknowns.as_slice()[first..first + count]);
         self.predictor.record(&self.unknowns);
+        if let Some(state) = &self.state
+            && !self.equations.charts_continue(&state.q, &proposal.next.q)
+        {
+            // The solutions so far are coordinates in charts that the next one does not continue.
+            self.predictor.clear(self.unknowns.len());
+        }
         self.violation = proposal.violation;
         self.steps += 1;
         self.before = self.state.replace(proposal.next);
