@@ -257,9 +257,11 @@ fn the_spherical_pendulum_matches_the_cartesian_one() {
                 spherical_pendulum::on_sphere(Product::exp(), Quadrature::midpoint(), h).unwrap();
             cartesian.run(n).unwrap();
             sphere.run(n).unwrap();
-            let x = cartesian.q();
+            let (x, v) = (cartesian.q(), cartesian.v().unwrap());
             let gap = (sphere.q().direction[0] * l - x).amax();
-            ((h, (x - x_ref).amax()), (h, gap))
+            // The same measure as on the sphere: position and velocity.
+            let error = (x - x_ref).amax().max((v - v_ref).amax());
+            ((h, error), (h, gap))
         })
         .unzip();
     order_of("Cartesian SHAKE", &cartesian_errors, 2.0);
@@ -320,6 +322,7 @@ fn a_looping_spherical_pendulum_crosses_the_equator_at_order_two() {
                     .windows(2)
                     .filter(|w| w[0].direction[0][2].signum() != w[1].direction[0][2].signum())
                     .count();
+                println!("looping, {n} steps: {crossings} equator crossings");
                 assert!(crossings >= 6, "{n}: {crossings} crossings");
                 (
                     h,
@@ -363,7 +366,7 @@ fn a_looping_spherical_pendulum_crosses_the_equator_at_order_two() {
 
 /// The rolling ball against its closed form with the one-forms at the start, the midpoint and
 /// the end of each step: order 2 at the midpoint, the one-forms held to round-off at every
-/// point, and every point converging.
+/// point, and every point converging; a Galerkin step with one-forms is refused.
 #[test]
 fn the_rolling_ball_follows_its_closed_form_at_every_constraint_point() {
     let t_end = 2.0;
@@ -397,6 +400,17 @@ fn the_rolling_ball_follows_its_closed_form_at_every_constraint_point() {
         // Every point converges.
         assert!(errors[3].1 < errors[0].1 / 3.0, "{point:?}: {errors:?}");
     }
+    // One-forms are held at one point of a degree-1 step: a Galerkin step is refused up front.
+    let error = rolling_ball::started(
+        Quadrature::galerkin(2).unwrap(),
+        0.01,
+        ConstraintPoint::Midpoint,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(&error, DiracError::InvalidQuadrature(m) if m.contains("one-forms")),
+        "{error}"
+    );
 }
 
 /// A constant torque about a principal axis from rest turns the satellite about that axis by
@@ -516,14 +530,15 @@ fn a_start_off_the_manifold_is_refused_naming_the_variable() {
     assert_eq!(*pendulum.state().unwrap(), before);
 }
 
-/// Turns of up to π per step. Spin about the symmetry axis of a symmetric body is a
-/// one-parameter subgroup, which the midpoint step in the exponential chart follows exactly; an
-/// asymmetric body tumbling by 2.8 rad per step keeps its spatial momentum. A step past π, where
-/// the exponential chart ends (its equations would belong to another branch of the chart), is
-/// refused, as is one of 3 rad with the Cayley chart (whose step cannot turn that far here):
-/// errors that leave the state as it was.
+/// Turns of up to π per step. Spin about the symmetry axis of a symmetric body and a free unit
+/// vector on a great circle are one-parameter subgroups, which the midpoint step in the
+/// exponential chart follows exactly; an asymmetric body tumbling by 2.8 rad per step keeps its
+/// spatial momentum. Steps past π, where the exponential chart ends (their equations would
+/// belong to another branch of it), and one of 3 rad with the Cayley chart (whose step cannot
+/// turn that far here) are errors that leave the state as it was.
 #[test]
 fn large_turns_per_step_are_exact_below_pi_and_refused_past_it() {
+    use std::f64::consts::PI;
     let h = 0.1;
     let spun = |space: Product<0, 1, 0>, body, spin: Vector3<f64>| {
         rigid_body::started(
@@ -590,6 +605,87 @@ fn large_turns_per_step_are_exact_below_pi_and_refused_past_it() {
         );
         assert_eq!(*stepper.state().unwrap(), before);
     }
+    // A free unit vector follows a great circle, which the exponential chart's midpoint step
+    // follows exactly up to π per step; past it the step is refused.
+    let free = spherical_pendulum::SphericalPendulum {
+        g: 0.0,
+        ..spherical_pendulum::SCENE
+    };
+    let (n0, e) = (Vector3::z(), Vector3::x());
+    for turn in [2.5, 3.0, 3.5] {
+        let mut stepper =
+            Stepper::on_manifold(free, Product::exp(), Quadrature::midpoint(), h).unwrap();
+        stepper
+            .start_from_velocity(
+                Configuration::of_direction(n0),
+                Rates::of_direction(e * (turn / h)),
+            )
+            .unwrap();
+        let before = *stepper.state().unwrap();
+        match stepper.step() {
+            Ok(_) => {
+                assert!(turn < PI, "{turn}");
+                let n = stepper.q().direction[0];
+                let expected = n0 * turn.cos() + e * turn.sin();
+                assert!((n - expected).amax() < 1e-12, "{turn}: {n} vs {expected}");
+            }
+            Err(error) => {
+                println!("S², {turn} rad per step: {error}");
+                assert!(turn > PI, "{turn}: {error}");
+                assert!(matches!(error, DiracError::OutsideChart(_)), "{error}");
+                assert_eq!(*stepper.state().unwrap(), before);
+            }
+        }
+    }
+}
+
+/// Events see the points on the group: a symmetric body spinning about its axis at ω turns its
+/// first body axis through the `yz`-plane at `t = (k + ½)π/ω`. The run locates each crossing
+/// with the event's function at zero to round-off on an attitude that is a rotation; in the
+/// exponential chart (whose steps follow this spin exactly) at the dense output's accuracy, with
+/// Cayley at order 2.
+#[test]
+fn events_locate_crossings_of_the_attitude() {
+    use std::f64::consts::PI;
+    let omega = 2.0;
+    let crossings = |space: Product<0, 1, 0>, h: f64| {
+        let mut stepper = rigid_body::started(
+            rigid_body::SYMMETRIC,
+            space,
+            Quadrature::midpoint(),
+            h,
+            (Matrix3::identity(), Vector3::new(0.0, 0.0, omega)),
+        )
+        .unwrap();
+        let axis = Event::new(
+            "first axis in the yz-plane",
+            |_t, q: &Configuration<f64, 0, 1, 0>, _v: &Rates<f64, 0, 1, 0>| q.rotation[0][(0, 0)],
+        );
+        let solution = stepper.solve(Run::until(4.0).event(axis)).unwrap();
+        assert_eq!(
+            solution.events.len(),
+            3,
+            "{:?}, h = {h}",
+            space.retraction()
+        );
+        let mut worst = 0.0_f64;
+        for (k, crossing) in solution.events.iter().enumerate() {
+            let r = crossing.sample.q.rotation[0];
+            assert!(r[(0, 0)].abs() < 1e-14, "{}", r[(0, 0)]);
+            assert!(orthogonality(&r) < 1e-14);
+            let expected = (k as f64 + 0.5) * PI / omega;
+            worst = worst.max((crossing.sample.t - expected).abs());
+        }
+        (h, worst)
+    };
+    let (_, exact) = crossings(Product::exp(), 0.01);
+    println!("exp, h = 0.01: crossing times within {exact:.1e}");
+    assert!(exact < 1e-12, "{exact:e}");
+    let errors: Vec<(f64, f64)> = [0.04, 0.02, 0.01, 0.005]
+        .iter()
+        .map(|&h| crossings(Product::cayley(), h))
+        .collect();
+    order_of("Cayley crossing times", &errors, 2.0);
 }
 
 /// A step that cannot converge (a step far too large for the spin) is an error that leaves the
