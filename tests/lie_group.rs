@@ -332,9 +332,10 @@ fn a_looping_spherical_pendulum_crosses_the_equator_at_order_two() {
             .collect();
         order_of(&format!("looping, {:?}", space.retraction()), &errors, 2.0);
         // At coarse steps too (0.3 to 0.6 rad per step), where a first guess extrapolated across
-        // the change of branch made Newton's updates stop contracting: the run goes through,
-        // and it is the run turned by 90° about the vertical, turned back (the steps do not
-        // depend on the frames of the charts, which differ between the two).
+        // the change of branch made Newton's updates stop contracting: the run goes through, its
+        // events find every crossing, and it is the run turned by 90° about the vertical,
+        // turned back (the steps do not depend on the frames of the charts, which differ
+        // between the two).
         let quarter = Matrix3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
         for h in [0.04, 0.08] {
             let n = (t_end / h).round() as u64;
@@ -354,7 +355,26 @@ fn a_looping_spherical_pendulum_crosses_the_equator_at_order_two() {
                             Rates::of_direction(turn * start.1),
                         )
                         .unwrap();
-                    stepper.run(n).unwrap();
+                    // The crossings located as events: the dense output of a step whose end
+                    // changed branch is read in its own chart.
+                    let equator = Event::new(
+                        "equator",
+                        |_t, q: &Configuration<f64, 0, 0, 1>, _v: &Rates<f64, 0, 0, 1>| {
+                            q.direction[0][2]
+                        },
+                    );
+                    let solution = stepper.solve(Run::steps(n).event(equator)).unwrap();
+                    let stored = solution
+                        .trajectory
+                        .q()
+                        .windows(2)
+                        .filter(|w| w[0].direction[0][2].signum() != w[1].direction[0][2].signum())
+                        .count();
+                    assert_eq!(solution.events.len(), stored);
+                    assert!(stored >= 6, "{stored}");
+                    for crossing in &solution.events {
+                        assert!(crossing.sample.q.direction[0][2].abs() < 1e-14);
+                    }
                     turn.transpose() * stepper.q().direction[0]
                 })
                 .collect();

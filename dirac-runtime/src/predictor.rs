@@ -8,7 +8,8 @@
 //! h = 0.01 Newton's method takes 2.97 evaluations per step from the cubic, 3.06 from the
 //! parabola and 3.22 from the line (1 000 steps); its coefficients amplify the solutions'
 //! round-off by `√69 ≈ 8`, far below any tolerance. After a start or a change of inputs the
-//! history begins again.
+//! history begins again, and where the chart of the next step does not continue those of the
+//! history (a unit vector whose chart frame changes branch).
 
 use nalgebra::DVector;
 
@@ -19,6 +20,8 @@ pub(crate) struct Predictor {
     solutions: [DVector<f64>; 4],
     /// How many of `solutions` hold accepted steps of the current history.
     count: usize,
+    /// The next step is predicted afresh (see [`detach`](Self::detach)).
+    detached: bool,
     extrapolated: DVector<f64>,
 }
 
@@ -28,6 +31,7 @@ impl Predictor {
         Self {
             solutions: std::array::from_fn(|_| DVector::zeros(n)),
             count: 0,
+            detached: false,
             extrapolated: DVector::zeros(n),
         }
     }
@@ -38,11 +42,19 @@ impl Predictor {
             *self = Self::new(n);
         }
         self.count = 0;
+        self.detached = false;
     }
 
     /// Keeps only the last solution: the next step follows a change the history did not see.
     pub fn restart(&mut self) {
         self.count = self.count.min(1);
+    }
+
+    /// Keeps the last solution (for its step's dense output) but predicts the next step afresh,
+    /// and begins the history again from it: the next step's unknowns are coordinates that the
+    /// solutions so far do not continue (a chart that changed branch).
+    pub fn detach(&mut self) {
+        self.detached = true;
     }
 
     /// Records an accepted step's solution.
@@ -52,7 +64,12 @@ impl Predictor {
         }
         self.solutions.rotate_right(1);
         self.solutions[0].copy_from(x);
-        self.count = (self.count + 1).min(4);
+        self.count = if self.detached {
+            1
+        } else {
+            (self.count + 1).min(4)
+        };
+        self.detached = false;
     }
 
     /// The last accepted solution.
@@ -62,6 +79,9 @@ impl Predictor {
 
     /// The prediction for the next step (none before the first accepted step).
     pub fn predict(&mut self) -> Option<&DVector<f64>> {
+        if self.detached {
+            return None;
+        }
         let [a, b, c, d] = &self.solutions;
         match self.count {
             0 => return None,
@@ -120,6 +140,13 @@ mod tests {
         predictor.restart();
         assert_eq!(predictor.predict().unwrap(), &f(4.0));
         assert_eq!(predictor.last(), Some(&f(4.0)));
+        // Detached: no prediction, the last solution kept, the history begun again from the
+        // next one.
+        predictor.detach();
+        assert!(predictor.predict().is_none());
+        assert_eq!(predictor.last(), Some(&f(4.0)));
+        predictor.record(&f(5.0));
+        assert_eq!(predictor.predict().unwrap(), &f(5.0));
         predictor.clear(3);
         assert!(predictor.predict().is_none() && predictor.last().is_none());
     }

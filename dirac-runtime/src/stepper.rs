@@ -1148,7 +1148,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             && !self.equations.charts_continue(&state.q, &proposal.next.q)
         {
             // The solutions so far are coordinates in charts that the next one does not continue.
-            self.predictor.clear(self.unknowns.len());
+            self.predictor.detach();
         }
         self.violation = proposal.violation;
         self.steps += 1;
