@@ -72,7 +72,7 @@ pub enum DiracError {
     },
     /// The Newton matrix is singular: the discrete equations do not determine the unknowns.
     #[error(
-        "{problem} has a singular Jacobian at step {step}: the unknowns for {unknowns} are not \
+        "{problem} at step {step}: singular Jacobian, the unknowns for {unknowns} are not \
          determined (is the Lagrangian degenerate in these velocities?)"
     )]
     SingularJacobian {
