@@ -521,31 +521,26 @@ fn a_start_off_the_manifold_is_refused_naming_the_variable() {
         matches!(&error, DiracError::InconsistentInitialState(m) if m.contains("of n") && m.contains("unit vector")),
         "{error}"
     );
-    let error = pendulum
-        .start_from_velocity(
-            Configuration::of_direction(-Vector3::z()),
-            Rates::of_direction(Vector3::new(1.0, 0.0, 0.5)),
-        )
-        .unwrap_err();
-    assert!(
-        error
-            .to_string()
-            .contains("velocity of n leaves the sphere"),
-        "{error}"
-    );
-    // A momentum is a covector on the tangent plane: one with a normal part is refused too.
-    let error = pendulum
-        .start_from_momentum(
-            Configuration::of_direction(-Vector3::z()),
-            Rates::of_direction(Vector3::new(1.0, 0.0, 0.5)),
-        )
-        .unwrap_err();
-    assert!(
-        error
-            .to_string()
-            .contains("momentum of n leaves the sphere"),
-        "{error}"
-    );
+    // A velocity, or a momentum (a covector on the tangent plane), with a normal part.
+    let (down, off) = (-Vector3::z(), Vector3::new(1.0, 0.0, 0.5));
+    for (what, error) in [
+        (
+            "velocity",
+            pendulum
+                .start_from_velocity(Configuration::of_direction(down), Rates::of_direction(off)),
+        ),
+        (
+            "momentum",
+            pendulum
+                .start_from_momentum(Configuration::of_direction(down), Rates::of_direction(off)),
+        ),
+    ] {
+        let error = error.unwrap_err().to_string();
+        assert!(
+            error.contains(&format!("{what} of n leaves the sphere")),
+            "{error}"
+        );
+    }
     // A refused start leaves the running state as it was.
     assert_eq!(*pendulum.state().unwrap(), before);
 }

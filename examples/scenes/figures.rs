@@ -51,22 +51,21 @@ pub fn heavy_top_invariants() -> Result<&'static str, Box<dyn Error>> {
     for space in [Product::cayley(), Product::exp()] {
         let rows = rigid_body::top_invariants(space, 1_000_000)?;
         let retraction = format!("{:?}", space.retraction());
-        series.push(Series {
-            label: format!("log10 |E − E0|, {retraction}"),
-            points: rows
-                .iter()
-                .skip(1)
-                .map(|(t, e, _)| (*t, e.max(1e-18).log10()))
-                .collect(),
-        });
-        series.push(Series {
-            label: format!("log10 |ΔL_z|, {retraction}"),
-            points: rows
-                .iter()
-                .skip(1)
-                .map(|(t, _, l)| (*t, l.max(1e-18).log10()))
-                .collect(),
-        });
+        let energy = |row: &(f64, f64, f64)| row.1;
+        let momentum = |row: &(f64, f64, f64)| row.2;
+        for (what, value) in [
+            ("|E − E0|", &energy as &dyn Fn(_) -> f64),
+            ("|ΔL_z|", &momentum),
+        ] {
+            series.push(Series {
+                label: format!("log10 {what}, {retraction}"),
+                points: rows
+                    .iter()
+                    .skip(1)
+                    .map(|row| (row.0, value(row).max(1e-18).log10()))
+                    .collect(),
+            });
+        }
     }
     line_chart(
         path,
