@@ -157,7 +157,10 @@ pub enum Shape {
 pub struct Model {
     pub item: syn::ItemStruct,
     pub coordinates: Vec<Coordinate>,
+    /// The Lagrangian, or the Hamiltonian when `hamiltonian` (its second slot is then `p`).
     pub lagrangian: Lagrangian,
+    /// Whether the model is given by a Hamiltonian (`impl HamiltonianSystem`).
+    pub hamiltonian: bool,
     pub quadrature: TokenStream,
     pub parameters: Vec<Parameter>,
     /// Constraint one-forms, each a list of terms.

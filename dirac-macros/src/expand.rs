@@ -1,4 +1,5 @@
-//! Emits the struct unchanged and its `impl __dirac::DiracSystem<N>`.
+//! Emits the struct unchanged and its `impl __dirac::DiracSystem<N>` (or, for a model given by
+//! a Hamiltonian, `impl __dirac::HamiltonianSystem<N>`).
 
 use proc_macro2::{Span, TokenStream};
 use quote::{quote, quote_spanned};
@@ -40,12 +41,13 @@ pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
             errors,
             coordinates,
             item,
+            hamiltonian,
             krate,
         } => {
             let errors = errors.to_compile_errors();
             let stub = coordinates
                 .filter(|c| !c.is_empty())
-                .map(|c| in_scope(&krate, stub(&item, &c)));
+                .map(|c| in_scope(&krate, stub(&item, &c, hamiltonian)));
             quote!(#errors #item #stub)
         }
     }
@@ -77,13 +79,19 @@ struct Space {
 }
 
 impl Space {
-    fn of(coordinates: &[Coordinate]) -> Self {
+    /// The space of `coordinates`, for a model given by a Lagrangian or, when `hamiltonian`,
+    /// by a Hamiltonian (on `Rⁿ`).
+    fn of(coordinates: &[Coordinate], hamiltonian: bool) -> Self {
         let n = dimension(coordinates);
-        if !validate::is_product(coordinates) {
+        if !validate::is_product(coordinates) || hamiltonian {
+            let trait_ = match hamiltonian {
+                true => quote!(__dirac::HamiltonianSystem<#n>),
+                false => quote!(__dirac::DiracSystem<#n>),
+            };
             let vector = quote!(__dirac::nalgebra::SVector<__D, #n>);
             let zero = quote!(<__D as ::core::convert::From<f64>>::from(0.0));
             return Self {
-                trait_: quote!(__dirac::DiracSystem<#n>),
+                trait_,
                 point: vector.clone(),
                 tangent: vector.clone(),
                 zero: quote!(__dirac::nalgebra::SVector::<__D, #n>::from_element(#zero)),
@@ -137,8 +145,12 @@ fn too_deep(args: &TokenStream) -> Option<syn::Error> {
 fn expand(model: &Model) -> TokenStream {
     let item = &model.item;
     let n = dimension(&model.coordinates);
-    let space = Space::of(&model.coordinates);
+    let space = Space::of(&model.coordinates, model.hamiltonian);
     let header = header(item, &space);
+    let function = match model.hamiltonian {
+        true => quote!(hamiltonian),
+        false => quote!(lagrangian),
+    };
     let offsets = offsets(&model.coordinates);
     let kind_indices = crate::ast::kind_indices(&model.coordinates);
     let bindings = |velocities: bool| {
@@ -197,7 +209,7 @@ fn expand(model: &Model) -> TokenStream {
         #[automatically_derived]
         #header {
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
-            fn lagrangian<__D: __dirac::Scalar>(
+            fn #function<__D: __dirac::Scalar>(
                 &self,
                 __q: &#point,
                 __v: &#tangent,
@@ -469,13 +481,17 @@ fn dirac_items(
 
 /// After an error: an implementation with the right dimension, so that the user's code using
 /// the system reports no second wave of errors. It is never run: compilation has failed.
-fn stub(item: &syn::ItemStruct, coordinates: &[Coordinate]) -> TokenStream {
-    let space = Space::of(coordinates);
+fn stub(item: &syn::ItemStruct, coordinates: &[Coordinate], hamiltonian: bool) -> TokenStream {
+    let space = Space::of(coordinates, hamiltonian);
     let header = header(item, &space);
     let (point, tangent) = (&space.point, &space.tangent);
+    let function = match hamiltonian {
+        true => quote!(hamiltonian),
+        false => quote!(lagrangian),
+    };
     quote! {
         #header {
-            fn lagrangian<__D: __dirac::Scalar>(
+            fn #function<__D: __dirac::Scalar>(
                 &self,
                 _: &#point,
                 _: &#tangent,

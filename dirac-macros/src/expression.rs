@@ -77,6 +77,9 @@ pub struct Scope<'a> {
     pub fields: &'a [Ident],
     /// `None` where velocities are allowed, else what to say when `dot(...)` appears.
     pub no_velocities: Option<&'static str>,
+    /// The name of the rate of a coordinate: `dot` (a velocity, for a Lagrangian) or `p` (a
+    /// momentum, for a Hamiltonian); the generated code binds either from the second slot.
+    pub rate: &'static str,
     /// Appended to the message for an unsupported expression (where else to write code).
     pub elsewhere: &'static str,
     /// The generated method the expression is emitted into.
@@ -466,16 +469,16 @@ impl<'a> Rewriter<'a> {
         valid
     }
 
-    /// `dot(x)` or `dot(theta[i])`.
+    /// `dot(x)` or `dot(theta[i])` (`p(x)`, `p(theta[i])` for a Hamiltonian).
     fn velocity(&mut self, call: &syn::ExprCall, whole: &Expr) -> Piece {
+        let rate = self.scope.rate;
         if let Some(message) = self.scope.no_velocities {
             return self.error_on(whole, message);
         }
         let [arg] = call.args.iter().collect::<Vec<_>>()[..] else {
-            return self.error_on(
-                whole,
-                "dot(...) takes one coordinate, e.g. dot(x) or dot(theta[i])",
-            );
+            let message =
+                format!("{rate}(...) takes one coordinate, e.g. {rate}(x) or {rate}(theta[i])");
+            return self.error_on(whole, message);
         };
         let (ident, index) = match arg {
             Expr::Path(p) => (p.path.get_ident(), None),
@@ -486,7 +489,7 @@ impl<'a> Rewriter<'a> {
             _ => (None, None),
         };
         let Some(ident) = ident else {
-            let message = format!("dot(...) takes a coordinate, one of {}", self.names());
+            let message = format!("{rate}(...) takes a coordinate, one of {}", self.names());
             return self.error_on(arg, message);
         };
         let Some(coordinate) = self.coordinate(ident) else {
@@ -514,7 +517,7 @@ impl<'a> Rewriter<'a> {
             (None, Some(_)) => {
                 let message = format!(
                     "`{ident}` is an array of coordinates: write the velocity of one element, \
-                     dot({ident}[i])"
+                     {rate}({ident}[i])"
                 );
                 self.error(ident.span(), message)
             }
@@ -634,7 +637,12 @@ impl<'a> Rewriter<'a> {
             },
             Expr::Call(call) => match &*call.func {
                 Expr::Path(p) => match p.path.get_ident() {
-                    Some(name) if name == "dot" => self.velocity(call, expr),
+                    Some(name) if name == self.scope.rate => self.velocity(call, expr),
+                    Some(name) if name == "dot" => self.error_on(
+                        expr,
+                        "a Hamiltonian is written in the coordinates and their momenta p(x), \
+                         not velocities dot(x)",
+                    ),
                     Some(name) if is_known(name) => {
                         let arguments: Vec<&Expr> = call.args.iter().collect();
                         self.function(name, &arguments, false, expr, depth)

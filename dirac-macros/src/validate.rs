@@ -16,7 +16,7 @@ use crate::symbolic;
 use crate::vector_algebra::{self, Algebra};
 use crate::{expression, one_form, quadrature};
 
-const KEYS: &str = "`coordinates(...)`, `lagrangian = ...`, `quadrature = ...`, \
+const KEYS: &str = "`coordinates(...)`, `lagrangian = ...`, `hamiltonian = ...`, `quadrature = ...`, \
      `constraints(...)`, `holonomic(...)`, `forces(...)`, `inputs(...)`, `constraint_at = ...` \
      and `crate = ...`";
 
@@ -69,6 +69,8 @@ pub enum Outcome {
         coordinates: Option<Vec<Coordinate>>,
         /// The struct as it is to be emitted (without a repeated attribute).
         item: Box<syn::ItemStruct>,
+        /// Whether the model is given by a Hamiltonian (the stub implements its trait).
+        hamiltonian: bool,
         /// The path of the runtime (for the stub).
         krate: syn::Path,
     },
@@ -80,6 +82,7 @@ struct Entries {
     /// `Some((span, None))`: given but unreadable (already reported).
     coordinates: Option<(Span, Option<Vec<Coordinate>>)>,
     lagrangian: Option<Expr>,
+    hamiltonian: Option<Expr>,
     quadrature: Option<Expr>,
     constraints: Option<Vec<Expr>>,
     holonomic: Option<Vec<Expr>>,
@@ -135,6 +138,7 @@ fn entries(arguments: Arguments, errors: &mut Errors) -> Entries {
             ("forces", Meta::List(l)) => e.forces = list(&l, LEAVE_OUT, errors),
             ("inputs", Meta::List(l)) => e.inputs = list(&l, LEAVE_OUT, errors),
             ("lagrangian", Meta::NameValue(nv)) => e.lagrangian = Some(nv.value),
+            ("hamiltonian", Meta::NameValue(nv)) => e.hamiltonian = Some(nv.value),
             ("quadrature", Meta::NameValue(nv)) => e.quadrature = Some(nv.value),
             ("constraint_at", Meta::NameValue(nv)) => e.constraint_at = Some(nv.value),
             ("crate", Meta::NameValue(nv)) => e.krate = Some(nv.value),
@@ -143,7 +147,7 @@ fn entries(arguments: Arguments, errors: &mut Errors) -> Entries {
                     other.span(),
                     format!("write `{key}` as a list: {key}(a, b, ...)"),
                 ),
-            ("lagrangian" | "quadrature" | "constraint_at" | "crate", other) => {
+            ("lagrangian" | "hamiltonian" | "quadrature" | "constraint_at" | "crate", other) => {
                 errors.push(other.span(), format!("write `{key} = ...`"))
             }
             (_, other) => errors.push(
@@ -219,16 +223,30 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         one_forms,
         &mut errors,
     );
+    let hamiltonian = e.hamiltonian.is_some();
+    if hamiltonian {
+        let coordinates = coordinates.as_deref().unwrap_or_default();
+        hamiltonian_route(
+            e.lagrangian.as_ref(),
+            e.holonomic.as_ref(),
+            coordinates,
+            &mut errors,
+        );
+    }
+    // The rate of a coordinate: its velocity dot(x), or for a Hamiltonian its momentum p(x).
+    let rate = if hamiltonian { "p" } else { "dot" };
     let mut closed_form = None;
-    let lagrangian = match (e.lagrangian, &coordinates) {
+    let lagrangian = match (e.hamiltonian.take().or(e.lagrangian.take()), &coordinates) {
         (None, _) => {
-            errors.push(Span::call_site(), "missing `lagrangian = ...`: an expression in the coordinates, dot(coordinate) and the parameters, or the path of a generic function");
+            errors.push(Span::call_site(), "missing `lagrangian = ...`: an expression in the coordinates, dot(coordinate) and the parameters, or the path of a generic function (or `hamiltonian = ...`, in the coordinates and their momenta p(coordinate))");
             None
         }
         (Some(expr), Some(coordinates)) => {
-            let n = literal_dimension(coordinates).filter(|_| !is_product(coordinates));
+            let n =
+                literal_dimension(coordinates).filter(|_| !is_product(coordinates) && !hamiltonian);
             let closed = n.and_then(|n| symbolic::closed_form(&expr, coordinates, n));
-            let lagrangian = lagrangian_of(expr, coordinates, &parameters, &parts, &mut errors);
+            let lagrangian =
+                lagrangian_of(expr, coordinates, &parameters, &parts, rate, &mut errors);
             // A function path has no expression to differentiate.
             if matches!(lagrangian, Some(Lagrangian::Expression(_))) {
                 closed_form = closed;
@@ -273,6 +291,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 inputs: &[],
                 fields: &fields,
                 no_velocities: Some(NO_VELOCITIES),
+                rate,
                 elsewhere: "",
                 context: Context::Positions,
                 parts: &parts,
@@ -316,6 +335,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 inputs: &inputs,
                 fields: &fields,
                 no_velocities: None,
+                rate,
                 elsewhere: "",
                 context: Context::Force,
                 parts: &parts,
@@ -344,6 +364,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 item,
                 coordinates,
                 lagrangian,
+                hamiltonian,
                 quadrature,
                 parameters,
                 one_forms,
@@ -360,6 +381,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
             errors,
             coordinates,
             item: Box::new(item),
+            hamiltonian,
             krate,
         },
     }
@@ -378,6 +400,36 @@ fn runtime_path(given: Option<Expr>, errors: &mut Errors) -> syn::Path {
             );
             syn::parse_quote!(::dirac)
         }
+    }
+}
+
+/// What the Hamiltonian route does not offer, reported on the user's tokens: both a Lagrangian
+/// and a Hamiltonian, rotations or unit vectors, holonomic constraints.
+fn hamiltonian_route(
+    lagrangian: Option<&Expr>,
+    holonomic: Option<&Vec<Expr>>,
+    coordinates: &[Coordinate],
+    errors: &mut Errors,
+) {
+    if let Some(lagrangian) = lagrangian {
+        errors.push(
+            lagrangian.span(),
+            "give either `lagrangian = ...` or `hamiltonian = ...`, not both",
+        );
+    }
+    if let Some(c) = coordinates.iter().find(|c| c.is_group()) {
+        errors.push(
+            c.name.span(),
+            "`hamiltonian = ...` is offered on real coordinates; write a model with rotations or \
+             unit vectors with `lagrangian = ...`",
+        );
+    }
+    if let Some(g) = holonomic.and_then(|g| g.first()) {
+        errors.push(
+            g.span(),
+            "holonomic constraints are not offered with `hamiltonian = ...`; write their \
+             differentials in constraints(...), or give a Lagrangian",
+        );
     }
 }
 
@@ -439,6 +491,7 @@ fn lagrangian_of(
     coordinates: &[Coordinate],
     parameters: &[Parameter],
     parts: &RefCell<Vec<Part>>,
+    rate: &'static str,
     errors: &mut Errors,
 ) -> Option<Lagrangian> {
     if let Expr::Path(p) = &expr {
@@ -456,6 +509,7 @@ fn lagrangian_of(
         inputs: &[],
         fields: &fields,
         no_velocities: None,
+        rate,
         elsewhere: "; for other code write a generic function and give \
                     `lagrangian = path::to::function`",
         context: Context::Lagrangian,

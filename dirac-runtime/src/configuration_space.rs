@@ -465,7 +465,7 @@ impl<const N: usize> ConfigurationSpace<N> for Positive {
 }
 
 /// `sum += increment` with Kahan compensation.
-fn compensated_add<const N: usize>(
+pub(crate) fn compensated_add<const N: usize>(
     sum: &mut SVector<f64, N>,
     carry: &mut SVector<f64, N>,
     increment: &SVector<f64, N>,

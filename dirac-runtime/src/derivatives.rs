@@ -11,6 +11,7 @@ use num_dual::{Derivative, DualSVec64, HyperDualSVec64, HyperHyperDual64};
 
 use crate::closed_form::{LagrangianGradient, LagrangianHessian};
 use crate::configuration_space::{ConfigurationSpace, Point};
+use crate::hamiltonian_system::HamiltonianSystem;
 use crate::quadrature::Quadrature;
 use crate::scalar::Scalar;
 use crate::system::DiracSystem;
@@ -60,6 +61,17 @@ impl<S: DiracSystem<N>, const N: usize> PhaseFunction<N> for S {
         v: &SVector<f64, N>,
     ) -> Option<LagrangianHessian<N>> {
         self.lagrangian_hessian(q, v)
+    }
+}
+
+/// A model's Hamiltonian as a function of `(q, p)`: the second slot holds the momentum, so the
+/// Lagrangian's derivative machinery gives `∂H/∂q`, `∂H/∂p` and the blocks of `D²H`.
+pub(crate) struct Hamiltonian<'a, S>(pub &'a S);
+
+impl<S: HamiltonianSystem<N>, const N: usize> PhaseFunction<N> for Hamiltonian<'_, S> {
+    #[inline]
+    fn value<D: Scalar>(&self, q: &SVector<D, N>, p: &SVector<D, N>) -> D {
+        self.0.hamiltonian(q, p)
     }
 }
 
@@ -471,6 +483,18 @@ pub(crate) fn lift<const N: usize>(x: &SVector<f64, N>, weight: f64) -> SVector<
 
 pub(crate) fn gradient<const N: usize>(x: &Dual<N>) -> SVector<f64, N> {
     x.eps.unwrap_generic(Const::<N>, U1)
+}
+
+/// `f(x)` and its Jacobian `∂f/∂x` at `x`, by one pass of first-order duals.
+pub(crate) fn jacobian<const N: usize>(
+    x: &SVector<f64, N>,
+    f: impl FnOnce(&SVector<Dual<N>, N>) -> SVector<Dual<N>, N>,
+) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
+    let y = f(&lift(x, 1.0));
+    (
+        y.map(|y| y.re),
+        SMatrix::from_fn(|r, c| y[r].eps.unwrap_generic(Const::<N>, U1)[c]),
+    )
 }
 
 /// Coordinates whose rows of `∂²L/∂v²` vanish at `(q, v)` (one probe: enough to check that a

@@ -23,6 +23,8 @@ use crate::error::DiracError;
 use crate::euler_lagrange::{EulerLagrange, check_finite};
 use crate::first_order_scheme::FirstOrderScheme;
 use crate::group_euler_lagrange::GroupEulerLagrange;
+use crate::hamilton::Hamilton;
+use crate::hamiltonian_system::HamiltonianSystem;
 use crate::holonomic_scheme::HolonomicScheme;
 use crate::input::Input;
 use crate::legendre;
@@ -157,6 +159,44 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
     pub fn from_system(system: S, h: f64) -> Result<Self, DiracError> {
         let quadrature = system.quadrature()?;
         Self::new(system, quadrature, h)
+    }
+}
+
+impl<S: HamiltonianSystem<N>, const N: usize> Stepper<S, N, Hamilton<S, N>> {
+    /// A stepper for a model given by its Hamiltonian, on the discrete Hamiltonian route
+    /// ([`Hamilton`]: the Galerkin discrete Hamiltonian `H_d⁺` of `quadrature`) with step `h`.
+    /// Fails as [`Hamilton::new`] does.
+    ///
+    /// ```
+    /// use dirac_runtime::{HamiltonianSystem, Quadrature, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// /// A pendulum, H = p²/2 − cos q.
+    /// struct Pendulum;
+    /// impl HamiltonianSystem<1> for Pendulum {
+    ///     fn hamiltonian<D: Scalar>(&self, q: &SVector<D, 1>, p: &SVector<D, 1>) -> D {
+    ///         p[0] * p[0] * 0.5 - q[0].cos()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::hamiltonian(Pendulum, Quadrature::midpoint(), 0.01)?;
+    /// stepper.start_from_momentum(vector![1.0], vector![0.0])?;
+    /// let trajectory = stepper.run(1000)?;
+    /// assert!(trajectory.max_energy_error() < 1e-4);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn hamiltonian(system: S, quadrature: Quadrature, h: f64) -> Result<Self, DiracError> {
+        Self::with_equations(Hamilton::new(system, quadrature, h)?)
+    }
+
+    /// A stepper with the system's own quadrature (the one named in `#[dirac_system]`), on the
+    /// discrete Hamiltonian route.
+    pub fn hamiltonian_from_system(system: S, h: f64) -> Result<Self, DiracError> {
+        let quadrature = system.quadrature()?;
+        Self::hamiltonian(system, quadrature, h)
+    }
+
+    /// The quadrature of the phase-space action.
+    pub fn quadrature(&self) -> &Quadrature {
+        self.equations.quadrature()
     }
 }
 

@@ -10,6 +10,7 @@ pub mod double_pendulum;
 pub mod ensemble;
 pub mod figures;
 pub mod first_order;
+pub mod hamiltonian;
 pub mod hand_written;
 pub mod hand_written_lgvi;
 pub mod kepler;

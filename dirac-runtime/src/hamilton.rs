@@ -1,0 +1,621 @@
+//! The discrete Hamiltonian route: the discrete Hamilton's equations of a Galerkin discrete
+//! Hamiltonian, with constraint one-forms and forces.
+//!
+//! The type II generating function `H_d⁺(q_k, p_{k+1}) = ext [p_{k+1} q_{k+1} − 𝕃]` of the
+//! phase-space action over one step, with the path `Q(τ) = Σ_j ℓ_j(τ) Q_j` of degree `s`
+//! through `Q_0 = q_k, Q_1, …, Q_s = q_{k+1}` (equispaced) and a momentum `P_i` of its own at
+//! each node `c_i` of the quadrature `(c_i, b_i)`,
+//!
+//! ```text
+//! 𝕃(Q_0..Q_s, P_1..P_m) = h Σ_i b_i [ P_i · Q̇(c_i) − H(Q(c_i), P_i) ],   Q̇(c_i) = Σ_j ℓ'_j(c_i) Q_j / h,
+//! ```
+//!
+//! gives `p_k = D₁H_d⁺`, `q_{k+1} = D₂H_d⁺` as the stationarity conditions of `𝕃`:
+//!
+//! ```text
+//! p_k + ∂𝕃/∂Q_0 + f_0 + w_0 Aᵀμ = 0,        ∂𝕃/∂Q_j + f_j + w_j Aᵀμ = 0   (j = 1..s−1),
+//! Q̇(c_i) − ∂H/∂p(Q(c_i), P_i) = 0  (i = 1..m),                A(Q_c) Q̇_c = 0,
+//! ∂𝕃/∂Q_j = Σ_i b_i [ ℓ'_j(c_i) P_i − h ℓ_j(c_i) ∂H/∂q(Q(c_i), P_i) ],
+//! ```
+//!
+//! solved for `x = [Q_1 − q_k, …, Q_s − q_k, P_1, …, P_m, μ]`, then
+//! `p_{k+1} = p_k + h Σ_i b_i (F_i − ∂H/∂q_i) + Aᵀμ` (the sum of the rows, which equals
+//! `∂𝕃/∂Q_s + f_s + w_s Aᵀμ` at the solution without its cancellation) and `q_{k+1} = Q_s`.
+//! Forces enter as in the discrete Lagrange–d'Alembert principle, `f_j = h Σ_i b_i ℓ_j(c_i)
+//! F(Q(c_i), P_i, t_k + c_i h, u)`. The one-forms are held where the Lagrangian route holds
+//! them (a degree-1 step at its constraint point `Q_c = q_k + θ(q_{k+1} − q_k)` with
+//! `Q̇_c = (q_{k+1} − q_k)/h` and the impulse shared `w = (σ, 1 − σ)`, see
+//! [`ConstraintPoint`]; a Galerkin step at its Gauss nodes, with the force `A(Q(c_i))ᵀμ_i`
+//! weighted as a force, `w_j = h b_i ℓ_j(c_i)`): the issue's implicit discrete Hamiltonian
+//! system `p_k − D₁H_d⁺ ∈ Δ°`, `(q_k, q_{k+1}) ∈ Δ_d`.
+//!
+//! **When the two routes agree.** Where `∂²H/∂p²` is invertible, the stationarity in `P_i`
+//! is the Legendre transform at the node, and `P_i Q̇_i − H(Q_i, P_i) = L(Q_i, Q̇_i)`: `𝕃`
+//! extremised over the momenta is the Galerkin discrete Lagrangian of the same path and
+//! quadrature, so both routes take the same steps (`tests/hamiltonian.rs` checks it to
+//! round-off on a non-separable `H`). They differ where there is no Lagrangian: a Hamiltonian
+//! whose `∂²H/∂p²` is singular (`H = p f(q)`, whose steps are the Gauss collocation of
+//! `q̇ = f(q)` with its adjoint) has no Lagrangian route at all.
+//!
+//! ```
+//! use dirac_runtime::{HamiltonianSystem, Quadrature, Scalar, Stepper};
+//! use nalgebra::{SVector, vector};
+//!
+//! /// H = (p² + q²)/2.
+//! struct Oscillator;
+//! impl HamiltonianSystem<1> for Oscillator {
+//!     fn hamiltonian<D: Scalar>(&self, q: &SVector<D, 1>, p: &SVector<D, 1>) -> D {
+//!         (p[0] * p[0] + q[0] * q[0]) * 0.5
+//!     }
+//! }
+//!
+//! let mut stepper = Stepper::hamiltonian(Oscillator, Quadrature::galerkin(3)?, 0.1)?;
+//! stepper.start_from_momentum(vector![1.0], vector![0.0])?;
+//! let trajectory = stepper.run(10)?;
+//! assert!((trajectory.q()[10][0] - 1.0_f64.cos()).abs() < 1e-8);
+//! # Ok::<(), dirac_runtime::DiracError>(())
+//! ```
+
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+
+use crate::configuration_space::compensated_add;
+use crate::constraint_point::ConstraintPoint;
+use crate::derivatives::{self, Dual, Hamiltonian};
+use crate::error::DiracError;
+use crate::hamiltonian_system::HamiltonianSystem;
+use crate::lu;
+use crate::manifold::Vectors;
+use crate::newton::{Newton, NewtonFailure};
+use crate::quadrature::{Quadrature, Rule};
+use crate::step_equations::{State, StepEquations};
+
+/// Where a step holds the constraint one-forms: the point `Q_c = Σ_j position_j Q_j`, the
+/// velocity `Q̇_c = Σ_j rate_j Q_j / h` and the weights `w_j` of the constraint's force on the
+/// rows of `Q_0 … Q_s`.
+#[derive(Debug, Clone, PartialEq)]
+struct Site {
+    position: Vec<f64>,
+    rate: Vec<f64>,
+    weight: Vec<f64>,
+}
+
+/// The discrete Hamilton's equations of the Galerkin discrete Hamiltonian `H_d⁺` of a
+/// [`HamiltonianSystem`] on `Rᴺ` (see the [module](self)), as [`StepEquations`] a
+/// [`Stepper`](crate::Stepper) drives.
+///
+/// ```
+/// use dirac_runtime::{HamiltonianSystem, Quadrature, Scalar, Stepper, hamilton::Hamilton};
+/// use nalgebra::{SVector, vector};
+/// struct Free;
+/// impl HamiltonianSystem<1> for Free {
+///     fn hamiltonian<D: Scalar>(&self, _q: &SVector<D, 1>, p: &SVector<D, 1>) -> D {
+///         p[0] * p[0] * 0.5
+///     }
+/// }
+/// let equations = Hamilton::new(Free, Quadrature::midpoint(), 0.5)?;
+/// let mut stepper = Stepper::with_equations(equations)?;
+/// stepper.start_from_momentum(vector![0.0], vector![2.0])?;
+/// stepper.step()?;
+/// assert_eq!(stepper.q()[0], 1.0);
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Hamilton<S, const N: usize> {
+    system: S,
+    quadrature: Quadrature,
+    h: f64,
+    sites: Vec<Site>,
+    inputs: Vec<f64>,
+    /// `p_{k+1} − p_k` at the point assembled last.
+    impulse: SVector<f64, N>,
+}
+
+impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
+    /// The equations of `system` with `quadrature` and step `h`, every input at 0. Fails on a
+    /// non-positive or non-finite step, a non-finite parameter, or constraint one-forms with a
+    /// Galerkin quadrature other than a Gauss rule with as many nodes as its degree, or with a
+    /// constraint point other than the midpoint on such a quadrature (the one-forms are then
+    /// held at its nodes).
+    pub fn new(system: S, quadrature: Quadrature, h: f64) -> Result<Self, DiracError> {
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(DiracError::InvalidStep { h });
+        }
+        if let Some((name, value)) = system
+            .parameters()
+            .into_iter()
+            .find(|(_, v)| !v.is_finite())
+        {
+            return Err(DiracError::NonFinite {
+                what: format!("parameter {name}"),
+                value,
+            });
+        }
+        let sites = Self::sites(&system, &quadrature, h)?;
+        Ok(Self {
+            system,
+            quadrature,
+            h,
+            sites,
+            inputs: vec![0.0; S::INPUTS],
+            impulse: SVector::zeros(),
+        })
+    }
+
+    /// Where the one-forms are held (none without one-forms).
+    fn sites(system: &S, quadrature: &Quadrature, h: f64) -> Result<Vec<Site>, DiracError> {
+        let s = quadrature.degree();
+        let point = system.constraint_point();
+        if S::ONE_FORMS == 0 {
+            return Ok(Vec::new());
+        }
+        if s == 1 {
+            let (theta, sigma) = (point.theta(), point.share());
+            return Ok(vec![Site {
+                position: vec![1.0 - theta, theta],
+                rate: vec![-1.0, 1.0],
+                weight: vec![sigma, 1.0 - sigma],
+            }]);
+        }
+        if quadrature.rule() != Rule::GaussLegendre(s) || point != ConstraintPoint::Midpoint {
+            return Err(DiracError::InvalidQuadrature(format!(
+                "{}: constraint one-forms of a Galerkin step are held at the nodes of a Gauss \
+                 rule with as many nodes as the path's degree (galerkin(s) with \
+                 gauss_legendre(s)), which has no constraint point (leave it at the midpoint)",
+                quadrature.name()
+            )));
+        }
+        Ok((0..quadrature.nodes().len())
+            .map(|i| {
+                let b = quadrature.weights()[i];
+                Site {
+                    position: (0..=s).map(|j| quadrature.ell(i, j)).collect(),
+                    rate: (0..=s).map(|j| quadrature.ell_prime(i, j)).collect(),
+                    weight: (0..=s).map(|j| h * b * quadrature.ell(i, j)).collect(),
+                }
+            })
+            .collect())
+    }
+
+    /// The model.
+    pub fn system(&self) -> &S {
+        &self.system
+    }
+
+    /// The quadrature of the phase-space action.
+    pub fn quadrature(&self) -> &Quadrature {
+        &self.quadrature
+    }
+
+    fn degree(&self) -> usize {
+        self.quadrature.degree()
+    }
+
+    fn nodes(&self) -> usize {
+        self.quadrature.nodes().len()
+    }
+
+    /// First column of `Q_j − q_k` (`j = 1..=s`).
+    fn point(&self, j: usize) -> usize {
+        (j - 1) * N
+    }
+
+    /// First column of the momentum `P_i` at node `i` (`0..m`).
+    fn node_momentum(&self, i: usize) -> usize {
+        (self.degree() + i) * N
+    }
+
+    /// Column of the multiplier of one-form `a` at site `k`.
+    fn multiplier(&self, k: usize, a: usize) -> usize {
+        (self.degree() + self.nodes()) * N + k * S::ONE_FORMS + a
+    }
+
+    /// `Σ_{j≥1} weights_j ξ_j` over the step's increments in `x`.
+    fn combination(&self, x: &DVector<f64>, weights: &[f64]) -> SVector<f64, N> {
+        (1..=self.degree()).fold(SVector::zeros(), |sum, j| {
+            sum + x.fixed_rows::<N>(self.point(j)) * weights[j]
+        })
+    }
+
+    /// The force at node values `(q, p)` at time `t`, with its Jacobians in `q` and `p` when
+    /// `derivatives` (zeros otherwise).
+    fn force(
+        &self,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        t: f64,
+        derivatives: bool,
+    ) -> (SVector<f64, N>, SMatrix<f64, N, N>, SMatrix<f64, N, N>) {
+        if !S::FORCES {
+            return (SVector::zeros(), SMatrix::zeros(), SMatrix::zeros());
+        }
+        if !derivatives {
+            return (
+                self.system.force(q, p, t, &self.inputs),
+                SMatrix::zeros(),
+                SMatrix::zeros(),
+            );
+        }
+        let inputs: Vec<Dual<N>> = self.inputs.iter().map(|&u| Dual::from(u)).collect();
+        let constant = |x: &SVector<f64, N>| x.map(Dual::<N>::from);
+        let (f, fq) = derivatives::jacobian(q, |q| self.system.force(q, &constant(p), t, &inputs));
+        let (_, fp) = derivatives::jacobian(p, |p| self.system.force(&constant(q), p, t, &inputs));
+        (f, fq, fp)
+    }
+
+    /// The worst `|A_a(Q_c) Q̇_c|` over the sites of the step solved by `x`.
+    fn violation(&self, state: &State<N>, x: &DVector<f64>) -> f64 {
+        let mut worst: f64 = 0.0;
+        for site in &self.sites {
+            let q = state.q + self.combination(x, &site.position);
+            let v = self.combination(x, &site.rate) / self.h;
+            for a in 0..S::ONE_FORMS {
+                worst = worst.max(self.system.one_form(&q, a).dot(&v).abs());
+            }
+        }
+        worst
+    }
+
+    /// `∂H/∂p` at `(q, p)`.
+    fn velocity_at(&self, q: &SVector<f64, N>, p: &SVector<f64, N>) -> SVector<f64, N> {
+        derivatives::directional_gradient(
+            &Hamiltonian(&self.system),
+            q,
+            p,
+            derivatives::Seed::VELOCITY,
+        )
+    }
+}
+
+/// Whether `matrix` is singular (a pivot below 1e-13 of its largest entry, or all zero).
+fn singular<const N: usize>(matrix: &SMatrix<f64, N, N>) -> bool {
+    let mut lu = DMatrix::from_fn(N, N, |r, c| matrix[(r, c)]);
+    let mut pivots = vec![0; N];
+    matrix.amax() == 0.0 || lu::factorise(&mut lu, &mut pivots, 1e-13).is_err()
+}
+
+/// Fails naming `what` where a component of `x` is not finite.
+fn finite<const N: usize>(what: &str, x: &SVector<f64, N>) -> Result<(), DiracError> {
+    match x.iter().find(|x| !x.is_finite()) {
+        Some(&value) => Err(DiracError::NonFinite {
+            what: what.into(),
+            value,
+        }),
+        None => Ok(()),
+    }
+}
+
+impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N> {
+    type System = S;
+    type Manifold = Vectors;
+    const NAME: &'static str = "the discrete Hamilton's equations";
+    const VELOCITY: &'static str = "the velocity v = ∂H/∂p";
+
+    fn system(&self) -> &S {
+        &self.system
+    }
+
+    fn h(&self) -> f64 {
+        self.h
+    }
+
+    fn method(&self) -> String {
+        format!("discrete Hamiltonian, {}", self.quadrature.name())
+    }
+
+    fn unknowns(&self) -> usize {
+        (self.degree() + self.nodes()) * N + self.multipliers()
+    }
+
+    fn multipliers(&self) -> usize {
+        self.sites.len() * S::ONE_FORMS
+    }
+
+    fn multiplier_names(&self) -> Vec<String> {
+        let nodes = self.sites.len() > 1 || self.degree() > 1;
+        (0..self.sites.len())
+            .flat_map(|k| {
+                (0..S::ONE_FORMS).map(move |a| match nodes {
+                    false => format!("mu_{a}"),
+                    true => format!("mu_{a}_node_{}", k + 1),
+                })
+            })
+            .collect()
+    }
+
+    fn coordinate_name(&self, i: usize) -> String {
+        self.system.coordinate_name(i)
+    }
+
+    /// The position, the momentum and `H` finite, and the velocity `∂H/∂p` allowed by the
+    /// one-forms to the relative `tolerance`.
+    fn check_start(&self, state: &State<N>, tolerance: f64) -> Result<(), DiracError> {
+        finite("initial position", &state.q)?;
+        finite("initial momentum", &state.p)?;
+        let energy = self.system.hamiltonian(&state.q, &state.p);
+        if !energy.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: "the Hamiltonian at the initial state (is (q0, p0) in its domain?)".into(),
+                value: energy,
+            });
+        }
+        let second = derivatives::hessian(&Hamiltonian(&self.system), &state.q, &state.p);
+        let v = second.gradient.v;
+        finite("initial velocity ∂H/∂p", &v)?;
+        if self.nodes() > self.degree() && singular(&second.vv) {
+            return Err(DiracError::InvalidQuadrature(format!(
+                "{}: ∂²H/∂p² is singular at the initial state, so the velocity conditions \
+                 Q̇(c_i) = ∂H/∂p at its {} nodes fix a path of degree {} on their own: use a \
+                 Gauss rule with as many nodes as the degree (galerkin(s))",
+                self.quadrature.name(),
+                self.nodes(),
+                self.degree()
+            )));
+        }
+        for a in 0..S::ONE_FORMS {
+            let form = self.system.one_form(&state.q, a);
+            let scale = form.abs().dot(&v.abs()).max(form.amax() * v.amax());
+            let value = form.dot(&v);
+            if value.abs() > tolerance * scale.max(f64::MIN_POSITIVE) && value.abs() > 0.0 {
+                return Err(DiracError::InconsistentInitialState(format!(
+                    "one-form {a} at the initial state: A(q) ∂H/∂p = {value:e} (the momentum \
+                     must give a velocity the one-forms allow)"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>) {
+        if let Some(previous) = previous.filter(|p| p.len() == x.len()) {
+            x.copy_from(previous);
+            return;
+        }
+        x.fill(0.0);
+        let s = self.degree();
+        for j in 1..=s {
+            let c = j as f64 / s as f64;
+            x.fixed_rows_mut::<N>(self.point(j))
+                .copy_from(&(state.velocity * (c * self.h)));
+        }
+        for i in 0..self.nodes() {
+            x.fixed_rows_mut::<N>(self.node_momentum(i))
+                .copy_from(&state.p);
+        }
+    }
+
+    fn assemble(
+        &mut self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        residual: &mut DVector<f64>,
+        mut jacobian: Option<&mut DMatrix<f64>>,
+    ) -> f64 {
+        let (s, h) = (self.degree(), self.h);
+        let hamiltonian = Hamiltonian(&self.system);
+        residual.fill(0.0);
+        let mut rows = residual.fixed_rows_mut::<N>(0);
+        rows += state.p;
+        let mut impulse = SVector::<f64, N>::zeros();
+        let mut scale = state.p.amax();
+        let identity = SMatrix::<f64, N, N>::identity();
+        for i in 0..self.nodes() {
+            let (c, b) = (self.quadrature.nodes()[i], self.quadrature.weights()[i]);
+            let ell = |j: usize| self.quadrature.ell(i, j);
+            let ell_prime = |j: usize| self.quadrature.ell_prime(i, j);
+            let position: Vec<f64> = (0..=s).map(ell).collect();
+            let rate: Vec<f64> = (0..=s).map(ell_prime).collect();
+            let q = state.q + self.combination(x, &position);
+            let v = self.combination(x, &rate) / h;
+            let column = self.node_momentum(i);
+            let p = x.fixed_rows::<N>(column).into_owned();
+            let t = state.t + c * h;
+            let second = jacobian
+                .is_some()
+                .then(|| derivatives::hessian(&hamiltonian, &q, &p));
+            let (h_q, h_p) = match &second {
+                Some(second) => (second.gradient.q, second.gradient.v),
+                None => derivatives::gradients(&hamiltonian, &q, &p),
+            };
+            let (f, f_q, f_p) = self.force(&q, &p, t, jacobian.is_some());
+            let generalised = f - h_q;
+            for j in 0..s {
+                let mut row = residual.fixed_rows_mut::<N>(j * N);
+                row += p * (b * ell_prime(j)) + generalised * (h * b * ell(j));
+            }
+            impulse += generalised * (h * b);
+            residual.fixed_rows_mut::<N>(column).copy_from(&(v - h_p));
+            scale = scale
+                .max(p.amax())
+                .max(h * h_q.amax())
+                .max(h * f.amax())
+                .max(v.amax())
+                .max(h_p.amax());
+            if let (Some(jacobian), Some(second)) = (jacobian.as_deref_mut(), &second) {
+                let force_q = f_q - second.qq;
+                let force_p = f_p - second.qv;
+                for j in 0..s {
+                    for l in 1..=s {
+                        let mut block = jacobian.fixed_view_mut::<N, N>(j * N, self.point(l));
+                        block += force_q * (h * b * ell(j) * ell(l));
+                    }
+                    let mut block = jacobian.fixed_view_mut::<N, N>(j * N, column);
+                    block += identity * (b * ell_prime(j)) + force_p * (h * b * ell(j));
+                }
+                for l in 1..=s {
+                    let mut block = jacobian.fixed_view_mut::<N, N>(column, self.point(l));
+                    block += identity * (ell_prime(l) / h) - second.qv.transpose() * ell(l);
+                }
+                let mut block = jacobian.fixed_view_mut::<N, N>(column, column);
+                block -= second.vv;
+            }
+        }
+        for (k, site) in self.sites.iter().enumerate() {
+            let q = state.q + self.combination(x, &site.position);
+            let v = self.combination(x, &site.rate) / h;
+            let total: f64 = site.weight.iter().sum();
+            for a in 0..S::ONE_FORMS {
+                let column = self.multiplier(k, a);
+                let mu = x[column];
+                let (form, differential) = match jacobian.is_some() {
+                    true => derivatives::jacobian(&q, |q| self.system.one_form(q, a)),
+                    false => (self.system.one_form(&q, a), SMatrix::zeros()),
+                };
+                for j in 0..s {
+                    let mut row = residual.fixed_rows_mut::<N>(j * N);
+                    row += form * (site.weight[j] * mu);
+                }
+                impulse += form * (total * mu);
+                residual[column] = form.dot(&v);
+                scale = scale.max(total.abs() * (form * mu).amax());
+                if let Some(jacobian) = jacobian.as_deref_mut() {
+                    // d(A(q)·v)/dq = Σ_r v_r ∂A_r/∂q.
+                    let along = differential.transpose() * v;
+                    for l in 1..=s {
+                        for j in 0..s {
+                            let mut block = jacobian.fixed_view_mut::<N, N>(j * N, self.point(l));
+                            block += differential * (site.weight[j] * site.position[l] * mu);
+                        }
+                        let mut row = jacobian.fixed_view_mut::<1, N>(column, self.point(l));
+                        row += (form * (site.rate[l] / h) + along * site.position[l]).transpose();
+                    }
+                    for j in 0..s {
+                        let mut entries = jacobian.fixed_view_mut::<N, 1>(j * N, column);
+                        entries += form * site.weight[j];
+                    }
+                }
+            }
+        }
+        self.impulse = impulse;
+        scale.max(f64::MIN_POSITIVE)
+    }
+
+    /// `q_{k+1} = q_k + (Q_s − q_k)` and `p_{k+1} = p_k + impulse` (compensated sums), the
+    /// velocity `∂H/∂p` there, and the one-forms' violation at the step's sites.
+    fn advance(
+        &self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        step: u64,
+    ) -> Result<(State<N>, f64), DiracError> {
+        let mut next = *state;
+        let xi = x.fixed_rows::<N>(self.point(self.degree())).into_owned();
+        compensated_add(&mut next.q, &mut next.q_carry, &xi);
+        compensated_add(&mut next.p, &mut next.p_carry, &self.impulse);
+        finite("new position", &next.q)?;
+        finite("new momentum", &next.p)?;
+        let energy = self.system.hamiltonian(&next.q, &next.p);
+        if !energy.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: format!(
+                    "the Hamiltonian at the end of step {step} (the step leaves its domain or \
+                     overflows; try a smaller step)"
+                ),
+                value: energy,
+            });
+        }
+        next.velocity = self.velocity_at(&next.q, &next.p);
+        Ok((next, self.violation(state, x)))
+    }
+
+    fn first_multiplier(&self) -> usize {
+        (self.degree() + self.nodes()) * N
+    }
+
+    fn unknown_name(&self, column: usize) -> String {
+        let (s, m) = (self.degree(), self.nodes());
+        let name = |i: usize| self.coordinate_name(i % N);
+        match column / N {
+            block if block < s && block + 1 == s => format!("{} (q_{{k+1}})", name(column)),
+            block if block < s => format!("{} (internal point {})", name(column), block + 1),
+            block if block < s + m => format!(
+                "the momentum of {} at quadrature node {}",
+                name(column),
+                block - s + 1
+            ),
+            _ => {
+                let c = column - self.first_multiplier();
+                let (k, a) = (c / S::ONE_FORMS.max(1), c % S::ONE_FORMS.max(1));
+                match self.sites.len() {
+                    1 if s == 1 => format!("the multiplier of one-form {a}"),
+                    _ => format!(
+                        "the multiplier of one-form {a} at quadrature node {}",
+                        k + 1
+                    ),
+                }
+            }
+        }
+    }
+
+    /// `∂H/∂p(q, p)`: explicit, no solve.
+    fn velocity(
+        &self,
+        _newton: &mut Newton,
+        _t: f64,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        _guess: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, NewtonFailure> {
+        Ok(self.velocity_at(q, p))
+    }
+
+    /// The momentum whose velocity `∂H/∂p(q, p)` is `v`, by Newton's method on the Legendre
+    /// map from `p = v`; fails where `∂²H/∂p²` is singular (no Lagrangian counterpart: start
+    /// from a momentum) or where the iteration does not converge.
+    fn momentum(
+        &self,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, DiracError> {
+        finite("initial position", q)?;
+        finite("initial velocity", v)?;
+        let hamiltonian = Hamiltonian(&self.system);
+        let mut p = *v;
+        let singular_map = || {
+            DiracError::Unsupported(
+                "a start from a velocity where ∂²H/∂p² is singular (the Legendre map \
+                 p ↦ ∂H/∂p does not determine p there); start from a momentum"
+                    .into(),
+            )
+        };
+        for _ in 0..50 {
+            let second = derivatives::hessian(&hamiltonian, q, &p);
+            let mut matrix = DMatrix::from_fn(N, N, |r, c| second.vv[(r, c)]);
+            let mut pivots = vec![0; N];
+            if second.vv.amax() == 0.0 || lu::factorise(&mut matrix, &mut pivots, 1e-13).is_err() {
+                return Err(singular_map());
+            }
+            let mut step = second.gradient.v - v;
+            if step.amax() <= 4.0 * f64::EPSILON * (1.0 + v.amax()) {
+                finite("initial momentum", &p)?;
+                return Ok(p);
+            }
+            lu::solve(&matrix, &pivots, step.as_mut_slice());
+            p -= step;
+            if step.amax() <= 4.0 * f64::EPSILON * (1.0 + p.amax()) {
+                finite("initial momentum", &p)?;
+                return Ok(p);
+            }
+        }
+        Err(DiracError::InconsistentInitialState(
+            "no momentum p with ∂H/∂p(q, p) = v was found from p = v in 50 Newton iterations; \
+             start from a momentum"
+                .into(),
+        ))
+    }
+
+    fn energy(&self, q: &SVector<f64, N>, p: &SVector<f64, N>, _v: &SVector<f64, N>) -> f64 {
+        self.system.hamiltonian(q, p)
+    }
+
+    fn inputs(&self) -> &[f64] {
+        &self.inputs
+    }
+
+    fn inputs_mut(&mut self) -> &mut [f64] {
+        &mut self.inputs
+    }
+
+    fn input_name(&self, i: usize) -> String {
+        self.system.input_name(i)
+    }
+}

@@ -1,0 +1,500 @@
+//! The discrete Hamiltonian route (`H_d⁺`, Galerkin): measured orders 2, 4, 6 against closed
+//! forms and Dop853, a non-separable Hamiltonian (bounded energy, order, the same steps as its
+//! Lagrangian), Kepler's angular momentum to round-off, the knife edge written with `H` against
+//! its closed form and the Lagrangian scene, forces and inputs, a Hamiltonian with no Lagrangian,
+//! and the errors.
+
+#[path = "../examples/scenes/mod.rs"]
+mod scenes;
+mod support;
+
+use dirac::prelude::*;
+use dirac::{Hamilton, HamiltonianSystem, StepEquations};
+use ode_solvers::System;
+use scenes::hamiltonian::{
+    Coupled, CoupledLagrangian, Damped, Kepler, KnifeEdge, Lifted, PENDULUM, lifted_exact,
+};
+use support::assert_order;
+
+/// The quadratures of orders 2, 4 and 6 with their orders.
+fn orders() -> Vec<(Quadrature, f64)> {
+    vec![
+        (Quadrature::midpoint(), 2.0),
+        (Quadrature::trapezoid(), 2.0),
+        (Quadrature::galerkin(2).unwrap(), 4.0),
+        (Quadrature::galerkin(3).unwrap(), 6.0),
+    ]
+}
+
+/// The end of a run of `steps` steps of `h` from `(q0, p0)` on the Hamiltonian route.
+fn end<S: HamiltonianSystem<N>, const N: usize>(
+    system: S,
+    quadrature: &Quadrature,
+    h: f64,
+    steps: usize,
+    q0: SVector<f64, N>,
+    p0: SVector<f64, N>,
+) -> (SVector<f64, N>, SVector<f64, N>) {
+    let mut stepper = Stepper::hamiltonian(system, quadrature.clone(), h).unwrap();
+    stepper.start_from_momentum(q0, p0).unwrap();
+    for _ in 0..steps {
+        stepper.step().unwrap();
+    }
+    let state = stepper.state().unwrap();
+    (*state.q(), *state.p())
+}
+
+/// `H = (p² + q²)/2` written by hand.
+struct Oscillator;
+
+impl HamiltonianSystem<1> for Oscillator {
+    fn hamiltonian<D: Scalar>(&self, q: &SVector<D, 1>, p: &SVector<D, 1>) -> D {
+        (p[0] * p[0] + q[0] * q[0]) * 0.5
+    }
+}
+
+#[test]
+fn the_oscillator_converges_at_orders_2_4_and_6() {
+    let t: f64 = 2.0;
+    for (quadrature, order) in orders() {
+        let hs = [0.2, 0.1, 0.05];
+        let errors: Vec<f64> = hs
+            .iter()
+            .map(|&h| {
+                let steps = (t / h).round() as usize;
+                let (q, p) = end(
+                    Oscillator,
+                    &quadrature,
+                    h,
+                    steps,
+                    vector![1.0],
+                    vector![0.0],
+                );
+                (q[0] - t.cos()).abs().max((p[0] + t.sin()).abs())
+            })
+            .collect();
+        assert_order(
+            &format!("oscillator, {}", quadrature.name()),
+            &hs,
+            &errors,
+            order,
+        );
+    }
+}
+
+/// The pendulum's ODE `θ̇ = p/(m l²)`, `ṗ = −m g l sin θ`, for Dop853.
+struct PendulumOde;
+
+type Y2 = ode_solvers::SVector<f64, 2>;
+
+impl System<f64, Y2> for PendulumOde {
+    fn system(&self, _t: f64, y: &Y2, dy: &mut Y2) {
+        let (m, l, g) = (PENDULUM.m, PENDULUM.l, PENDULUM.g);
+        dy[0] = y[1] / (m * l * l);
+        dy[1] = -m * g * l * y[0].sin();
+    }
+}
+
+#[test]
+fn the_pendulum_converges_at_orders_2_4_and_6_against_dop853() {
+    let t: f64 = 2.0;
+    let reference = scenes::peers::dop853_end(PendulumOde, Y2::new(1.0, 0.0), t, 1e-14).unwrap();
+    for (quadrature, order) in orders() {
+        let hs = [0.1, 0.05, 0.025];
+        let errors: Vec<f64> = hs
+            .iter()
+            .map(|&h| {
+                let steps = (t / h).round() as usize;
+                let (q, p) = end(PENDULUM, &quadrature, h, steps, vector![1.0], vector![0.0]);
+                (q[0] - reference[0]).abs().max((p[0] - reference[1]).abs())
+            })
+            .collect();
+        assert_order(
+            &format!("pendulum, {}", quadrature.name()),
+            &hs,
+            &errors,
+            order,
+        );
+    }
+}
+
+/// The non-separable `Coupled`'s ODE: `q̇ = (q² + 1) p`, `ṗ = −q (p² + 1)`.
+struct CoupledOde;
+
+impl System<f64, Y2> for CoupledOde {
+    fn system(&self, _t: f64, y: &Y2, dy: &mut Y2) {
+        dy[0] = (y[0] * y[0] + 1.0) * y[1];
+        dy[1] = -y[0] * (y[1] * y[1] + 1.0);
+    }
+}
+
+#[test]
+fn a_non_separable_hamiltonian_converges_at_its_orders_against_dop853() {
+    let t: f64 = 3.0;
+    let reference = scenes::peers::dop853_end(CoupledOde, Y2::new(0.5, 0.0), t, 1e-14).unwrap();
+    for (quadrature, order) in orders() {
+        let hs = [0.1, 0.05, 0.025];
+        let errors: Vec<f64> = hs
+            .iter()
+            .map(|&h| {
+                let steps = (t / h).round() as usize;
+                let (q, p) = end(Coupled, &quadrature, h, steps, vector![0.5], vector![0.0]);
+                (q[0] - reference[0]).abs().max((p[0] - reference[1]).abs())
+            })
+            .collect();
+        assert_order(
+            &format!("H = (q²+1)(p²+1)/2, {}", quadrature.name()),
+            &hs,
+            &errors,
+            order,
+        );
+    }
+}
+
+#[test]
+fn a_non_separable_hamiltonian_keeps_its_energy_bounded_without_drift() {
+    let mut stepper = Stepper::hamiltonian(Coupled, Quadrature::midpoint(), 0.05).unwrap();
+    stepper
+        .start_from_momentum(vector![0.5], vector![0.0])
+        .unwrap();
+    let trajectory = stepper.run(100_000).unwrap();
+    let (first, last) = support::energy_error_first_and_last_tenth(trajectory.energy());
+    println!("energy error: first tenth {first:.3e}, last tenth {last:.3e}");
+    // Midpoint at h = 0.05: an O(h²) oscillation, the same in the first and the last tenth.
+    assert!(first > 1e-6 && first < 1e-2, "{first}");
+    assert!(last < 1.1 * first, "drift: {first} then {last}");
+}
+
+/// Where `∂²H/∂p²` is invertible both routes extremise the same action: the Hamiltonian route's
+/// steps are the Lagrangian route's with the same quadrature, to solver tolerance.
+#[test]
+fn the_two_routes_take_the_same_steps_where_the_legendre_transform_is_invertible() {
+    let quadratures = [
+        Quadrature::midpoint(),
+        Quadrature::trapezoid(),
+        Quadrature::galerkin(2).unwrap(),
+        Quadrature::galerkin(3).unwrap(),
+        Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3)).unwrap(),
+    ];
+    for quadrature in quadratures {
+        let mut hamiltonian = Stepper::hamiltonian(Coupled, quadrature.clone(), 0.05).unwrap();
+        hamiltonian
+            .start_from_momentum(vector![0.5], vector![0.3])
+            .unwrap();
+        let mut lagrangian = Stepper::new(CoupledLagrangian, quadrature.clone(), 0.05).unwrap();
+        lagrangian
+            .start_from_momentum(vector![0.5], vector![0.3])
+            .unwrap();
+        let (a, b) = (
+            hamiltonian.run(2000).unwrap(),
+            lagrangian.run(2000).unwrap(),
+        );
+        let difference = a
+            .q()
+            .iter()
+            .zip(b.q())
+            .chain(a.p().iter().zip(b.p()))
+            .map(|(x, y)| (x - y).amax())
+            .fold(0.0, f64::max);
+        println!("{}: max difference {difference:.2e}", quadrature.name());
+        assert!(difference < 1e-11, "{}: {difference}", quadrature.name());
+    }
+}
+
+#[test]
+fn keplers_angular_momentum_is_conserved_to_round_off() {
+    let (q0, p0) = (vector![0.5, 0.0], vector![0.0, 3f64.sqrt()]);
+    let l = |q: &SVector<f64, 2>, p: &SVector<f64, 2>| q[0] * p[1] - q[1] * p[0];
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let mut stepper =
+            Stepper::hamiltonian(Kepler { mu: 1.0 }, quadrature.clone(), 0.01).unwrap();
+        stepper.start_from_momentum(q0, p0).unwrap();
+        let trajectory = stepper.run(20_000).unwrap();
+        let drift = trajectory
+            .q()
+            .iter()
+            .zip(trajectory.p())
+            .map(|(q, p)| (l(q, p) - l(&q0, &p0)).abs())
+            .fold(0.0, f64::max);
+        println!(
+            "{}: angular momentum drift {drift:.2e}, energy error {:.2e}",
+            quadrature.name(),
+            trajectory.max_energy_error()
+        );
+        assert!(drift < 1e-11, "{}: {drift}", quadrature.name());
+        // The energy is not conserved to round-off: the test would not be one of round-off.
+        assert!(trajectory.max_energy_error() > 1e3 * drift);
+    }
+}
+
+const KNIFE: KnifeEdge = KnifeEdge {
+    m: 1.0,
+    j: 1.0,
+    g: 9.81,
+    alpha: std::f64::consts::FRAC_PI_6,
+};
+
+#[test]
+fn the_knife_edge_written_with_h_follows_its_closed_form_at_order_2() {
+    let t: f64 = 2.0;
+    let hs = [0.02, 0.01, 0.005];
+    let errors: Vec<f64> = hs
+        .iter()
+        .map(|&h| {
+            let mut stepper = Stepper::hamiltonian(KNIFE, Quadrature::midpoint(), h).unwrap();
+            let omega = scenes::knife_edge::OMEGA;
+            stepper
+                .start_from_momentum(SVector::zeros(), vector![0.0, 0.0, omega])
+                .unwrap();
+            for _ in 0..(t / h).round() as usize {
+                stepper.step().unwrap();
+                assert!(stepper.constraint_violation() < 1e-12);
+            }
+            (stepper.q() - scenes::knife_edge::exact(t)).amax()
+        })
+        .collect();
+    assert_order("knife edge (H)", &hs, &errors, 2.0);
+}
+
+#[test]
+fn the_knife_edge_takes_the_lagrangian_scenes_steps_at_each_constraint_point_and_order() {
+    let cases = [
+        (Quadrature::midpoint(), ConstraintPoint::Midpoint),
+        (Quadrature::midpoint(), ConstraintPoint::Start),
+        (Quadrature::trapezoid(), ConstraintPoint::End),
+        (Quadrature::galerkin(2).unwrap(), ConstraintPoint::Midpoint),
+    ];
+    for (quadrature, point) in cases {
+        let h = 0.01;
+        let mut lagrangian = Stepper::new(scenes::knife_edge::SCENE, quadrature.clone(), h)
+            .unwrap()
+            .with_constraint_point(point);
+        lagrangian
+            .start_from_momentum(SVector::zeros(), vector![0.0, 0.0, 1.0])
+            .unwrap();
+        let system = KnifeEdgeAt {
+            model: KNIFE,
+            point,
+        };
+        let mut hamiltonian = Stepper::hamiltonian(system, quadrature.clone(), h).unwrap();
+        hamiltonian
+            .start_from_momentum(SVector::zeros(), vector![0.0, 0.0, 1.0])
+            .unwrap();
+        let (a, b) = (hamiltonian.run(500).unwrap(), lagrangian.run(500).unwrap());
+        let difference = a
+            .q()
+            .iter()
+            .zip(b.q())
+            .chain(a.p().iter().zip(b.p()))
+            .map(|(x, y)| (x - y).amax())
+            .fold(0.0, f64::max);
+        println!("{} at {point:?}: {difference:.2e}", quadrature.name());
+        assert!(
+            difference < 1e-10,
+            "{} {point:?}: {difference}",
+            quadrature.name()
+        );
+    }
+}
+
+/// The knife edge with its constraint point chosen.
+struct KnifeEdgeAt {
+    model: KnifeEdge,
+    point: ConstraintPoint,
+}
+
+impl HamiltonianSystem<3> for KnifeEdgeAt {
+    const ONE_FORMS: usize = 1;
+    fn hamiltonian<D: Scalar>(&self, q: &SVector<D, 3>, p: &SVector<D, 3>) -> D {
+        self.model.hamiltonian(q, p)
+    }
+    fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, a: usize) -> SVector<D, 3> {
+        self.model.one_form(q, a)
+    }
+    fn constraint_point(&self) -> ConstraintPoint {
+        self.point
+    }
+}
+
+/// `H = (p² + q²)/2` with the force `(u − c v) dq` on the Lagrangian route.
+#[dirac_system(
+    coordinates(q),
+    lagrangian = 0.5 * (dot(q) * dot(q) - q * q),
+    forces((u - c * dot(q)) * dq),
+    inputs(u),
+)]
+#[derive(Debug, Clone, Copy)]
+struct DampedLagrangian {
+    c: f64,
+}
+
+#[test]
+fn forces_and_inputs_act_as_on_the_lagrangian_route() {
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let mut a = Stepper::hamiltonian(Damped { c: 0.3 }, quadrature.clone(), 0.05).unwrap();
+        let mut b = Stepper::new(DampedLagrangian { c: 0.3 }, quadrature.clone(), 0.05).unwrap();
+        a.start_from_momentum(vector![1.0], vector![0.0]).unwrap();
+        b.start_from_momentum(vector![1.0], vector![0.0]).unwrap();
+        let mut worst: f64 = 0.0;
+        for k in 0..400 {
+            let u = (0.1 * k as f64).sin();
+            a.set_input("u", u).unwrap();
+            b.set_input("u", u).unwrap();
+            a.step().unwrap();
+            b.step().unwrap();
+            worst = worst
+                .max((a.q() - b.q()).amax())
+                .max((a.p() - b.p()).amax());
+        }
+        println!("{}: {worst:.2e}", quadrature.name());
+        assert!(worst < 1e-12, "{}: {worst}", quadrature.name());
+    }
+    // Without the input the damping takes energy out: E(20) = E(0) e^{−c t} to O(c²).
+    let mut a =
+        Stepper::hamiltonian(Damped { c: 0.3 }, Quadrature::galerkin(2).unwrap(), 0.05).unwrap();
+    a.start_from_momentum(vector![1.0], vector![0.0]).unwrap();
+    let trajectory = a.run(400).unwrap();
+    let energy = trajectory.energy();
+    assert!(energy[400] < 0.01 * energy[0], "{}", energy[400]);
+}
+
+#[test]
+fn a_hamiltonian_without_a_lagrangian_is_stepped_at_the_gauss_order() {
+    // H = p (1 − q²): ∂²H/∂p² = 0, so no Lagrangian route; the steps are Gauss collocation of
+    // q̇ = 1 − q² with its adjoint, of order 2s in q and p.
+    let t: f64 = 1.0;
+    for (quadrature, order) in orders()
+        .into_iter()
+        .filter(|(q, _)| q.rule() == Rule::GaussLegendre(q.degree()))
+    {
+        let hs = [0.1, 0.05, 0.025];
+        let errors: Vec<f64> = hs
+            .iter()
+            .map(|&h| {
+                let steps = (t / h).round() as usize;
+                let (q, p) = end(Lifted, &quadrature, h, steps, vector![0.0], vector![1.0]);
+                let (q_exact, p_exact) = lifted_exact(t, 1.0);
+                (q[0] - q_exact).abs().max((p[0] - p_exact).abs())
+            })
+            .collect();
+        assert_order(
+            &format!("H = p(1 − q²), {}", quadrature.name()),
+            &hs,
+            &errors,
+            order,
+        );
+    }
+    // With more nodes than the path's degree the velocity conditions q̇(c_i) = f(Q(c_i)) alone
+    // over-determine the path (no momentum enters them): the trapezoid rule is refused.
+    let mut stepper = Stepper::hamiltonian(Lifted, Quadrature::trapezoid(), 0.1).unwrap();
+    let error = stepper
+        .start_from_momentum(vector![0.0], vector![1.0])
+        .unwrap_err();
+    assert!(matches!(error, DiracError::InvalidQuadrature(_)), "{error}");
+    // A start from a velocity needs the Legendre map inverted, which this H does not allow.
+    let mut stepper = Stepper::hamiltonian(Lifted, Quadrature::midpoint(), 0.1).unwrap();
+    let error = stepper
+        .start_from_velocity(vector![0.0], vector![1.0])
+        .unwrap_err();
+    assert!(matches!(error, DiracError::Unsupported(_)), "{error}");
+    assert!(stepper.state().is_none());
+}
+
+#[test]
+fn a_start_from_a_velocity_inverts_the_legendre_map() {
+    // v = (q² + 1) p: at q = 0.5, v = 0.5 gives p = 0.4.
+    let mut stepper = Stepper::hamiltonian(Coupled, Quadrature::midpoint(), 0.1).unwrap();
+    stepper
+        .start_from_velocity(vector![0.5], vector![0.5])
+        .unwrap();
+    assert!((stepper.state().unwrap().p()[0] - 0.4).abs() < 1e-15);
+}
+
+#[test]
+fn invalid_models_and_states_are_refused_with_the_reason() {
+    let lobatto = Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3)).unwrap();
+    assert!(matches!(
+        Stepper::hamiltonian(KNIFE, lobatto, 0.01),
+        Err(DiracError::InvalidQuadrature(_))
+    ));
+    assert!(matches!(
+        Stepper::hamiltonian(Oscillator, Quadrature::midpoint(), 0.0),
+        Err(DiracError::InvalidStep { .. })
+    ));
+    let nan = KnifeEdge {
+        m: f64::NAN,
+        ..KNIFE
+    };
+    assert!(matches!(
+        Stepper::hamiltonian(nan, Quadrature::midpoint(), 0.01),
+        Err(DiracError::NonFinite { .. })
+    ));
+    // p_x = 1 at φ = 0 moves across the blade: refused, and nothing is started.
+    let mut stepper = Stepper::hamiltonian(KNIFE, Quadrature::midpoint(), 0.01).unwrap();
+    let error = stepper
+        .start_from_momentum(SVector::zeros(), vector![0.0, 1.0, 0.0])
+        .unwrap_err();
+    assert!(
+        matches!(error, DiracError::InconsistentInitialState(_)),
+        "{error}"
+    );
+    assert!(stepper.state().is_none());
+    let error = stepper
+        .start_from_momentum(vector![f64::NAN, 0.0, 0.0], SVector::zeros())
+        .unwrap_err();
+    assert!(matches!(error, DiracError::NonFinite { .. }), "{error}");
+    // Kepler at the origin: H is not finite there.
+    let mut kepler =
+        Stepper::hamiltonian(Kepler { mu: 1.0 }, Quadrature::midpoint(), 0.01).unwrap();
+    assert!(
+        kepler
+            .start_from_momentum(SVector::zeros(), vector![0.0, 1.0])
+            .is_err()
+    );
+}
+
+#[test]
+fn a_step_that_leaves_the_domain_fails_and_changes_nothing() {
+    // Straight at the attracting centre with a step too long to resolve the passage.
+    let mut stepper =
+        Stepper::hamiltonian(Kepler { mu: 1.0 }, Quadrature::midpoint(), 0.5).unwrap();
+    stepper
+        .start_from_momentum(vector![2.0, 0.0], vector![-1.0, 0.0])
+        .unwrap();
+    let mut failed = false;
+    for _ in 0..10 {
+        let before = *stepper.state().unwrap();
+        if let Err(error) = stepper.step() {
+            println!("step {}: {error}", stepper.steps());
+            assert_eq!(*stepper.state().unwrap(), before);
+            failed = true;
+            break;
+        }
+    }
+    assert!(
+        failed,
+        "a head-on fall through r = 0 was stepped without an error"
+    );
+}
+
+#[test]
+fn the_trajectory_names_the_hamiltonian_routes_columns() {
+    let mut stepper = Stepper::hamiltonian(KNIFE, Quadrature::galerkin(2).unwrap(), 0.01).unwrap();
+    stepper
+        .start_from_momentum(SVector::zeros(), vector![0.0, 0.0, 1.0])
+        .unwrap();
+    let trajectory = stepper.run(3).unwrap();
+    let header = support::csv_header(&trajectory);
+    assert!(
+        header.starts_with("t,x,y,phi,v_x,v_y,v_phi,p_x,p_y,p_phi,energy"),
+        "{header}"
+    );
+    assert!(
+        header.contains("mu_0_node_1") && header.contains("mu_0_node_2"),
+        "{header}"
+    );
+    assert_eq!(
+        <Hamilton<KnifeEdge, 3> as StepEquations<3>>::NAME,
+        "the discrete Hamilton's equations"
+    );
+}
