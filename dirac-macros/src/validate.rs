@@ -241,6 +241,8 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
             errors.push(Span::call_site(), "missing `lagrangian = ...`: an expression in the coordinates, dot(coordinate) and the parameters, or the path of a generic function (or `hamiltonian = ...`, in the coordinates and their momenta p(coordinate))");
             None
         }
+        // Refused in `hamiltonian_route`; its expression is not read.
+        (Some(_), Some(coordinates)) if hamiltonian && is_product(coordinates) => None,
         (Some(expr), Some(coordinates)) => {
             let n =
                 literal_dimension(coordinates).filter(|_| !is_product(coordinates) && !hamiltonian);
@@ -412,8 +414,10 @@ fn hamiltonian_route(
     errors: &mut Errors,
 ) {
     if let Some(lagrangian) = lagrangian {
-        errors.push(
-            lagrangian.span(),
+        let (start, end) = bounds(lagrangian);
+        errors.push_range(
+            start,
+            end,
             "give either `lagrangian = ...` or `hamiltonian = ...`, not both",
         );
     }
@@ -425,8 +429,10 @@ fn hamiltonian_route(
         );
     }
     if let Some(g) = holonomic.and_then(|g| g.first()) {
-        errors.push(
-            g.span(),
+        let (start, end) = bounds(g);
+        errors.push_range(
+            start,
+            end,
             "holonomic constraints are not offered with `hamiltonian = ...`; write their \
              differentials in constraints(...), or give a Lagrangian",
         );
