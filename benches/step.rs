@@ -300,8 +300,59 @@ fn lie_group(c: &mut Criterion) {
     group.finish();
 }
 
+/// One step of the same model on the Lagrangian and the discrete Hamiltonian route: Kepler
+/// (h = 0.01) and the knife edge (h = 0.01, one one-form), midpoint and `galerkin(2)`.
+fn routes(c: &mut Criterion) {
+    let mut group = c.benchmark_group("route_step");
+    let knife = scenes::hamiltonian::KnifeEdge {
+        m: 1.0,
+        j: 1.0,
+        g: 9.81,
+        alpha: std::f64::consts::FRAC_PI_6,
+    };
+    let (q0, p0) = (scenes::kepler::q0(), scenes::kepler::p0());
+    let knife_p0 = vector![0.0, 0.0, 1.0];
+    for quadrature in [
+        Quadrature::midpoint(),
+        Quadrature::galerkin(2).expect("valid"),
+    ] {
+        let name = quadrature.name();
+        let mut lagrangian =
+            Stepper::new(scenes::kepler::SCENE, quadrature.clone(), 0.01).expect("valid scene");
+        lagrangian.start_from_momentum(q0, p0).expect("start");
+        group.bench_function(format!("kepler/lagrangian/{name}"), |b| {
+            b.iter(|| black_box(lagrangian.step()).expect("step"))
+        });
+        let model = scenes::hamiltonian::Kepler { mu: 1.0 };
+        let mut hamiltonian =
+            Stepper::hamiltonian(model, quadrature.clone(), 0.01).expect("valid scene");
+        hamiltonian.start_from_momentum(q0, p0).expect("start");
+        group.bench_function(format!("kepler/hamiltonian/{name}"), |b| {
+            b.iter(|| black_box(hamiltonian.step()).expect("step"))
+        });
+        let mut lagrangian =
+            Stepper::new(scenes::knife_edge::SCENE, quadrature.clone(), 0.01).expect("valid scene");
+        lagrangian
+            .start_from_momentum(SVector::zeros(), knife_p0)
+            .expect("start");
+        group.bench_function(format!("knife_edge/lagrangian/{name}"), |b| {
+            b.iter(|| black_box(lagrangian.step()).expect("step"))
+        });
+        let mut hamiltonian =
+            Stepper::hamiltonian(knife, quadrature.clone(), 0.01).expect("valid scene");
+        hamiltonian
+            .start_from_momentum(SVector::zeros(), knife_p0)
+            .expect("start");
+        group.bench_function(format!("knife_edge/hamiltonian/{name}"), |b| {
+            b.iter(|| black_box(hamiltonian.step()).expect("step"))
+        });
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
+    routes,
     lie_group,
     recording,
     generated_vs_hand,

@@ -19,12 +19,13 @@ use scenes::{Report, circuit, knife_edge, rigid_body, rolling_ball};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     type Scene = fn(Quadrature) -> Result<Report, DiracError>;
-    let scenes: [Scene; 5] = [
+    let scenes: [Scene; 6] = [
         scenes::oscillator::report,
         scenes::pendulum::report,
         scenes::double_pendulum::report,
         scenes::kepler::report,
         scenes::chain::report,
+        scenes::hamiltonian::report,
     ];
     let mut reports = Vec::new();
     for scene in scenes {

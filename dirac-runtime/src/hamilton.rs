@@ -489,6 +489,12 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         scale.max(f64::MIN_POSITIVE)
     }
 
+    /// A Jacobian takes three hyper-dual passes of `H` per node (about `(N + 1)²` numbers per
+    /// operation) where the residual takes two first-order passes (`N + 1` each).
+    fn jacobian_cost(&self) -> f64 {
+        1.5 * (N + 1) as f64
+    }
+
     /// `q_{k+1} = q_k + (Q_s − q_k)` and `p_{k+1} = p_k + impulse` (compensated sums), the
     /// velocity `∂H/∂p` there, and the one-forms' violation at the step's sites.
     fn advance(
