@@ -498,3 +498,191 @@ fn the_trajectory_names_the_hamiltonian_routes_columns() {
         "the discrete Hamilton's equations"
     );
 }
+
+/// One step of `equations` from `(q, p)` without start checks (so that perturbations off the
+/// constraint manifold are allowed): the new state and the exact derivatives at the solution.
+fn raw_step<E: StepEquations<N, Manifold = dirac::Vectors>, const N: usize>(
+    equations: &mut E,
+    q: SVector<f64, N>,
+    p: SVector<f64, N>,
+) -> (SVector<f64, N>, SVector<f64, N>, dirac::StepDerivatives<N>) {
+    use dirac::nalgebra::DVector;
+    use dirac::{Newton, State};
+    let v = p; // a guess: it seeds the predictor only
+    let state = State::new(0.3, q, p, v);
+    let mut x = DVector::zeros(equations.unknowns());
+    equations.predict(&state, None, &mut x);
+    let options = NewtonOptions {
+        max_contraction: f64::INFINITY,
+        ..Default::default()
+    };
+    let mut newton = Newton::new(equations.unknowns(), options).unwrap();
+    newton
+        .solve(&mut x, |x, r, j| equations.assemble(&state, x, r, j))
+        .expect("step");
+    let (next, _) = equations.advance(&state, &x, 0).unwrap();
+    newton
+        .factorise_at(&x, |x, r, j| equations.assemble(&state, x, r, j))
+        .expect("a regular root");
+    let derivatives = equations.linearise(&state, &x, &newton).unwrap();
+    (*next.q(), *next.p(), derivatives)
+}
+
+/// The exact `A` (and `B` for one input) of the step of `make(u)` from `(q, p)` against central
+/// differences (δ = 1e-5); returns `A` and `B`.
+fn against_central_differences<S: HamiltonianSystem<N>, const N: usize>(
+    name: &str,
+    make: impl Fn(f64) -> Hamilton<S, N>,
+    q: SVector<f64, N>,
+    p: SVector<f64, N>,
+    u: Option<f64>,
+) -> dirac::StepDerivatives<N> {
+    let u0 = u.unwrap_or(0.0);
+    let (_, _, exact) = raw_step(&mut make(u0), q, p);
+    let (a, delta) = (exact.matrix(), 1e-5);
+    let mut worst = 0.0_f64;
+    for c in 0..2 * N {
+        let nudge = |sign: f64| {
+            let (mut q, mut p) = (q, p);
+            match c < N {
+                true => q[c] += sign * delta,
+                false => p[c - N] += sign * delta,
+            }
+            raw_step(&mut make(u0), q, p)
+        };
+        let ((q1p, p1p, _), (q1m, p1m, _)) = (nudge(1.0), nudge(-1.0));
+        for r in 0..N {
+            worst = worst.max((a[(r, c)] - (q1p[r] - q1m[r]) / (2.0 * delta)).abs());
+            worst = worst.max((a[(N + r, c)] - (p1p[r] - p1m[r]) / (2.0 * delta)).abs());
+        }
+    }
+    println!("{name}: |A − central differences| = {worst:.1e}");
+    assert!(worst < 1e-7, "{name}: A differs by {worst:e}");
+    assert!(
+        (a.clone() - DMatrix::identity(2 * N, 2 * N)).amax() > 1e-3,
+        "{name}"
+    );
+    if let Some(u) = u {
+        let ((q1p, p1p, _), (q1m, p1m, _)) = (
+            raw_step(&mut make(u + delta), q, p),
+            raw_step(&mut make(u - delta), q, p),
+        );
+        let b = exact.input_matrix();
+        for r in 0..N {
+            let dq = (q1p[r] - q1m[r]) / (2.0 * delta);
+            let dp = (p1p[r] - p1m[r]) / (2.0 * delta);
+            assert!((b[(r, 0)] - dq).abs() < 1e-7, "{name}: B row {r}");
+            assert!((b[(N + r, 0)] - dp).abs() < 1e-7, "{name}: B row {}", N + r);
+        }
+        assert!(b.amax() > 1e-3, "{name}: the input moves the state");
+    }
+    exact
+}
+
+use dirac::nalgebra::DMatrix;
+
+/// The equations of `system` with `quadrature` and `h`, the first input at `u`.
+fn hamilton<S: HamiltonianSystem<N>, const N: usize>(
+    system: S,
+    quadrature: &Quadrature,
+    h: f64,
+    u: f64,
+) -> Hamilton<S, N> {
+    let mut equations = Hamilton::new(system, quadrature.clone(), h).unwrap();
+    if let Some(first) = equations.inputs_mut().first_mut() {
+        *first = u;
+    }
+    equations
+}
+
+#[test]
+fn step_derivatives_match_central_differences_and_are_symplectic() {
+    let g2 = Quadrature::galerkin(2).unwrap();
+    let g3 = Quadrature::galerkin(3).unwrap();
+    let conservative = [
+        (
+            "coupled, galerkin(2)",
+            against_central_differences(
+                "coupled, galerkin(2)",
+                |u| hamilton(Coupled, &g2, 0.1, u),
+                vector![0.5],
+                vector![0.3],
+                None,
+            ),
+        ),
+        (
+            "pendulum, galerkin(3)",
+            against_central_differences(
+                "pendulum, galerkin(3)",
+                |u| hamilton(PENDULUM, &g3, 0.1, u),
+                vector![1.0],
+                vector![0.5],
+                None,
+            ),
+        ),
+        (
+            "H = p(1 − q²), galerkin(2)",
+            against_central_differences(
+                "H = p(1 − q²), galerkin(2)",
+                |u| hamilton(Lifted, &g2, 0.1, u),
+                vector![0.2],
+                vector![1.3],
+                None,
+            ),
+        ),
+    ];
+    for (name, a) in &conservative {
+        let det = a.matrix().determinant();
+        println!(
+            "{name}: AᵀJA − J = {:.1e}, det A − 1 = {:.1e}",
+            a.symplecticity_defect(),
+            det - 1.0
+        );
+        assert!(a.symplecticity_defect() < 1e-12, "{name}");
+        assert!((det - 1.0).abs() < 1e-12, "{name}");
+    }
+    let kepler = against_central_differences(
+        "kepler, midpoint",
+        |u| hamilton(Kepler { mu: 1.0 }, &Quadrature::midpoint(), 0.05, u),
+        vector![0.5, 0.1],
+        vector![0.2, 1.7],
+        None,
+    );
+    println!("kepler: AᵀJA − J = {:.1e}", kepler.symplecticity_defect());
+    assert!(kepler.symplecticity_defect() < 1e-12);
+    // Damping is not symplectic, and the input moves the state: B against differences too.
+    let damped = against_central_differences(
+        "damped, galerkin(2)",
+        |u| hamilton(Damped { c: 0.3 }, &g2, 0.1, u),
+        vector![0.7],
+        vector![-0.2],
+        Some(0.4),
+    );
+    assert!(damped.symplecticity_defect() > 1e-3);
+}
+
+#[test]
+fn constrained_step_derivatives_match_central_differences() {
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let mut stepper = Stepper::hamiltonian(KNIFE, quadrature.clone(), 0.01).unwrap();
+        stepper
+            .start_from_momentum(SVector::zeros(), vector![0.0, 0.0, 1.0])
+            .unwrap();
+        stepper.run(40).unwrap();
+        let state = *stepper.state().unwrap();
+        let name = format!("knife edge, {}", quadrature.name());
+        against_central_differences(
+            &name,
+            |u| hamilton(KNIFE, &quadrature, 0.01, u),
+            *state.q(),
+            *state.p(),
+            None,
+        );
+        // The stepper's own linearised step is the step it would take.
+        let mut twin = stepper.clone();
+        let a = stepper.step_linearised().unwrap();
+        twin.step().unwrap();
+        assert_eq!(stepper.q(), twin.q());
+        assert!(a.matrix().amax().is_finite());
+    }
+}

@@ -57,6 +57,7 @@
 //! ```
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+use num_dual::Dual64;
 
 use crate::configuration_space::compensated_add;
 use crate::constraint_point::ConstraintPoint;
@@ -67,6 +68,7 @@ use crate::lu;
 use crate::manifold::Vectors;
 use crate::newton::{Newton, NewtonFailure};
 use crate::quadrature::{Quadrature, Rule};
+use crate::step_derivatives::StepDerivatives;
 use crate::step_equations::{State, StepEquations};
 
 /// Where a step holds the constraint one-forms: the point `Q_c = Σ_j position_j Q_j`, the
@@ -242,6 +244,159 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         (f, fq, fp)
     }
 
+    /// The step's rows at `x` into `rows`, their Jacobian added into `jacobian` when one is
+    /// given, the scale of their terms and the impulse `p_{k+1} − p_k`. The rows are those of
+    /// `Q_0 … Q_{s−1}` (`p_k` in the first), the velocity rows of the nodes and the one-forms'
+    /// rows; `extended` appends the rows `T_s` of `Q_s` (so that `p_{k+1} = T_s` at the
+    /// solution) and one column per coordinate of `q_k` (which moves every point of the path
+    /// with weight 1 and no velocity).
+    fn rows(
+        &self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        rows: &mut DVector<f64>,
+        mut jacobian: Option<&mut DMatrix<f64>>,
+        extended: bool,
+    ) -> (f64, SVector<f64, N>) {
+        let (s, h, n) = (self.degree(), self.h, self.unknowns());
+        // Row of point j (j = s only when extended) and column of point l (l = 0: q_k).
+        let row_of = |j: usize| if j < s { j * N } else { n };
+        let column_of = |l: usize| if l == 0 { n } else { self.point(l) };
+        let last = if extended { s } else { s - 1 };
+        let first = if extended { 0 } else { 1 };
+        // q_k enters every point of the path with weight 1 and no velocity.
+        let moved = |weights: &[f64], l: usize| if l == 0 { 1.0 } else { weights[l] };
+        let rate = |weights: &[f64], l: usize| if l == 0 { 0.0 } else { weights[l] };
+        let hamiltonian = Hamiltonian(&self.system);
+        rows.fill(0.0);
+        let mut row = rows.fixed_rows_mut::<N>(0);
+        row += state.p;
+        let mut impulse = SVector::<f64, N>::zeros();
+        let mut scale = state.p.amax();
+        let identity = SMatrix::<f64, N, N>::identity();
+        for i in 0..self.nodes() {
+            let (c, b) = (self.quadrature.nodes()[i], self.quadrature.weights()[i]);
+            let position: Vec<f64> = (0..=s).map(|j| self.quadrature.ell(i, j)).collect();
+            let velocity: Vec<f64> = (0..=s).map(|j| self.quadrature.ell_prime(i, j)).collect();
+            let q = state.q + self.combination(x, &position);
+            let v = self.combination(x, &velocity) / h;
+            let column = self.node_momentum(i);
+            let p = x.fixed_rows::<N>(column).into_owned();
+            let t = state.t + c * h;
+            let second = jacobian
+                .is_some()
+                .then(|| derivatives::hessian(&hamiltonian, &q, &p));
+            let (h_q, h_p) = match &second {
+                Some(second) => (second.gradient.q, second.gradient.v),
+                None => derivatives::gradients(&hamiltonian, &q, &p),
+            };
+            let (f, f_q, f_p) = self.force(&q, &p, t, jacobian.is_some());
+            let generalised = f - h_q;
+            for j in 0..=last {
+                let mut target = rows.fixed_rows_mut::<N>(row_of(j));
+                target += p * (b * velocity[j]) + generalised * (h * b * position[j]);
+            }
+            impulse += generalised * (h * b);
+            rows.fixed_rows_mut::<N>(column).copy_from(&(v - h_p));
+            scale = scale
+                .max(p.amax())
+                .max(h * h_q.amax())
+                .max(h * f.amax())
+                .max(v.amax())
+                .max(h_p.amax());
+            let (Some(jacobian), Some(second)) = (jacobian.as_deref_mut(), &second) else {
+                continue;
+            };
+            let force_q = f_q - second.qq;
+            let force_p = f_p - second.qv;
+            for j in 0..=last {
+                for l in first..=s {
+                    let weight = h * b * position[j] * moved(&position, l);
+                    let mut block = jacobian.fixed_view_mut::<N, N>(row_of(j), column_of(l));
+                    block += force_q * weight;
+                }
+                let mut block = jacobian.fixed_view_mut::<N, N>(row_of(j), column);
+                block += identity * (b * velocity[j]) + force_p * (h * b * position[j]);
+            }
+            for l in first..=s {
+                let mut block = jacobian.fixed_view_mut::<N, N>(column, column_of(l));
+                block += identity * (rate(&velocity, l) / h)
+                    - second.qv.transpose() * moved(&position, l);
+            }
+            let mut block = jacobian.fixed_view_mut::<N, N>(column, column);
+            block -= second.vv;
+        }
+        for (k, site) in self.sites.iter().enumerate() {
+            let q = state.q + self.combination(x, &site.position);
+            let v = self.combination(x, &site.rate) / h;
+            let total: f64 = site.weight.iter().sum();
+            for a in 0..S::ONE_FORMS {
+                let column = self.multiplier(k, a);
+                let mu = x[column];
+                let (form, differential) = match jacobian.is_some() {
+                    true => derivatives::jacobian(&q, |q| self.system.one_form(q, a)),
+                    false => (self.system.one_form(&q, a), SMatrix::zeros()),
+                };
+                for j in 0..=last {
+                    let mut target = rows.fixed_rows_mut::<N>(row_of(j));
+                    target += form * (site.weight[j] * mu);
+                }
+                impulse += form * (total * mu);
+                rows[column] = form.dot(&v);
+                scale = scale.max(total.abs() * (form * mu).amax());
+                let Some(jacobian) = jacobian.as_deref_mut() else {
+                    continue;
+                };
+                // d(A(q)·v)/dq = Σ_r v_r ∂A_r/∂q.
+                let along = differential.transpose() * v;
+                for l in first..=s {
+                    let weight = moved(&site.position, l);
+                    for j in 0..=last {
+                        let mut block = jacobian.fixed_view_mut::<N, N>(row_of(j), column_of(l));
+                        block += differential * (site.weight[j] * weight * mu);
+                    }
+                    let mut target = jacobian.fixed_view_mut::<1, N>(column, column_of(l));
+                    target += (form * (rate(&site.rate, l) / h) + along * weight).transpose();
+                }
+                for j in 0..=last {
+                    let mut entries = jacobian.fixed_view_mut::<N, 1>(row_of(j), column);
+                    entries += form * site.weight[j];
+                }
+            }
+        }
+        (scale.max(f64::MIN_POSITIVE), impulse)
+    }
+
+    /// `∂T_j/∂u` for the rows `j = 0..=s` of the step solved by `x` (the inputs enter through
+    /// the forces), `(n + N) × inputs` in the rows' order of [`rows`](Self::rows) extended.
+    fn input_rows(&self, state: &State<N>, x: &DVector<f64>) -> DMatrix<f64> {
+        let (s, h, n) = (self.degree(), self.h, self.unknowns());
+        let inputs = self.inputs.len();
+        let mut rows = DMatrix::zeros(n + N, inputs);
+        if !S::FORCES {
+            return rows;
+        }
+        for i in 0..self.nodes() {
+            let (c, b) = (self.quadrature.nodes()[i], self.quadrature.weights()[i]);
+            let position: Vec<f64> = (0..=s).map(|j| self.quadrature.ell(i, j)).collect();
+            let q = (state.q + self.combination(x, &position)).map(Dual64::from);
+            let p = x.fixed_rows::<N>(self.node_momentum(i)).map(Dual64::from);
+            for m in 0..inputs {
+                let seeded: Vec<Dual64> = (0..inputs)
+                    .map(|k| Dual64::new(self.inputs[k], if k == m { 1.0 } else { 0.0 }))
+                    .collect();
+                let f = self.system.force(&q, &p, state.t + c * h, &seeded);
+                for (j, &weight) in position.iter().enumerate() {
+                    let row = if j < s { j * N } else { n };
+                    for r in 0..N {
+                        rows[(row + r, m)] += f[r].eps * (h * b * weight);
+                    }
+                }
+            }
+        }
+        rows
+    }
+
     /// The worst `|A_a(Q_c) Q̇_c|` over the sites of the step solved by `x`.
     fn violation(&self, state: &State<N>, x: &DVector<f64>) -> f64 {
         let mut worst: f64 = 0.0;
@@ -388,105 +543,11 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         state: &State<N>,
         x: &DVector<f64>,
         residual: &mut DVector<f64>,
-        mut jacobian: Option<&mut DMatrix<f64>>,
+        jacobian: Option<&mut DMatrix<f64>>,
     ) -> f64 {
-        let (s, h) = (self.degree(), self.h);
-        let hamiltonian = Hamiltonian(&self.system);
-        residual.fill(0.0);
-        let mut rows = residual.fixed_rows_mut::<N>(0);
-        rows += state.p;
-        let mut impulse = SVector::<f64, N>::zeros();
-        let mut scale = state.p.amax();
-        let identity = SMatrix::<f64, N, N>::identity();
-        for i in 0..self.nodes() {
-            let (c, b) = (self.quadrature.nodes()[i], self.quadrature.weights()[i]);
-            let ell = |j: usize| self.quadrature.ell(i, j);
-            let ell_prime = |j: usize| self.quadrature.ell_prime(i, j);
-            let position: Vec<f64> = (0..=s).map(ell).collect();
-            let rate: Vec<f64> = (0..=s).map(ell_prime).collect();
-            let q = state.q + self.combination(x, &position);
-            let v = self.combination(x, &rate) / h;
-            let column = self.node_momentum(i);
-            let p = x.fixed_rows::<N>(column).into_owned();
-            let t = state.t + c * h;
-            let second = jacobian
-                .is_some()
-                .then(|| derivatives::hessian(&hamiltonian, &q, &p));
-            let (h_q, h_p) = match &second {
-                Some(second) => (second.gradient.q, second.gradient.v),
-                None => derivatives::gradients(&hamiltonian, &q, &p),
-            };
-            let (f, f_q, f_p) = self.force(&q, &p, t, jacobian.is_some());
-            let generalised = f - h_q;
-            for j in 0..s {
-                let mut row = residual.fixed_rows_mut::<N>(j * N);
-                row += p * (b * ell_prime(j)) + generalised * (h * b * ell(j));
-            }
-            impulse += generalised * (h * b);
-            residual.fixed_rows_mut::<N>(column).copy_from(&(v - h_p));
-            scale = scale
-                .max(p.amax())
-                .max(h * h_q.amax())
-                .max(h * f.amax())
-                .max(v.amax())
-                .max(h_p.amax());
-            if let (Some(jacobian), Some(second)) = (jacobian.as_deref_mut(), &second) {
-                let force_q = f_q - second.qq;
-                let force_p = f_p - second.qv;
-                for j in 0..s {
-                    for l in 1..=s {
-                        let mut block = jacobian.fixed_view_mut::<N, N>(j * N, self.point(l));
-                        block += force_q * (h * b * ell(j) * ell(l));
-                    }
-                    let mut block = jacobian.fixed_view_mut::<N, N>(j * N, column);
-                    block += identity * (b * ell_prime(j)) + force_p * (h * b * ell(j));
-                }
-                for l in 1..=s {
-                    let mut block = jacobian.fixed_view_mut::<N, N>(column, self.point(l));
-                    block += identity * (ell_prime(l) / h) - second.qv.transpose() * ell(l);
-                }
-                let mut block = jacobian.fixed_view_mut::<N, N>(column, column);
-                block -= second.vv;
-            }
-        }
-        for (k, site) in self.sites.iter().enumerate() {
-            let q = state.q + self.combination(x, &site.position);
-            let v = self.combination(x, &site.rate) / h;
-            let total: f64 = site.weight.iter().sum();
-            for a in 0..S::ONE_FORMS {
-                let column = self.multiplier(k, a);
-                let mu = x[column];
-                let (form, differential) = match jacobian.is_some() {
-                    true => derivatives::jacobian(&q, |q| self.system.one_form(q, a)),
-                    false => (self.system.one_form(&q, a), SMatrix::zeros()),
-                };
-                for j in 0..s {
-                    let mut row = residual.fixed_rows_mut::<N>(j * N);
-                    row += form * (site.weight[j] * mu);
-                }
-                impulse += form * (total * mu);
-                residual[column] = form.dot(&v);
-                scale = scale.max(total.abs() * (form * mu).amax());
-                if let Some(jacobian) = jacobian.as_deref_mut() {
-                    // d(A(q)·v)/dq = Σ_r v_r ∂A_r/∂q.
-                    let along = differential.transpose() * v;
-                    for l in 1..=s {
-                        for j in 0..s {
-                            let mut block = jacobian.fixed_view_mut::<N, N>(j * N, self.point(l));
-                            block += differential * (site.weight[j] * site.position[l] * mu);
-                        }
-                        let mut row = jacobian.fixed_view_mut::<1, N>(column, self.point(l));
-                        row += (form * (site.rate[l] / h) + along * site.position[l]).transpose();
-                    }
-                    for j in 0..s {
-                        let mut entries = jacobian.fixed_view_mut::<N, 1>(j * N, column);
-                        entries += form * site.weight[j];
-                    }
-                }
-            }
-        }
+        let (scale, impulse) = self.rows(state, x, residual, jacobian, false);
         self.impulse = impulse;
-        scale.max(f64::MIN_POSITIVE)
+        scale
     }
 
     /// A Jacobian takes three hyper-dual passes of `H` per node (about `(N + 1)²` numbers per
@@ -527,6 +588,64 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         }
         next.velocity = self.velocity_at(&next.q, &next.p);
         Ok((next, self.violation(state, x)))
+    }
+
+    /// By the implicit function theorem on the rows `R(x; q_k, p_k, u) = 0` with Newton's
+    /// factorised `J = ∂R/∂x`: `∂x/∂z = −J⁻¹ ∂R/∂z` for `z = (q_k, p_k, u)`, where `q_k` moves
+    /// every point of the path with weight 1, `p_k` enters the first row, and the inputs enter
+    /// through the forces. Then `q_{k+1} = q_k + (Q_s − q_k)` and `p_{k+1} = T_s`, the row of
+    /// `Q_s`, are differentiated along.
+    fn linearise(
+        &self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        newton: &Newton,
+    ) -> Result<StepDerivatives<N>, DiracError> {
+        let (n, inputs) = (self.unknowns(), self.inputs.len());
+        let mut rows = DVector::zeros(n + N);
+        let mut jacobian = DMatrix::zeros(n + N, n + N);
+        self.rows(state, x, &mut rows, Some(&mut jacobian), true);
+        // ∂R/∂z with the end rows T_s below: columns q_k, p_k, u.
+        let mut dr = DMatrix::zeros(n + N, 2 * N + inputs);
+        dr.columns_mut(0, N).copy_from(&jacobian.columns(n, N));
+        for i in 0..N {
+            dr[(i, N + i)] = 1.0;
+        }
+        dr.columns_mut(2 * N, inputs)
+            .copy_from(&self.input_rows(state, x));
+        let mut dx = dr.rows(0, n).clone_owned();
+        for column in dx.as_mut_slice().chunks_exact_mut(n) {
+            newton.solve_factorised_in(x, column).ok_or_else(|| {
+                DiracError::Dimension(
+                    "the Newton solver does not hold the factorisation at this solution (take \
+                     the derivatives right after the solve that produced it)"
+                        .into(),
+                )
+            })?;
+            column.iter_mut().for_each(|v| *v = -*v);
+        }
+        let mut dq = dx.rows(self.point(self.degree()), N).clone_owned();
+        for i in 0..N {
+            dq[(i, i)] += 1.0;
+        }
+        let dp = dr.rows(n, N) + jacobian.view((n, 0), (N, n)) * &dx;
+        if !dq.iter().chain(dp.iter()).all(|v| v.is_finite()) {
+            return Err(DiracError::NonFinite {
+                what: "a derivative of the step map".into(),
+                value: f64::NAN,
+            });
+        }
+        let block =
+            |m: &DMatrix<f64>, c: usize| SMatrix::<f64, N, N>::from_fn(|i, j| m[(i, c + j)]);
+        Ok(StepDerivatives {
+            q_q: block(&dq, 0),
+            q_p: block(&dq, N),
+            p_q: block(&dp, 0),
+            p_p: block(&dp, N),
+            q_u: dq.columns(2 * N, inputs).clone_owned(),
+            p_u: dp.columns(2 * N, inputs).clone_owned(),
+            pivot_ratio: newton.pivot_ratio(),
+        })
     }
 
     fn first_multiplier(&self) -> usize {
