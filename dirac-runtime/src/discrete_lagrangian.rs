@@ -471,15 +471,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     }
 
     /// Every second slot derivative `∂²L_d/∂ξ_j∂ξ_m` (`j, m = 0..=s`, `ξ_0 = 0`) at the step
-    /// with points `ξ_1..ξ_s` from `base`, as blocks `[j][m]` (rows: the components of `ξ_j`).
+    /// with points `ξ_1..ξ_s` from `base`.
     pub(crate) fn slot_hessian(
         &self,
         base: &SVector<f64, N>,
         increments: &[SVector<f64, N>],
-    ) -> Vec<Vec<SMatrix<f64, N, N>>> {
+    ) -> SlotBlocks<N> {
         let (quad, h) = (&self.quadrature, self.h);
-        let s = quad.degree();
-        let mut blocks = vec![vec![SMatrix::<f64, N, N>::zeros(); s + 1]; s + 1];
+        let mut blocks = SlotBlocks::zeros(quad.degree() + 1);
         let chart = self.in_chart(base);
         for (i, &b) in quad.weights().iter().enumerate() {
             let w = h * b;
@@ -487,17 +486,50 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             let LagrangianHessian { qq, qv, vv, .. } = hessian(&chart, &xi, &xi_dot);
             let a = |j: usize| quad.ell(i, j);
             let d = |j: usize| quad.ell_prime(i, j) / h;
-            for (j, row) in blocks.iter_mut().enumerate() {
-                for (m, block) in row.iter_mut().enumerate() {
-                    *block += (qq * (a(j) * a(m))
-                        + qv * (a(j) * d(m))
-                        + qv.transpose() * (d(j) * a(m))
-                        + vv * (d(j) * d(m)))
-                        * w;
-                }
-            }
+            blocks.add(|j, m| {
+                (qq * (a(j) * a(m))
+                    + qv * (a(j) * d(m))
+                    + qv.transpose() * (d(j) * a(m))
+                    + vv * (d(j) * d(m)))
+                    * w
+            });
         }
         blocks
+    }
+}
+
+/// Blocks `G_jm` (`j, m = 0..=s`; rows: the components of point `j`) of the second derivatives
+/// of a step's discrete Lagrangian, or of its forces, in the step's points: one buffer, row by
+/// row.
+pub(crate) struct SlotBlocks<const N: usize> {
+    points: usize,
+    blocks: Vec<SMatrix<f64, N, N>>,
+}
+
+impl<const N: usize> SlotBlocks<N> {
+    /// Zero blocks for a step of `points` points.
+    pub(crate) fn zeros(points: usize) -> Self {
+        Self {
+            points,
+            blocks: vec![SMatrix::zeros(); points * points],
+        }
+    }
+
+    /// Adds `term(j, m)` to every block `G_jm`.
+    pub(crate) fn add(&mut self, mut term: impl FnMut(usize, usize) -> SMatrix<f64, N, N>) {
+        for (k, block) in self.blocks.iter_mut().enumerate() {
+            *block += term(k / self.points, k % self.points);
+        }
+    }
+
+    /// Row `j`: the blocks `G_jm`, `m = 0..=s`.
+    pub(crate) fn row(&self, j: usize) -> &[SMatrix<f64, N, N>] {
+        &self.blocks[j * self.points..(j + 1) * self.points]
+    }
+
+    /// `Σ_m G_jm`: how row `j` moves when every point moves alike (as with `q_k`).
+    pub(crate) fn row_sum(&self, j: usize) -> SMatrix<f64, N, N> {
+        self.row(j).iter().sum()
     }
 }
 

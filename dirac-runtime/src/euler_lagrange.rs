@@ -22,7 +22,7 @@ use crate::configuration_space::{ConfigurationSpace, StepCovectors};
 use crate::constraint::{self, ConstraintPoint, StepConstraints};
 use crate::dense_output::{ChartPath, Sample, chart_path};
 use crate::derivatives::{Dual, Seed, seeded};
-use crate::discrete_lagrangian::DiscreteLagrangian;
+use crate::discrete_lagrangian::{DiscreteLagrangian, SlotBlocks};
 use crate::error::DiracError;
 use crate::first_order;
 use crate::first_order_scheme::FirstOrderScheme;
@@ -33,6 +33,7 @@ use crate::layout::Layout;
 use crate::legendre;
 use crate::manifold::Vectors;
 use crate::newton::{Newton, NewtonFailure};
+use crate::quadrature::MAX_DEGREE;
 use crate::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
@@ -449,11 +450,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                     .into(),
             ));
         }
-        let Sensitivity {
-            g, dx, increments, ..
-        } = self.sensitivity(state, x, newton)?;
+        let Sensitivity { g, dx, points, .. } = self.sensitivity(state, x, newton)?;
         let layout = &self.layout;
         let s = layout.points();
+        let increments = &points[..s];
         let unit = |i: usize| SVector::<f64, N>::from_fn(|r, _| if r == i { 1.0 } else { 0.0 });
         // dQ_m/dz_a for every point m = 0..=s.
         let moves: Vec<Vec<SVector<f64, N>>> = (0..2 * N)
@@ -480,13 +480,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         for a in 0..2 * N {
             for b in a..2 * N {
                 let third = |m: usize, r: usize| {
-                    discrete.slot_third(&state.q, &increments, [&nudge(m, r), &moves[a], &moves[b]])
+                    discrete.slot_third(&state.q, increments, [&nudge(m, r), &moves[a], &moves[b]])
                 };
                 // The forces' second derivatives along the same displacements (f_0..f_s).
                 let forces = if S::FORCES {
                     discrete.force_second_derivatives(
                         &state.q,
-                        &increments,
+                        increments,
                         state.t,
                         &self.inputs,
                         [&moves[a], &moves[b]],
@@ -504,7 +504,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                     .ok_or_else(stale_factorisation)?;
                 column.neg_mut();
                 let mut end = SVector::<f64, N>::from_fn(|r, _| third(s, r)) + forces[s];
-                for (m, g_sm) in g[s].iter().enumerate().skip(1) {
+                for (m, g_sm) in g.row(s).iter().enumerate().skip(1) {
                     end += g_sm * column.fixed_rows::<N>(layout.point(m));
                 }
                 for r in 0..N {
@@ -550,23 +550,24 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let system = discrete.system();
         let layout = &self.layout;
         let s = layout.points();
-        let increments: Vec<SVector<f64, N>> = (1..=s)
-            .map(|j| x.fixed_rows::<N>(layout.point(j)).into_owned())
-            .collect();
-        let mut g = discrete.slot_hessian(&state.q, &increments);
-        if S::FORCES {
-            let forces =
-                discrete.force_slot_derivatives(&state.q, &increments, state.t, &self.inputs);
-            for (row, force_row) in g.iter_mut().zip(forces) {
-                for (block, force) in row.iter_mut().zip(force_row) {
-                    *block += force;
-                }
-            }
+        let mut points = [SVector::<f64, N>::zeros(); MAX_DEGREE];
+        for (j, point) in points.iter_mut().take(s).enumerate() {
+            point.copy_from(&x.fixed_rows::<N>(layout.point(j + 1)));
         }
-        let moving_all: Vec<SMatrix<f64, N, N>> = g.iter().map(|row| row.iter().sum()).collect();
+        let increments = &points[..s];
+        let mut g = discrete.slot_hessian(&state.q, increments);
+        if S::FORCES {
+            discrete.add_force_slot_derivatives(
+                &state.q,
+                increments,
+                state.t,
+                &self.inputs,
+                &mut g,
+            );
+        }
         let inputs = self.inputs.len();
         let force_u = if S::FORCES && inputs > 0 {
-            discrete.force_input_derivatives(&state.q, &increments, state.t, &self.inputs)
+            discrete.force_input_derivatives(&state.q, increments, state.t, &self.inputs)
         } else {
             Vec::new()
         };
@@ -592,8 +593,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let n = layout.len();
         let parameters = 2 * N + inputs;
         let mut dr = DMatrix::zeros(n, parameters);
-        for (j, total) in moving_all.iter().take(s).enumerate() {
-            let mut block = total.clone_owned();
+        for j in 0..s {
+            let mut block = g.row_sum(j);
             if j == 0 {
                 block += turning * share + curvature;
             }
@@ -627,9 +628,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         }
         Ok(Sensitivity {
             g,
-            moving_all,
             dx,
-            increments,
+            points,
             force_u,
             end_rows: one_forms
                 .iter()
@@ -1217,7 +1217,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     ) -> Result<StepDerivatives<N>, DiracError> {
         let Sensitivity {
             g,
-            moving_all,
             dx,
             force_u,
             end_rows,
@@ -1235,15 +1234,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         }
         let layout = &self.layout;
         let s = layout.points();
-        let parameters = 2 * N + inputs;
-        // q_{k+1} = q_k + ξ_s.
-        let mut dq = dx.rows(layout.end_point(), N).clone_owned();
-        for i in 0..N {
-            dq[(i, i)] += 1.0;
-        }
-        if self.hidden().count() > 0 {
-            // The end point is projected along Z onto c = 0: dq ← (I − Z (dc Z)⁻¹ dc) dq, exact
-            // where dc and Z are (constant forms, degenerate rows without velocities).
+        // The end point is projected along Z onto c = 0: dq ← (I − Z (dc Z)⁻¹ dc) dq, exact where
+        // dc and Z are (constant forms, degenerate rows without velocities).
+        let projection = if self.hidden().count() > 0 {
             if !self.hidden().is_fixed() {
                 return Err(DiracError::Unsupported(
                     "derivatives of the step map through the projection onto hidden constraints \
@@ -1271,63 +1264,100 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                         .into(),
                 )
             })?;
-            let correction = free * reduced * &e.differential * &dq;
-            dq -= correction;
+            let projector = free * reduced * &e.differential;
+            Some(SMatrix::<f64, N, N>::from_fn(|i, j| projector[(i, j)]))
+        } else {
+            None
+        };
+        // p_{k+1} = ∂L_d/∂ξ_s + f_s + (1 − σ) A(q_c)ᵀμ moves with q_k at fixed points by
+        // `Σ_m G_sm` and the end impulse's turning, and with point m by `G_sm` (q_c moves with
+        // the end point by θ).
+        let end_moving = g.row_sum(s) + end_turning;
+        let mut end_blocks = [SMatrix::<f64, N, N>::zeros(); MAX_DEGREE];
+        for (m, block) in end_blocks.iter_mut().take(s).enumerate() {
+            *block = g.row(s)[m + 1];
         }
-        // p_{k+1} = ∂L_d/∂ξ_s + f_s + (1 − σ) A(q_c)ᵀμ.
-        let mut dp = DMatrix::zeros(N, parameters);
-        dp.view_mut((0, 0), (N, N))
-            .copy_from(&(moving_all[s] + end_turning));
-        if let Some(force) = force_u.get(s) {
-            dp.view_mut((0, 2 * N), (N, inputs)).copy_from(force);
-        }
-        for (m, g_sm) in g[s].iter().enumerate().skip(1) {
-            // q_c moves with the end point by θ.
-            let block = if m == s {
-                g_sm + end_turning * theta
-            } else {
-                *g_sm
-            };
-            // Column by column: fixed-size products, no allocation.
-            let row = layout.point(m);
-            for c in 0..parameters {
-                let moved = block * dx.fixed_view::<N, 1>(row, c);
-                let mut target = dp.fixed_view_mut::<N, 1>(0, c);
-                target += moved;
+        end_blocks[s - 1] += end_turning * theta;
+        let mut derivatives = StepDerivatives::<N> {
+            q_q: SMatrix::zeros(),
+            q_p: SMatrix::zeros(),
+            p_q: SMatrix::zeros(),
+            p_p: SMatrix::zeros(),
+            q_u: DMatrix::zeros(N, inputs),
+            p_u: DMatrix::zeros(N, inputs),
+            pivot_ratio: newton.pivot_ratio(),
+        };
+        // Column by column (q_k, p_k, u): fixed-size products, no allocation.
+        for c in 0..2 * N + inputs {
+            // q_{k+1} = q_k + ξ_s.
+            let mut dq = dx.fixed_view::<N, 1>(layout.end_point(), c).into_owned();
+            let mut dp = SVector::<f64, N>::zeros();
+            if c < N {
+                dq[c] += 1.0;
+                dp += end_moving.column(c);
+            } else if c >= 2 * N
+                && let Some(force) = force_u.get(s)
+            {
+                dp += force.column(c - 2 * N);
+            }
+            if let Some(projector) = &projection {
+                dq -= projector * dq;
+            }
+            for (m, block) in end_blocks.iter().take(s).enumerate() {
+                dp += block * dx.fixed_view::<N, 1>(layout.point(m + 1), c);
+            }
+            for (a, row) in end_rows.iter().enumerate() {
+                dp += row * dx[(layout.one_form(a), c)];
+            }
+            let d = &mut derivatives;
+            match c {
+                c if c < N => {
+                    d.q_q.set_column(c, &dq);
+                    d.p_q.set_column(c, &dp);
+                }
+                c if c < 2 * N => {
+                    d.q_p.set_column(c - N, &dq);
+                    d.p_p.set_column(c - N, &dp);
+                }
+                c => {
+                    d.q_u.set_column(c - 2 * N, &dq);
+                    d.p_u.set_column(c - 2 * N, &dp);
+                }
             }
         }
-        for (a, row) in end_rows.iter().enumerate() {
-            dp += row * dx.row(layout.one_form(a));
-        }
-        if !(dq.iter().chain(dp.iter()).all(|v| v.is_finite())) {
+        let finite = |m: &SMatrix<f64, N, N>| m.iter().all(|v| v.is_finite());
+        if ![
+            derivatives.q_q,
+            derivatives.q_p,
+            derivatives.p_q,
+            derivatives.p_p,
+        ]
+        .iter()
+        .all(finite)
+            || !derivatives
+                .q_u
+                .iter()
+                .chain(derivatives.p_u.iter())
+                .all(|v| v.is_finite())
+        {
             return Err(DiracError::NonFinite {
                 what: "a derivative of the step map".into(),
                 value: f64::NAN,
             });
         }
-        let block = |m: &DMatrix<f64>, c: usize| -> SMatrix<f64, N, N> {
-            SMatrix::from_fn(|i, j| m[(i, c + j)])
-        };
-        Ok(StepDerivatives {
-            q_q: block(&dq, 0),
-            q_p: block(&dq, N),
-            p_q: block(&dp, 0),
-            p_p: block(&dp, N),
-            q_u: dq.columns(2 * N, inputs).clone_owned(),
-            p_u: dp.columns(2 * N, inputs).clone_owned(),
-            pivot_ratio: newton.pivot_ratio(),
-        })
+        Ok(derivatives)
     }
 }
 
 /// What [`EulerLagrange::linearise`](StepEquations::linearise) and the second derivatives share:
-/// the slot Hessian `G_jm` (forces included), its row sums (`q_k` moves every point), the
-/// unknowns' derivatives `dx` (columns `q_k`, `p_k`, `u`), and the end point's constraint terms.
+/// the slot Hessian `G_jm` (forces included; its row sums are how `q_k`, moving every point,
+/// moves each row), the step's points, the unknowns' derivatives `dx` (columns `q_k`, `p_k`,
+/// `u`), and the end point's constraint terms.
 struct Sensitivity<const N: usize> {
-    g: Vec<Vec<SMatrix<f64, N, N>>>,
-    moving_all: Vec<SMatrix<f64, N, N>>,
+    g: SlotBlocks<N>,
     dx: DMatrix<f64>,
-    increments: Vec<SVector<f64, N>>,
+    /// The step's points `ξ_1..ξ_s` (first `s` entries).
+    points: [SVector<f64, N>; MAX_DEGREE],
     force_u: Vec<DMatrix<f64>>,
     /// `(1 − σ) A_a(q_c)`: the end point's share of each one-form impulse direction.
     end_rows: Vec<SVector<f64, N>>,

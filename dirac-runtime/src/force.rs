@@ -10,7 +10,7 @@ use crate::manifold::Vectors;
 use num_dual::{Dual64, HyperDual64};
 
 use crate::derivatives::{Dual, lift};
-use crate::discrete_lagrangian::DiscreteLagrangian;
+use crate::discrete_lagrangian::{DiscreteLagrangian, SlotBlocks};
 use crate::system::DiracSystem;
 
 impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
@@ -71,19 +71,19 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
     DiscreteLagrangian<S, N, C>
 {
-    /// The forces' slot derivatives `∂f_j/∂ξ_m` (`j, m = 0..=s`, `ξ_0 = 0`) as blocks `[j][m]`:
+    /// Adds the forces' slot derivatives `∂f_j/∂ξ_m` (`j, m = 0..=s`, `ξ_0 = 0`) to `blocks`:
     /// `h Σ_i b_i ℓ_j(c_i) (∂_q F ℓ_m(c_i) + ∂_v F ℓ'_m(c_i)/h)` at the nodes, on a translation
     /// chart (`Rⁿ`).
-    pub(crate) fn force_slot_derivatives(
+    pub(crate) fn add_force_slot_derivatives(
         &self,
         base: &SVector<f64, N>,
         increments: &[SVector<f64, N>],
         t: f64,
         inputs: &[f64],
-    ) -> Vec<Vec<SMatrix<f64, N, N>>> {
+        blocks: &mut SlotBlocks<N>,
+    ) {
         let quad = self.quadrature();
-        let (h, s) = (self.h(), quad.degree());
-        let mut blocks = vec![vec![SMatrix::<f64, N, N>::zeros(); s + 1]; s + 1];
+        let h = self.h();
         let inputs: Vec<Dual<N>> = inputs.iter().map(|&u| Dual::from(u)).collect();
         let inputs = &inputs[..];
         let jacobian = |f: SVector<Dual<N>, N>| {
@@ -104,14 +104,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                     self.system()
                         .force(&lift(&q, 0.0), &lift(&xi_dot, 1.0), time, inputs),
                 );
-            for (j, row) in blocks.iter_mut().enumerate() {
-                for (m, block) in row.iter_mut().enumerate() {
-                    *block += (f_q * quad.ell(i, m) + f_v * (quad.ell_prime(i, m) / h))
-                        * (w * quad.ell(i, j));
-                }
-            }
+            blocks.add(|j, m| {
+                (f_q * quad.ell(i, m) + f_v * (quad.ell_prime(i, m) / h)) * (w * quad.ell(i, j))
+            });
         }
-        blocks
     }
 
     /// The forces' derivatives in the inputs, `∂f_j/∂u` (`j = 0..=s`, `N × inputs` each):

@@ -68,22 +68,26 @@ fn null_vector_support(lu: &DMatrix<f64>, k: usize) -> Vec<usize> {
 /// Solves `A x = b` in place of `b` with the factors from [`factorise`].
 pub(crate) fn solve(lu: &DMatrix<f64>, pivots: &[usize], b: &mut [f64]) {
     let n = lu.nrows();
-    for (k, &p) in pivots.iter().enumerate().take(n) {
+    // Column-major factors read through one slice: the bounds are checked once, here.
+    let a = lu.as_slice();
+    let (b, pivots) = (&mut b[..n], &pivots[..n]);
+    assert_eq!(a.len(), n * n, "a square factorisation");
+    for (k, &p) in pivots.iter().enumerate() {
         b.swap(k, p);
     }
-    for i in 0..n {
-        let mut s = b[i];
-        for j in 0..i {
-            s -= lu[(i, j)] * b[j];
+    // L y = P b, column by column: the same order of subtractions as row by row.
+    for j in 0..n {
+        let (y, column) = (b[j], &a[j * n..(j + 1) * n]);
+        for i in j + 1..n {
+            b[i] -= column[i] * y;
         }
-        b[i] = s;
     }
     for i in (0..n).rev() {
         let mut s = b[i];
         for j in i + 1..n {
-            s -= lu[(i, j)] * b[j];
+            s -= a[i + j * n] * b[j];
         }
-        b[i] = s / lu[(i, i)];
+        b[i] = s / a[i + i * n];
     }
 }
 

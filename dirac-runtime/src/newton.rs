@@ -286,8 +286,10 @@ impl Newton {
         if !self.at_root {
             return f64::INFINITY;
         }
-        let pivots = self.jacobian.diagonal().map(f64::abs);
-        pivots.max() / pivots.min()
+        let (largest, smallest) = (0..self.jacobian.nrows())
+            .map(|i| self.jacobian[(i, i)].abs())
+            .fold((0.0_f64, f64::INFINITY), |(l, s), u| (l.max(u), s.min(u)));
+        largest / smallest
     }
 
     /// The number of unknowns the solver is sized for.
