@@ -397,14 +397,15 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         rows
     }
 
-    /// The worst `|A_a(Q_c) Q̇_c|` over the sites of the step solved by `x`.
+    /// The worst `|A_a(Q_c) Q̇_c h|` over the sites of the step solved by `x`: a displacement,
+    /// as the Lagrangian route reports it.
     fn violation(&self, state: &State<N>, x: &DVector<f64>) -> f64 {
         let mut worst: f64 = 0.0;
         for site in &self.sites {
             let q = state.q + self.combination(x, &site.position);
-            let v = self.combination(x, &site.rate) / self.h;
+            let displacement = self.combination(x, &site.rate);
             for a in 0..S::ONE_FORMS {
-                worst = worst.max(self.system.one_form(&q, a).dot(&v).abs());
+                worst = worst.max(self.system.one_form(&q, a).dot(&displacement).abs());
             }
         }
         worst
