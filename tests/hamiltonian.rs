@@ -425,6 +425,119 @@ fn forces_of_the_position_momentum_time_and_input_act_as_on_the_lagrangian_route
     }
 }
 
+/// The Cartesian pendulum written with `H`: a point mass on a rod, `g = x² + y² − l²`.
+#[dirac_system(
+    coordinates(x, y),
+    hamiltonian = 0.5 * (p(x).powi(2) + p(y).powi(2)) / m + m * g * y,
+    holonomic(x * x + y * y - l * l),
+)]
+#[derive(Debug, Clone, Copy)]
+struct CartesianPendulumH {
+    m: f64,
+    l: f64,
+    g: f64,
+}
+
+const ROD: CartesianPendulumH = CartesianPendulumH {
+    m: 1.0,
+    l: 1.0,
+    g: 1.0,
+};
+
+#[test]
+fn a_holonomic_constraint_is_held_and_the_lagrangian_routes_steps_are_taken() {
+    use scenes::cartesian_pendulum::{SCENE, angle, q0};
+    let rules = [
+        Quadrature::midpoint(),
+        Quadrature::trapezoid(),
+        Quadrature::galerkin(2).unwrap(),
+        Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3)).unwrap(),
+    ];
+    for quadrature in rules {
+        let h = 0.05;
+        let mut a = Stepper::hamiltonian(ROD, quadrature.clone(), h).unwrap();
+        let mut b = Stepper::new(SCENE, quadrature.clone(), h).unwrap();
+        a.start_from_momentum(q0(1.0), SVector::zeros()).unwrap();
+        b.start_from_momentum(q0(1.0), SVector::zeros()).unwrap();
+        let (mut worst, mut violation) = (0.0_f64, 0.0_f64);
+        for _ in 0..400 {
+            a.step().unwrap();
+            b.step().unwrap();
+            let q = a.q();
+            violation = violation.max((q[0] * q[0] + q[1] * q[1] - 1.0).abs());
+            assert!(a.constraint_violation() <= 1e-12);
+            worst = worst
+                .max((a.q() - b.q()).amax())
+                .max((a.p() - b.p()).amax());
+        }
+        println!(
+            "Cartesian pendulum (H), {}: routes differ by {worst:.1e}, |g| ≤ {violation:.1e}",
+            quadrature.name()
+        );
+        assert!(violation < 1e-13, "{}: {violation}", quadrature.name());
+        assert!(worst < 1e-11, "{}: {worst}", quadrature.name());
+    }
+    // The order against the pendulum's q(5) (the DESIGN scene): 2 and 4.
+    for (quadrature, order) in [
+        (Quadrature::midpoint(), 2.0),
+        (Quadrature::galerkin(2).unwrap(), 4.0),
+    ] {
+        let t = 5.0;
+        let hs = steps_for(order, t);
+        let errors: Vec<f64> = hs
+            .iter()
+            .map(|&h| {
+                let mut a = Stepper::hamiltonian(ROD, quadrature.clone(), h).unwrap();
+                a.start_from_momentum(q0(1.0), SVector::zeros()).unwrap();
+                for _ in 0..(t / h).round() as usize {
+                    a.step().unwrap();
+                }
+                (angle(&a.q()) - scenes::pendulum::Q5).abs()
+            })
+            .collect();
+        assert_order(
+            &format!("Cartesian pendulum (H), {}", quadrature.name()),
+            &hs,
+            &errors,
+            order,
+        );
+    }
+    // Degree 3 holds the constraint at order 4 only: refused, as on the Lagrangian route.
+    assert!(matches!(
+        Stepper::hamiltonian(ROD, Quadrature::galerkin(3).unwrap(), 0.05),
+        Err(DiracError::InvalidQuadrature(_))
+    ));
+    // A start off the rod, or moving across it, is refused and starts nothing.
+    let mut stepper = Stepper::hamiltonian(ROD, Quadrature::midpoint(), 0.05).unwrap();
+    for (q, p) in [
+        (vector![1.1, 0.0], SVector::zeros()),
+        (vector![1.0, 0.0], vector![0.3, 0.0]),
+    ] {
+        let error = stepper.start_from_momentum(q, p).unwrap_err();
+        assert!(
+            matches!(error, DiracError::InconsistentInitialState(_)),
+            "{error}"
+        );
+        assert!(stepper.state().is_none());
+    }
+}
+
+#[test]
+fn derivatives_through_a_holonomic_constraint_match_central_differences() {
+    // From a state on the rod; the map sends every state onto g = 0, so dg(q_{k+1}) ∂q_{k+1} = 0.
+    let (q, p) = (vector![0.6, -0.8], vector![0.4, 0.3]);
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let name = format!("Cartesian pendulum (H), {}", quadrature.name());
+        let a =
+            against_central_differences(&name, |u| hamilton(ROD, &quadrature, 0.1, u), q, p, None);
+        let (next, _, _) = raw_step(&mut hamilton(ROD, &quadrature, 0.1, 0.0), q, p);
+        let dg = vector![2.0 * next[0], 2.0 * next[1]].transpose();
+        let along = dg * a.matrix().view((0, 0), (2, 4));
+        println!("{name}: |dg ∂q_(k+1)| = {:.1e}", along.amax());
+        assert!(along.amax() < 1e-12, "{name}");
+    }
+}
+
 #[test]
 fn a_hamiltonian_without_a_lagrangian_is_stepped_at_the_gauss_order() {
     // H = p (1 − q²): ∂²H/∂p² = 0, so no Lagrangian route; the steps are Gauss collocation of

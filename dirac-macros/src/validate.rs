@@ -226,12 +226,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     let hamiltonian = e.hamiltonian.is_some();
     if hamiltonian {
         let coordinates = coordinates.as_deref().unwrap_or_default();
-        hamiltonian_route(
-            e.lagrangian.as_ref(),
-            e.holonomic.as_ref(),
-            coordinates,
-            &mut errors,
-        );
+        hamiltonian_route(e.lagrangian.as_ref(), coordinates, &mut errors);
     }
     // The rate of a coordinate: its velocity dot(x), or for a Hamiltonian its momentum p(x).
     let rate = if hamiltonian { "p" } else { "dot" };
@@ -406,13 +401,8 @@ fn runtime_path(given: Option<Expr>, errors: &mut Errors) -> syn::Path {
 }
 
 /// What the Hamiltonian route does not offer, reported on the user's tokens: both a Lagrangian
-/// and a Hamiltonian, rotations or unit vectors, holonomic constraints.
-fn hamiltonian_route(
-    lagrangian: Option<&Expr>,
-    holonomic: Option<&Vec<Expr>>,
-    coordinates: &[Coordinate],
-    errors: &mut Errors,
-) {
+/// and a Hamiltonian, rotations or unit vectors.
+fn hamiltonian_route(lagrangian: Option<&Expr>, coordinates: &[Coordinate], errors: &mut Errors) {
     if let Some(lagrangian) = lagrangian {
         let (start, end) = bounds(lagrangian);
         errors.push_range(
@@ -426,15 +416,6 @@ fn hamiltonian_route(
             c.name.span(),
             "`hamiltonian = ...` is offered on real coordinates; write a model with rotations or \
              unit vectors with `lagrangian = ...`",
-        );
-    }
-    if let Some(g) = holonomic.and_then(|g| g.first()) {
-        let (start, end) = bounds(g);
-        errors.push_range(
-            start,
-            end,
-            "holonomic constraints are not offered with `hamiltonian = ...`; write their \
-             differentials in constraints(...), or give a Lagrangian",
         );
     }
 }

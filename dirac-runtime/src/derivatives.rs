@@ -404,6 +404,14 @@ pub(crate) fn holonomic_hessian<S: DiracSystem<N>, const N: usize>(
     q: &SVector<f64, N>,
     b: usize,
 ) -> SMatrix<f64, N, N> {
+    scalar_hessian(q, |q| system.holonomic(q, b)).2
+}
+
+/// A scalar function of `q` with its gradient and Hessian at `q`, by one hyper-dual pass.
+pub(crate) fn scalar_hessian<const N: usize>(
+    q: &SVector<f64, N>,
+    f: impl Fn(&SVector<HyperDualSVec64<N, N>, N>) -> HyperDualSVec64<N, N>,
+) -> (f64, SVector<f64, N>, SMatrix<f64, N, N>) {
     type H<const N: usize> = HyperDualSVec64<N, N>;
     let lifted = SVector::<H<N>, N>::from_fn(|c, _| {
         let eps1 = SVector::<f64, N>::from_fn(|i, _| if i == c { 1.0 } else { 0.0 });
@@ -415,10 +423,12 @@ pub(crate) fn holonomic_hessian<S: DiracSystem<N>, const N: usize>(
             Derivative::none(),
         )
     });
-    system
-        .holonomic(&lifted, b)
-        .eps1eps2
-        .unwrap_generic(Const::<N>, Const::<N>)
+    let g = f(&lifted);
+    (
+        g.re,
+        g.eps1.unwrap_generic(Const::<N>, U1),
+        g.eps1eps2.unwrap_generic(Const::<N>, Const::<N>),
+    )
 }
 
 /// `D³L(q, v)` along three directions `(δq, δv)`, by hyper-hyper-dual numbers.

@@ -127,14 +127,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 quadrature.name()
             )));
         }
-        if S::HOLONOMIC > 0 && quadrature.degree() > 2 {
-            return Err(DiracError::InvalidQuadrature(format!(
-                "{}: with holonomic constraints held at the path's points the step is of order 4 \
-                 for every degree above 1 (measured on the Cartesian pendulum, 3.99 for degree 3 \
-                 with Gauss or Lobatto rules), not 2s; use degree 2 (order 4)",
-                quadrature.name()
-            )));
-        }
+        constraint::check_holonomic_degree(S::HOLONOMIC, quadrature)?;
         let s = quadrature.degree();
         let point = discrete.system().constraint_point();
         Ok(Self {

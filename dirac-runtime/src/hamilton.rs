@@ -1,5 +1,5 @@
 //! The discrete Hamiltonian route: the discrete Hamilton's equations of a Galerkin discrete
-//! Hamiltonian, with constraint one-forms and forces.
+//! Hamiltonian, with constraint one-forms, holonomic constraints and forces.
 //!
 //! The type II generating function `H_d⁺(q_k, p_{k+1}) = ext [p_{k+1} q_{k+1} − 𝕃]` of the
 //! phase-space action over one step, with the path `Q(τ) = Σ_j ℓ_j(τ) Q_j` of degree `s`
@@ -27,7 +27,11 @@
 //! `Q̇_c = (q_{k+1} − q_k)/h` and the impulse shared `w = (σ, 1 − σ)`, see
 //! [`ConstraintPoint`]; a Galerkin step at its Gauss nodes, with the force `A(Q(c_i))ᵀμ_i`
 //! weighted as a force, `w_j = h b_i ℓ_j(c_i)`): the issue's implicit discrete Hamiltonian
-//! system `p_k − D₁H_d⁺ ∈ Δ°`, `(q_k, q_{k+1}) ∈ Δ_d`.
+//! system `p_k − D₁H_d⁺ ∈ Δ°`, `(q_k, q_{k+1}) ∈ Δ_d`. Holonomic constraints `g_b(q) = 0` are
+//! held at the path's points `Q_1..Q_s` (degree 2 at most, as on the Lagrangian route): the
+//! rows `g_b(Q_j) = 0`, with the impulse `dg_b(Q_j)ᵀλ_j` in the row of an internal point and
+//! `dg_b(q_k)ᵀλ_s` in the row of `q_k` (SHAKE: `q_{k+1}` on the constraint, `p_{k+1}` not
+//! projected onto its tangent space).
 //!
 //! **When the two routes agree.** Where `∂²H/∂p²` is invertible, the stationarity in `P_i`
 //! is the Legendre transform at the node, and `P_i Q̇_i − H(Q_i, P_i) = L(Q_i, Q̇_i)`: `𝕃`
@@ -133,6 +137,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
             });
         }
         let sites = Self::sites(&system, &quadrature, h)?;
+        crate::constraint::check_holonomic_degree(S::HOLONOMIC, &quadrature)?;
         Ok(Self {
             system,
             quadrature,
@@ -209,6 +214,12 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
     /// Column of the multiplier of one-form `a` at site `k`.
     fn multiplier(&self, k: usize, a: usize) -> usize {
         (self.degree() + self.nodes()) * N + k * S::ONE_FORMS + a
+    }
+
+    /// Column of the multiplier `λ` of holonomic constraint `b` held at point `j` (`1..=s`):
+    /// the internal points' first, the end point's last (as on the Lagrangian route).
+    fn holonomic_multiplier(&self, j: usize, b: usize) -> usize {
+        self.first_multiplier() + self.sites.len() * S::ONE_FORMS + (j - 1) * S::HOLONOMIC + b
     }
 
     /// `Σ_{j≥1} weights_j ξ_j` over the step's increments in `x`.
@@ -364,6 +375,50 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
                 }
             }
         }
+        // Holonomic constraints g_b(Q_j) = 0 at the path's points j = 1..=s: the impulse
+        // dg_b(Q_j)ᵀλ acts on the row of Q_j at an internal point and, for the end point, on the
+        // row of q_k at q_k (SHAKE), as on the Lagrangian route.
+        for j in 1..=s {
+            let point = state.q + x.fixed_rows::<N>(self.point(j));
+            let (row, at) = if j < s { (j * N, point) } else { (0, state.q) };
+            for b in 0..S::HOLONOMIC {
+                let column = self.holonomic_multiplier(j, b);
+                let lambda = x[column];
+                let g = |q: &SVector<f64, N>| {
+                    derivatives::scalar_hessian(q, |q| self.system.holonomic(q, b))
+                };
+                let (value, form, _) = g(&point);
+                let (_, direction, curvature) = g(&at);
+                let mut target = rows.fixed_rows_mut::<N>(row);
+                target += direction * lambda;
+                impulse += direction * lambda;
+                rows[column] = value;
+                scale = scale
+                    .max((direction * lambda).amax())
+                    .max(form.abs().dot(&point.abs()));
+                let Some(jacobian) = jacobian.as_deref_mut() else {
+                    continue;
+                };
+                let mut entries = jacobian.fixed_view_mut::<N, 1>(row, column);
+                entries += direction;
+                // g_b(Q_j) moves with Q_j and, in the extended rows, with q_k.
+                let mut entries = jacobian.fixed_view_mut::<1, N>(column, self.point(j));
+                entries += form.transpose();
+                if extended {
+                    let mut entries = jacobian.fixed_view_mut::<1, N>(column, n);
+                    entries += form.transpose();
+                }
+                // The impulse turns with the point it acts at: Q_j (internal), or q_k.
+                if j < s {
+                    let mut block = jacobian.fixed_view_mut::<N, N>(row, self.point(j));
+                    block += curvature * lambda;
+                }
+                if extended {
+                    let mut block = jacobian.fixed_view_mut::<N, N>(row, n);
+                    block += curvature * lambda;
+                }
+            }
+        }
         (scale.max(f64::MIN_POSITIVE), impulse)
     }
 
@@ -397,8 +452,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         rows
     }
 
-    /// The worst `|A_a(Q_c) Q̇_c h|` over the sites of the step solved by `x`: a displacement,
-    /// as the Lagrangian route reports it.
+    /// The worst `|A_a(Q_c) Q̇_c h|` over the sites of the step solved by `x` (a displacement,
+    /// as the Lagrangian route reports it) and `|g_b(Q_j)|` over the path's points.
     fn violation(&self, state: &State<N>, x: &DVector<f64>) -> f64 {
         let mut worst: f64 = 0.0;
         for site in &self.sites {
@@ -406,6 +461,12 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
             let displacement = self.combination(x, &site.rate);
             for a in 0..S::ONE_FORMS {
                 worst = worst.max(self.system.one_form(&q, a).dot(&displacement).abs());
+            }
+        }
+        for j in 1..=self.degree() {
+            let point = state.q + x.fixed_rows::<N>(self.point(j));
+            for b in 0..S::HOLONOMIC {
+                worst = worst.max(self.system.holonomic(&point, b).abs());
             }
         }
         worst
@@ -463,7 +524,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
     }
 
     fn multipliers(&self) -> usize {
-        self.sites.len() * S::ONE_FORMS
+        self.sites.len() * S::ONE_FORMS + self.degree() * S::HOLONOMIC
     }
 
     fn multiplier_names(&self) -> Vec<String> {
@@ -475,6 +536,12 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
                     true => format!("mu_{a}_node_{}", k + 1),
                 })
             })
+            .chain(
+                (1..self.degree()).flat_map(|j| {
+                    (0..S::HOLONOMIC).map(move |b| format!("lambda_{b}_internal_{j}"))
+                }),
+            )
+            .chain((0..S::HOLONOMIC).map(|b| format!("lambda_{b}")))
             .collect()
     }
 
@@ -482,8 +549,9 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         self.system.coordinate_name(i)
     }
 
-    /// The position, the momentum and `H` finite, and the velocity `∂H/∂p` allowed by the
-    /// one-forms to the relative `tolerance`.
+    /// The position, the momentum and `H` finite, the position on the holonomic constraints,
+    /// and the velocity `∂H/∂p` tangent to them and allowed by the one-forms, to the relative
+    /// `tolerance`.
     fn check_start(&self, state: &State<N>, tolerance: f64) -> Result<(), DiracError> {
         finite("initial position", &state.q)?;
         finite("initial momentum", &state.p)?;
@@ -506,6 +574,22 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
                 self.nodes(),
                 self.degree()
             )));
+        }
+        for b in 0..S::HOLONOMIC {
+            let (g, form, _) =
+                derivatives::scalar_hessian(&state.q, |q| self.system.holonomic(q, b));
+            if g.abs() > tolerance * form.abs().dot(&state.q.abs()).max(f64::MIN_POSITIVE) {
+                return Err(DiracError::InconsistentInitialState(format!(
+                    "the initial position violates holonomic constraint {b}: g = {g:.3e}"
+                )));
+            }
+            let rate = form.dot(&v);
+            if rate.abs() > tolerance * form.abs().dot(&v.abs()).max(f64::MIN_POSITIVE) {
+                return Err(DiracError::InconsistentInitialState(format!(
+                    "holonomic constraint {b} at the initial state: dg(q) ∂H/∂p = {rate:.3e} (the \
+                     momentum must give a velocity tangent to the constraint)"
+                )));
+            }
         }
         for a in 0..S::ONE_FORMS {
             let form = self.system.one_form(&state.q, a);
@@ -664,6 +748,16 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
                 name(column),
                 block - s + 1
             ),
+            _ if column >= self.holonomic_multiplier(1, 0) => {
+                let c = column - self.holonomic_multiplier(1, 0);
+                let (j, b) = (c / S::HOLONOMIC.max(1) + 1, c % S::HOLONOMIC.max(1));
+                match j == s {
+                    true => format!("the multiplier of holonomic constraint {b}"),
+                    false => {
+                        format!("the multiplier of holonomic constraint {b} at internal point {j}")
+                    }
+                }
+            }
             _ => {
                 let c = column - self.first_multiplier();
                 let (k, a) = (c / S::ONE_FORMS.max(1), c % S::ONE_FORMS.max(1));

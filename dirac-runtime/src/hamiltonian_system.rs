@@ -41,6 +41,8 @@ use crate::scalar::Scalar;
 pub trait HamiltonianSystem<const N: usize> {
     /// Number of constraint one-forms `w^a(q)` (rows of `A(q)`).
     const ONE_FORMS: usize = 0;
+    /// Number of holonomic constraints `g_b(q) = 0`.
+    const HOLONOMIC: usize = 0;
     /// Whether [`force`](Self::force) is nonzero.
     const FORCES: bool = false;
     /// Number of named inputs the forces read.
@@ -54,6 +56,12 @@ pub trait HamiltonianSystem<const N: usize> {
     fn one_form<D: Scalar>(&self, q: &SVector<D, N>, a: usize) -> SVector<D, N> {
         let _ = (q, a);
         SVector::from_element(D::zero())
+    }
+
+    /// Holonomic constraint `b` (`0 <= b < HOLONOMIC`): the function `g_b(q)` held at zero.
+    fn holonomic<D: Scalar>(&self, q: &SVector<D, N>, b: usize) -> D {
+        let _ = (q, b);
+        D::zero()
     }
 
     /// The force one-form `F(q, p, t, u)`, with the inputs' current values in `inputs` (of the
