@@ -520,19 +520,78 @@ fn a_holonomic_constraint_is_held_and_the_lagrangian_routes_steps_are_taken() {
         Stepper::hamiltonian(ROD, Quadrature::galerkin(3).unwrap(), 0.05),
         Err(DiracError::InvalidQuadrature(_))
     ));
-    // A start off the rod, or moving across it, is refused and starts nothing.
+    // A start off the rod is refused, and a running stepper keeps its state.
     let mut stepper = Stepper::hamiltonian(ROD, Quadrature::midpoint(), 0.05).unwrap();
-    for (q, p) in [
-        (vector![1.1, 0.0], SVector::zeros()),
-        (vector![1.0, 0.0], vector![0.3, 0.0]),
-    ] {
-        let error = stepper.start_from_momentum(q, p).unwrap_err();
-        assert!(
-            matches!(error, DiracError::InconsistentInitialState(_)),
-            "{error}"
+    stepper
+        .start_from_momentum(q0(1.0), SVector::zeros())
+        .unwrap();
+    stepper.run(3).unwrap();
+    let before = *stepper.state().unwrap();
+    let error = stepper
+        .start_from_momentum(vector![1.1, 0.0], SVector::zeros())
+        .unwrap_err();
+    assert!(
+        matches!(error, DiracError::InconsistentInitialState(_)),
+        "{error}"
+    );
+    assert_eq!(stepper.state().unwrap().q(), before.q());
+    assert_eq!(stepper.state().unwrap().p(), before.p());
+}
+
+#[test]
+fn a_constrained_hamiltonian_state_reads_its_velocity_and_energy_tangent_to_the_constraint() {
+    use scenes::cartesian_pendulum::{SCENE, q0};
+    // SHAKE leaves p_{k+1} an O(h) part normal to the rod; the velocity and the energy are
+    // read at the momentum's tangent part, as the Lagrangian route reads them.
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let mut a = Stepper::hamiltonian(ROD, quadrature.clone(), 0.05).unwrap();
+        let mut b = Stepper::new(SCENE, quadrature.clone(), 0.05).unwrap();
+        a.start_from_momentum(q0(1.0), SVector::zeros()).unwrap();
+        b.start_from_momentum(q0(1.0), SVector::zeros()).unwrap();
+        let (ta, tb) = (a.run(400).unwrap(), b.run(400).unwrap());
+        let normal = ta
+            .q()
+            .iter()
+            .zip(ta.p())
+            .map(|(q, p)| q.dot(p).abs())
+            .fold(0.0, f64::max);
+        let gap = |x: &[f64], y: &[f64]| {
+            x.iter()
+                .zip(y)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max)
+        };
+        let energy = gap(ta.energy(), tb.energy());
+        let velocity = ta
+            .v()
+            .iter()
+            .zip(tb.v())
+            .map(|(x, y)| (x - y).amax())
+            .fold(0.0, f64::max);
+        println!(
+            "{}: normal momentum up to {normal:.1e}; energies differ by {energy:.1e}, velocities \
+             by {velocity:.1e}; energy error {:.1e}",
+            quadrature.name(),
+            ta.max_energy_error()
         );
-        assert!(stepper.state().is_none());
+        assert!(normal > 1e-3, "SHAKE's momentum has a normal part");
+        assert!(energy < 1e-12 && velocity < 1e-12, "{energy}, {velocity}");
+        // A restart from the stepper's own state continues the run.
+        let mut restart = Stepper::hamiltonian(ROD, quadrature.clone(), 0.05).unwrap();
+        restart.start_from_state(*a.state().unwrap()).unwrap();
+        a.run(50).unwrap();
+        restart.run(50).unwrap();
+        assert!((a.q() - restart.q()).amax() < 1e-12);
     }
+    // A momentum across the rod moves nothing: the start from it is the start from rest.
+    let start = |p: SVector<f64, 2>| {
+        let mut a = Stepper::hamiltonian(ROD, Quadrature::midpoint(), 0.05).unwrap();
+        a.start_from_momentum(vector![1.0, 0.0], p).unwrap();
+        a.run(20).unwrap()
+    };
+    let (across, rest) = (start(vector![0.3, 0.0]), start(SVector::zeros()));
+    assert!((across.q()[20] - rest.q()[20]).amax() < 1e-14);
+    assert!((across.energy()[0] - rest.energy()[0]).abs() < 1e-14);
 }
 
 #[test]
@@ -548,6 +607,30 @@ fn derivatives_through_a_holonomic_constraint_match_central_differences() {
         let along = dg * a.matrix().view((0, 0), (2, 4));
         println!("{name}: |dg ∂q_(k+1)| = {:.1e}", along.amax());
         assert!(along.amax() < 1e-12, "{name}");
+    }
+}
+
+#[test]
+fn the_angle_of_a_pendulum_does_not_depend_on_its_mass_from_1e_minus_12_to_1e13() {
+    // H = p²/(2 m l²) − m g l cos θ: θ(t) does not depend on m, p scales with it. The velocity
+    // rows (entries ~1/h, ∂²H/∂p² = 1/m) and the momentum rows (~h m g) of one Jacobian are in
+    // different units; a pivot test against the largest entry refused m ≥ 1e10. (At 1e14
+    // galerkin(2) is still refused: its momentum rows mix `b ℓ' ∼ 1` with `h m g`.)
+    let run = |m: f64, quadrature: &Quadrature| {
+        let model = scenes::hamiltonian::Pendulum { m, ..PENDULUM };
+        end(model, quadrature, 0.05, 100, vector![1.0], vector![0.3 * m])
+    };
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let (q1, p1) = run(1.0, &quadrature);
+        for m in [1e-12, 1e-6, 1e6, 1e10, 1e12, 1e13] {
+            let (q, p) = run(m, &quadrature);
+            let (dq, dp) = ((q[0] - q1[0]).abs(), (p[0] / m - p1[0]).abs());
+            println!(
+                "m = {m:e}, {}: |Δθ| = {dq:.1e}, |Δp/m| = {dp:.1e}",
+                quadrature.name()
+            );
+            assert!(dq < 1e-11 && dp < 1e-11, "m = {m:e}: {dq:e}, {dp:e}");
+        }
     }
 }
 

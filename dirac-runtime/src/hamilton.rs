@@ -472,14 +472,59 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         worst
     }
 
-    /// `∂H/∂p` at `(q, p)`.
+    /// `∂H/∂p` at `(q, p̃)`, with `p̃` the [`tangent_momentum`](Self::tangent_momentum).
     fn velocity_at(&self, q: &SVector<f64, N>, p: &SVector<f64, N>) -> SVector<f64, N> {
         derivatives::directional_gradient(
             &Hamiltonian(&self.system),
             q,
-            p,
+            &self.tangent_momentum(q, p),
             derivatives::Seed::VELOCITY,
         )
+    }
+
+    /// `p̃ = p + dg(q)ᵀν` with `dg(q) ∂H/∂p(q, p̃) = 0`: the momentum whose velocity is tangent
+    /// to the holonomic constraints (`p` itself without them). The step holds `g` as SHAKE
+    /// does, so `p_{k+1}` keeps a normal part of order `h` that the next step's multipliers
+    /// absorb: the state's velocity and energy are read at `p̃`, as the Lagrangian route reads
+    /// them at the velocity its constrained Legendre transform gives. By Newton's method on `ν`
+    /// (one step where `H` is quadratic in `p`); `p` where that does not converge.
+    fn tangent_momentum(&self, q: &SVector<f64, N>, p: &SVector<f64, N>) -> SVector<f64, N> {
+        if S::HOLONOMIC == 0 {
+            return *p;
+        }
+        let forms: Vec<SVector<f64, N>> = (0..S::HOLONOMIC)
+            .map(|b| derivatives::scalar_hessian(q, |q| self.system.holonomic(q, b)).1)
+            .collect();
+        let hamiltonian = Hamiltonian(&self.system);
+        let mut tangent = *p;
+        for _ in 0..20 {
+            let second = derivatives::hessian(&hamiltonian, q, &tangent);
+            let rates = DVector::from_fn(S::HOLONOMIC, |b, _| forms[b].dot(&second.gradient.v));
+            let scale = forms
+                .iter()
+                .map(|f| f.abs().dot(&second.gradient.v.abs()))
+                .fold(f64::MIN_POSITIVE, f64::max);
+            if rates.amax() <= 4.0 * f64::EPSILON * scale {
+                return tangent;
+            }
+            let matrix = DMatrix::from_fn(S::HOLONOMIC, S::HOLONOMIC, |b, c| {
+                forms[b].dot(&(second.vv * forms[c]))
+            });
+            let Some(nu) = matrix.lu().solve(&rates) else {
+                return *p;
+            };
+            let correction: SVector<f64, N> =
+                forms.iter().zip(nu.iter()).map(|(f, nu)| f * *nu).sum();
+            tangent -= correction;
+            if correction.amax() <= 4.0 * f64::EPSILON * tangent.amax() {
+                return tangent;
+            }
+        }
+        if tangent.iter().all(|v| v.is_finite()) {
+            tangent
+        } else {
+            *p
+        }
     }
 }
 
@@ -487,7 +532,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
 fn singular<const N: usize>(matrix: &SMatrix<f64, N, N>) -> bool {
     let mut lu = DMatrix::from_fn(N, N, |r, c| matrix[(r, c)]);
     let mut pivots = vec![0; N];
-    matrix.amax() == 0.0 || lu::factorise(&mut lu, &mut pivots, 1e-13).is_err()
+    matrix.amax() == 0.0 || lu::factorise(&mut lu, &mut pivots, &mut [0.0; N], 1e-13).is_err()
 }
 
 /// Fails naming `what` where a component of `x` is not finite.
@@ -575,6 +620,9 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
                 self.degree()
             )));
         }
+        // The velocity of the momentum's part tangent to the holonomic constraints (its normal
+        // part is the next step's multipliers' to absorb, see `tangent_momentum`).
+        let v = self.velocity_at(&state.q, &state.p);
         for b in 0..S::HOLONOMIC {
             let (g, form, _) =
                 derivatives::scalar_hessian(&state.q, |q| self.system.holonomic(q, b));
@@ -586,8 +634,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
             let rate = form.dot(&v);
             if rate.abs() > tolerance * form.abs().dot(&v.abs()).max(f64::MIN_POSITIVE) {
                 return Err(DiracError::InconsistentInitialState(format!(
-                    "holonomic constraint {b} at the initial state: dg(q) ∂H/∂p = {rate:.3e} (the \
-                     momentum must give a velocity tangent to the constraint)"
+                    "holonomic constraint {b} at the initial state: no momentum p + dg(q)ᵀν \
+                     gives a velocity ∂H/∂p tangent to it (dg(q) ∂H/∂p = {rate:.3e})"
                 )));
             }
         }
@@ -772,7 +820,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         }
     }
 
-    /// `∂H/∂p(q, p)`: explicit, no solve.
+    /// `∂H/∂p(q, p)`: explicit, no solve (with holonomic constraints, at the tangent momentum).
     fn velocity(
         &self,
         _newton: &mut Newton,
@@ -807,7 +855,9 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
             let second = derivatives::hessian(&hamiltonian, q, &p);
             let mut matrix = DMatrix::from_fn(N, N, |r, c| second.vv[(r, c)]);
             let mut pivots = vec![0; N];
-            if second.vv.amax() == 0.0 || lu::factorise(&mut matrix, &mut pivots, 1e-13).is_err() {
+            if second.vv.amax() == 0.0
+                || lu::factorise(&mut matrix, &mut pivots, &mut [0.0; N], 1e-13).is_err()
+            {
                 return Err(singular_map());
             }
             let mut step = second.gradient.v - v;
@@ -829,8 +879,10 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         ))
     }
 
+    /// `H(q, p̃)` at the momentum's part `p̃ = p + dg(q)ᵀν` tangent to the holonomic constraints
+    /// (`dg ∂H/∂p(q, p̃) = 0`; `H(q, p)` without them).
     fn energy(&self, q: &SVector<f64, N>, p: &SVector<f64, N>, _v: &SVector<f64, N>) -> f64 {
-        self.system.hamiltonian(q, p)
+        self.system.hamiltonian(q, &self.tangent_momentum(q, p))
     }
 
     fn inputs(&self) -> &[f64] {

@@ -14,15 +14,21 @@ pub struct SingularPivot {
 }
 
 /// Factorises `a` in place (`P a = L U`, unit lower `L` below the diagonal) and records the row
-/// permutation in `pivots`. A pivot at or below `tolerance · max|a|` counts as zero.
+/// permutation in `pivots`. A pivot at or below `tolerance` times the largest entry of its own
+/// row of `a` counts as zero: rows in different units (a velocity row beside a momentum row of a
+/// heavy body) do not make a regular pivot look singular, and a row that elimination cancels
+/// still does. `scales` (`n` entries) is scratch.
 pub(crate) fn factorise(
     a: &mut DMatrix<f64>,
     pivots: &mut [usize],
+    scales: &mut [f64],
     tolerance: f64,
 ) -> Result<(), SingularPivot> {
     let n = a.nrows();
-    let scale = a.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    let threshold = tolerance * scale;
+    let scales = &mut scales[..n];
+    for (i, scale) in scales.iter_mut().enumerate() {
+        *scale = a.row(i).iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    }
     for k in 0..n {
         let (mut p, mut best) = (k, a[(k, k)].abs());
         for i in k + 1..n {
@@ -31,7 +37,7 @@ pub(crate) fn factorise(
             }
         }
         pivots[k] = p;
-        if best <= threshold || !best.is_finite() {
+        if best <= tolerance * scales[p] || !best.is_finite() {
             return Err(SingularPivot {
                 column: k,
                 involved: null_vector_support(a, k),
@@ -39,6 +45,7 @@ pub(crate) fn factorise(
         }
         if p != k {
             a.swap_rows(k, p);
+            scales.swap(k, p);
         }
         let pivot = a[(k, k)];
         for i in k + 1..n {
@@ -103,7 +110,7 @@ mod tests {
         let mut b = &a * &x;
         let mut lu = a.clone();
         let mut pivots = [0; 3];
-        factorise(&mut lu, &mut pivots, 1e-14).unwrap();
+        factorise(&mut lu, &mut pivots, &mut [0.0; 3], 1e-14).unwrap();
         solve(&lu, &pivots, b.as_mut_slice());
         assert!((b - x).amax() < 1e-14);
     }
@@ -112,7 +119,7 @@ mod tests {
     fn reports_the_column_of_a_singular_matrix() {
         let mut a = DMatrix::from_row_slice(3, 3, &[1.0, 2.0, 3.0, 2.0, 4.0, 6.0, 1.0, 0.0, 1.0]);
         let mut pivots = [0; 3];
-        let err = factorise(&mut a, &mut pivots, 1e-14).unwrap_err();
+        let err = factorise(&mut a, &mut pivots, &mut [0.0; 3], 1e-14).unwrap_err();
         assert_eq!(err.column, 2);
         // The columns are dependent: col0 + col1 − col2 = 0.
         assert_eq!(err.involved, vec![0, 1, 2]);

@@ -50,7 +50,8 @@ pub struct NewtonOptions {
     /// up, at least 1. A point is accepted where its correction is at round-off, so a nonlinear
     /// solve takes three or more (Newton's method: two with the Jacobian, the last without).
     pub max_iterations: usize,
-    /// A pivot below this fraction of the largest Jacobian entry counts as zero, in `[0, 1)`.
+    /// A pivot below this fraction of the largest entry of its row of the Jacobian counts as
+    /// zero, in `[0, 1)`.
     pub singular_tolerance: f64,
     /// Largest accepted ratio of successive updates: positive; `f64::INFINITY` turns the
     /// root-acceptance check off.
@@ -192,6 +193,8 @@ pub struct Newton {
     residual: DVector<f64>,
     jacobian: DMatrix<f64>,
     pivots: Vec<usize>,
+    /// The rows' scales while the Jacobian is factorised (scratch).
+    row_scales: Vec<f64>,
     /// The Newton update `J⁻¹ F`, kept apart from the residual for the line search.
     update: DVector<f64>,
     /// The trial point of the line search.
@@ -248,6 +251,7 @@ impl Newton {
             residual: DVector::zeros(n),
             jacobian: DMatrix::zeros(n, n),
             pivots: vec![0; n],
+            row_scales: vec![0.0; n],
             update: DVector::zeros(n),
             trial: DVector::zeros(n),
             root: DVector::zeros(n),
@@ -351,6 +355,7 @@ impl Newton {
             lu::factorise(
                 &mut self.jacobian,
                 &mut self.pivots,
+                &mut self.row_scales,
                 self.options.singular_tolerance,
             )
             .map_err(NewtonFailure::Singular)?;
