@@ -26,8 +26,12 @@ pub(crate) fn factorise(
 ) -> Result<(), SingularPivot> {
     let n = a.nrows();
     let scales = &mut scales[..n];
-    for (i, scale) in scales.iter_mut().enumerate() {
-        *scale = a.row(i).iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    scales.fill(0.0);
+    // Column by column through the column-major storage.
+    for column in a.as_slice().chunks_exact(n.max(1)) {
+        for (scale, x) in scales.iter_mut().zip(column) {
+            *scale = scale.max(x.abs());
+        }
     }
     for k in 0..n {
         let (mut p, mut best) = (k, a[(k, k)].abs());
