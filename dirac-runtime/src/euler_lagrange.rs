@@ -613,12 +613,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         }
         // ∂x/∂z = −J⁻¹ ∂R/∂z.
         let mut dx = dr;
-        for column in dx.as_mut_slice().chunks_exact_mut(n) {
-            newton
-                .solve_factorised_in(x, column)
-                .ok_or_else(stale_factorisation)?;
-            column.iter_mut().for_each(|v| *v = -*v);
-        }
+        newton
+            .implicit_derivatives(x, &mut dx)
+            .ok_or_else(stale_factorisation)?;
         Ok(Sensitivity {
             g,
             dx,
@@ -1362,7 +1359,7 @@ struct Sensitivity<const N: usize> {
 
 /// The error for derivatives asked of a Newton solver that does not hold the factorisation at
 /// the solution (no solve, a failed one since, or another point).
-fn stale_factorisation() -> DiracError {
+pub(crate) fn stale_factorisation() -> DiracError {
     DiracError::Dimension(
         "the Newton solver does not hold the factorisation at this solution (take the \
          derivatives right after the solve that produced it)"

@@ -747,16 +747,9 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         dr.columns_mut(2 * N, inputs)
             .copy_from(&self.input_rows(state, x));
         let mut dx = dr.rows(0, n).clone_owned();
-        for column in dx.as_mut_slice().chunks_exact_mut(n) {
-            newton.solve_factorised_in(x, column).ok_or_else(|| {
-                DiracError::Dimension(
-                    "the Newton solver does not hold the factorisation at this solution (take \
-                     the derivatives right after the solve that produced it)"
-                        .into(),
-                )
-            })?;
-            column.iter_mut().for_each(|v| *v = -*v);
-        }
+        newton
+            .implicit_derivatives(x, &mut dx)
+            .ok_or_else(crate::euler_lagrange::stale_factorisation)?;
         let mut dq = dx.rows(self.point(self.degree()), N).clone_owned();
         for i in 0..N {
             dq[(i, i)] += 1.0;

@@ -276,12 +276,29 @@ impl Newton {
     /// of the last successful [`solve`](Self::solve) (the implicit function theorem's solves
     /// reuse it); `None` otherwise (no solve yet, a failed one since, or another point).
     pub(crate) fn solve_factorised(&self, root: &DVector<f64>, b: &mut DVector<f64>) -> Option<()> {
-        self.solve_factorised_in(root, b.as_mut_slice())
+        (self.at_root && &self.root == root)
+            .then(|| lu::solve(&self.jacobian, &self.pivots, b.as_mut_slice()))
     }
 
-    /// [`solve_factorised`](Self::solve_factorised) on a slice (a column of a matrix).
-    pub(crate) fn solve_factorised_in(&self, root: &DVector<f64>, b: &mut [f64]) -> Option<()> {
-        (self.at_root && &self.root == root).then(|| lu::solve(&self.jacobian, &self.pivots, b))
+    /// The implicit function theorem's `∂x/∂z = −J⁻¹ ∂R/∂z`, in place of `∂R/∂z` (`n` rows, a
+    /// column per parameter), with the Jacobian factorised at `root` (see
+    /// [`solve_factorised`](Self::solve_factorised)); `None` where it is not held there.
+    pub(crate) fn implicit_derivatives(
+        &self,
+        root: &DVector<f64>,
+        b: &mut DMatrix<f64>,
+    ) -> Option<()> {
+        if !(self.at_root && &self.root == root) || b.nrows() != self.jacobian.nrows() {
+            return None;
+        }
+        for column in b
+            .as_mut_slice()
+            .chunks_exact_mut(self.jacobian.nrows().max(1))
+        {
+            column.iter_mut().for_each(|v| *v = -*v);
+            lu::solve(&self.jacobian, &self.pivots, column);
+        }
+        Some(())
     }
 
     /// `max |u_ii| / min |u_ii|` over the pivots of the Jacobian factorised at the last
