@@ -482,24 +482,27 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         )
     }
 
-    /// `p̃ = p + dg(q)ᵀν` with `dg(q) ∂H/∂p(q, p̃) = 0`: the momentum whose velocity is tangent
-    /// to the holonomic constraints (`p` itself without them). The step holds `g` as SHAKE
-    /// does, so `p_{k+1}` keeps a normal part of order `h` that the next step's multipliers
-    /// absorb: the state's velocity and energy are read at `p̃`, as the Lagrangian route reads
-    /// them at the velocity its constrained Legendre transform gives. By Newton's method on `ν`
-    /// (one step where `H` is quadratic in `p`); `p` where that does not converge.
+    /// `p̃ = p + C(q)ᵀν` with `C(q) ∂H/∂p(q, p̃) = 0`, `C` the rows `dg_b(q)` and `A_a(q)`: the
+    /// momentum whose velocity the constraints allow (`p` itself without constraints). The
+    /// step holds `g` as SHAKE does and puts part of the one-forms' impulse on `p_{k+1}`, so
+    /// `p_{k+1}` keeps a part of order `h` that the next step's multipliers absorb: the state's
+    /// velocity and energy are read at `p̃`, as the Lagrangian route reads them at the velocity
+    /// its constrained Legendre transform gives. By Newton's method on `ν` (one step where `H`
+    /// is quadratic in `p`); `p` where that does not converge.
     fn tangent_momentum(&self, q: &SVector<f64, N>, p: &SVector<f64, N>) -> SVector<f64, N> {
-        if S::HOLONOMIC == 0 {
+        if S::HOLONOMIC + S::ONE_FORMS == 0 {
             return *p;
         }
         let forms: Vec<SVector<f64, N>> = (0..S::HOLONOMIC)
             .map(|b| derivatives::scalar_hessian(q, |q| self.system.holonomic(q, b)).1)
+            .chain((0..S::ONE_FORMS).map(|a| self.system.one_form(q, a)))
             .collect();
         let hamiltonian = Hamiltonian(&self.system);
         let mut tangent = *p;
         for _ in 0..20 {
             let second = derivatives::hessian(&hamiltonian, q, &tangent);
-            let rates = DVector::from_fn(S::HOLONOMIC, |b, _| forms[b].dot(&second.gradient.v));
+            let count = forms.len();
+            let rates = DVector::from_fn(count, |b, _| forms[b].dot(&second.gradient.v));
             let scale = forms
                 .iter()
                 .map(|f| f.abs().dot(&second.gradient.v.abs()))
@@ -507,9 +510,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
             if rates.amax() <= 4.0 * f64::EPSILON * scale {
                 return tangent;
             }
-            let matrix = DMatrix::from_fn(S::HOLONOMIC, S::HOLONOMIC, |b, c| {
-                forms[b].dot(&(second.vv * forms[c]))
-            });
+            let matrix =
+                DMatrix::from_fn(count, count, |b, c| forms[b].dot(&(second.vv * forms[c])));
             let Some(nu) = matrix.lu().solve(&rates) else {
                 return *p;
             };
@@ -620,8 +622,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
                 self.degree()
             )));
         }
-        // The velocity of the momentum's part tangent to the holonomic constraints (its normal
-        // part is the next step's multipliers' to absorb, see `tangent_momentum`).
+        // The velocity of the momentum whose velocity the constraints allow (the rest is the
+        // next step's multipliers' to absorb, see `tangent_momentum`).
         let v = self.velocity_at(&state.q, &state.p);
         for b in 0..S::HOLONOMIC {
             let (g, form, _) =
@@ -645,8 +647,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
             let value = form.dot(&v);
             if value.abs() > tolerance * scale.max(f64::MIN_POSITIVE) && value.abs() > 0.0 {
                 return Err(DiracError::InconsistentInitialState(format!(
-                    "one-form {a} at the initial state: A(q) ∂H/∂p = {value:e} (the momentum \
-                     must give a velocity the one-forms allow)"
+                    "one-form {a} at the initial state: no momentum p + C(q)ᵀν gives a velocity \
+                     ∂H/∂p the one-forms allow (A(q) ∂H/∂p = {value:e})"
                 )));
             }
         }
@@ -813,7 +815,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         }
     }
 
-    /// `∂H/∂p(q, p)`: explicit, no solve (with holonomic constraints, at the tangent momentum).
+    /// `∂H/∂p(q, p)`: explicit, no solve (with constraints, at the momentum whose velocity they
+    /// allow).
     fn velocity(
         &self,
         _newton: &mut Newton,
@@ -872,8 +875,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         ))
     }
 
-    /// `H(q, p̃)` at the momentum's part `p̃ = p + dg(q)ᵀν` tangent to the holonomic constraints
-    /// (`dg ∂H/∂p(q, p̃) = 0`; `H(q, p)` without them).
+    /// `H(q, p̃)` at the momentum `p̃ = p + C(q)ᵀν` whose velocity the constraints allow
+    /// (`C ∂H/∂p(q, p̃) = 0`, `C` the rows `dg_b` and `A_a`; `H(q, p)` without constraints).
     fn energy(&self, q: &SVector<f64, N>, p: &SVector<f64, N>, _v: &SVector<f64, N>) -> f64 {
         self.system.hamiltonian(q, &self.tangent_momentum(q, p))
     }
