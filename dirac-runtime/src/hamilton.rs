@@ -380,15 +380,22 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         // row of q_k at q_k (SHAKE), as on the Lagrangian route.
         for j in 1..=s {
             let point = state.q + x.fixed_rows::<N>(self.point(j));
-            let (row, at) = if j < s { (j * N, point) } else { (0, state.q) };
+            let row = if j < s { j * N } else { 0 };
             for b in 0..S::HOLONOMIC {
                 let column = self.holonomic_multiplier(j, b);
                 let lambda = x[column];
                 let g = |q: &SVector<f64, N>| {
                     derivatives::scalar_hessian(q, |q| self.system.holonomic(q, b))
                 };
-                let (value, form, _) = g(&point);
-                let (_, direction, curvature) = g(&at);
+                let (value, form, at_point) = g(&point);
+                // An internal point's impulse acts where g is held; the end point's at q_k.
+                let (direction, curvature) = match j < s {
+                    true => (form, at_point),
+                    false => {
+                        let (_, direction, curvature) = g(&state.q);
+                        (direction, curvature)
+                    }
+                };
                 let mut target = rows.fixed_rows_mut::<N>(row);
                 target += direction * lambda;
                 impulse += direction * lambda;
@@ -472,12 +479,12 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         worst
     }
 
-    /// `∂H/∂p` at `(q, p̃)`, with `p̃` the [`tangent_momentum`](Self::tangent_momentum).
+    /// `∂H/∂p` at `(q, p̃)`, with `p̃` the [`allowed_momentum`](Self::allowed_momentum).
     fn velocity_at(&self, q: &SVector<f64, N>, p: &SVector<f64, N>) -> SVector<f64, N> {
         derivatives::directional_gradient(
             &Hamiltonian(&self.system),
             q,
-            &self.tangent_momentum(q, p),
+            &self.allowed_momentum(q, p),
             derivatives::Seed::VELOCITY,
         )
     }
@@ -489,7 +496,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
     /// velocity and energy are read at `p̃`, as the Lagrangian route reads them at the velocity
     /// its constrained Legendre transform gives. By Newton's method on `ν` (one step where `H`
     /// is quadratic in `p`); `p` where that does not converge.
-    fn tangent_momentum(&self, q: &SVector<f64, N>, p: &SVector<f64, N>) -> SVector<f64, N> {
+    fn allowed_momentum(&self, q: &SVector<f64, N>, p: &SVector<f64, N>) -> SVector<f64, N> {
         if S::HOLONOMIC + S::ONE_FORMS == 0 {
             return *p;
         }
@@ -498,9 +505,9 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
             .chain((0..S::ONE_FORMS).map(|a| self.system.one_form(q, a)))
             .collect();
         let hamiltonian = Hamiltonian(&self.system);
-        let mut tangent = *p;
+        let mut allowed = *p;
         for _ in 0..20 {
-            let second = derivatives::hessian(&hamiltonian, q, &tangent);
+            let second = derivatives::hessian(&hamiltonian, q, &allowed);
             let count = forms.len();
             let rates = DVector::from_fn(count, |b, _| forms[b].dot(&second.gradient.v));
             let scale = forms
@@ -508,7 +515,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
                 .map(|f| f.abs().dot(&second.gradient.v.abs()))
                 .fold(f64::MIN_POSITIVE, f64::max);
             if rates.amax() <= 4.0 * f64::EPSILON * scale {
-                return tangent;
+                return allowed;
             }
             let matrix =
                 DMatrix::from_fn(count, count, |b, c| forms[b].dot(&(second.vv * forms[c])));
@@ -517,13 +524,13 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
             };
             let correction: SVector<f64, N> =
                 forms.iter().zip(nu.iter()).map(|(f, nu)| f * *nu).sum();
-            tangent -= correction;
-            if correction.amax() <= 4.0 * f64::EPSILON * tangent.amax() {
-                return tangent;
+            allowed -= correction;
+            if correction.amax() <= 4.0 * f64::EPSILON * allowed.amax() {
+                return allowed;
             }
         }
-        if tangent.iter().all(|v| v.is_finite()) {
-            tangent
+        if allowed.iter().all(|v| v.is_finite()) {
+            allowed
         } else {
             *p
         }
@@ -623,7 +630,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
             )));
         }
         // The velocity of the momentum whose velocity the constraints allow (the rest is the
-        // next step's multipliers' to absorb, see `tangent_momentum`).
+        // next step's multipliers' to absorb, see `allowed_momentum`).
         let v = self.velocity_at(&state.q, &state.p);
         for b in 0..S::HOLONOMIC {
             let (g, form, _) =
@@ -878,7 +885,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
     /// `H(q, p̃)` at the momentum `p̃ = p + C(q)ᵀν` whose velocity the constraints allow
     /// (`C ∂H/∂p(q, p̃) = 0`, `C` the rows `dg_b` and `A_a`; `H(q, p)` without constraints).
     fn energy(&self, q: &SVector<f64, N>, p: &SVector<f64, N>, _v: &SVector<f64, N>) -> f64 {
-        self.system.hamiltonian(q, &self.tangent_momentum(q, p))
+        self.system.hamiltonian(q, &self.allowed_momentum(q, p))
     }
 
     fn inputs(&self) -> &[f64] {
