@@ -58,22 +58,23 @@ fn lc_circuit_is_second_order_keeps_kcl_and_energy() {
 #[test]
 fn rlc_circuit_golden_values_and_energy_balance() {
     let h = 0.01;
-    let mut stepper = Stepper::new(circuit::RLC, Quadrature::midpoint(), h).unwrap();
+    let rlc = circuit::rlc(circuit::LC, circuit::R).unwrap();
+    let mut stepper = Stepper::new(rlc, Quadrature::midpoint(), h).unwrap();
     stepper
-        .start_from_velocity(circuit::q0(), SVector::zeros())
+        .start_from_velocity(circuit::rlc_q0(), SVector::zeros())
         .unwrap();
     let mut worst: f64 = 0.0;
     for _ in 0..1000 {
         let (e0, q0) = (stepper.energy().unwrap(), stepper.q());
         stepper.step().unwrap();
-        let dissipated = h * circuit::RLC.r * ((stepper.q()[0] - q0[0]) / h).powi(2);
+        let dissipated = h * circuit::R * ((stepper.q()[0] - q0[0]) / h).powi(2);
         worst = worst.max((stepper.energy().unwrap() - e0 + dissipated).abs());
     }
     assert!(worst < 1e-14, "energy balance off by {worst:e}");
-    let error = (stepper.q() - SVector::from(circuit::RLC_Q10)).amax();
+    let error = (stepper.q().fixed_rows::<4>(0) - SVector::from(circuit::RLC_Q10)).amax();
     assert!(error < 1e-5, "{error:e}");
     // Measured error 1.0e-5 at h = 0.01 (second order).
-    let current = stepper.p()[0] / circuit::RLC.l;
+    let current = stepper.p()[0] / circuit::LC.l;
     assert!((current - circuit::RLC_CURRENT10).abs() < 2e-5, "{current}");
 }
 
@@ -249,20 +250,21 @@ fn driven_rlc_reaches_the_phasor_amplitude() {
         "peak {peak}, phasor {phasor}"
     );
     assert!(balance < 1e-12, "energy balance error {balance:e}");
-    let mut stepper = Stepper::new(circuit::RLC, Quadrature::midpoint(), 0.01).unwrap();
+    let rlc = circuit::rlc(circuit::LC, circuit::R).unwrap();
+    let mut stepper = Stepper::new(rlc, Quadrature::midpoint(), 0.01).unwrap();
     assert!(matches!(
-        stepper.set_input("v", 1.0),
+        stepper.set_input("u", 1.0),
         Err(DiracError::UnknownInput(_))
     ));
     assert!(matches!(
-        stepper.set_input("u", f64::NAN),
+        stepper.set_input("drive.source.u", f64::NAN),
         Err(DiracError::NonFinite { .. })
     ));
     assert!(stepper.set_inputs(&[1.0, 2.0]).is_err());
     stepper.set_inputs(&[0.5]).unwrap();
     assert_eq!(stepper.inputs(), &[0.5]);
     // A handle resolved once sets the same input; a bad value changes nothing.
-    let u = stepper.input("u").unwrap();
+    let u = stepper.input("drive.source.u").unwrap();
     assert_eq!(u.index(), 0);
     stepper.set_input_value(u, 0.25).unwrap();
     assert_eq!(stepper.inputs(), &[0.25]);
@@ -317,7 +319,7 @@ fn only_what_a_model_names_is_there() {
     let mut stepper = double_pendulum::stepper(Quadrature::midpoint(), 0.01).unwrap();
     stepper.step().unwrap();
     assert!(stepper.multipliers().is_empty());
-    assert_eq!(<circuit::RlcCircuit as DiracSystem<4>>::INPUTS, 1);
+    assert_eq!(<circuit::Rlc as DiracSystem<6>>::INPUTS, 1);
 
     let mut stepper = Stepper::new(circuit::LC, Quadrature::midpoint(), 0.1).unwrap();
     stepper

@@ -4,6 +4,7 @@
 
 #[path = "../examples/scenes/mod.rs"]
 mod scenes;
+mod support;
 
 use dirac::euler_lagrange::EulerLagrange;
 use dirac::nalgebra::{DMatrix, DVector};
@@ -342,11 +343,18 @@ fn constrained_derivatives_match_central_differences() {
     )
     .unwrap();
     constrained_case("unequal LC circuit", unequal, lc, None);
-    let mut rlc = Stepper::new(circuit::RLC, Quadrature::midpoint(), 0.05).unwrap();
+    let system = support::monolithic_rlc::MonolithicRlc {
+        l: 1.0,
+        c1: 1.0,
+        c2: 1.0,
+        c3: 1.0,
+        r: 0.5,
+    };
+    let mut rlc = Stepper::new(system, Quadrature::midpoint(), 0.05).unwrap();
     rlc.start_from_velocity(circuit::q0(), SVector::zeros())
         .unwrap();
     rlc.set_input("u", 0.4).unwrap();
-    constrained_case("RLC circuit", circuit::RLC, rlc, Some(0.4));
+    constrained_case("RLC circuit", system, rlc, Some(0.4));
 }
 
 #[test]

@@ -118,6 +118,10 @@ pub enum DiracError {
     /// message names the derivative and the point).
     #[error("{0}")]
     InconsistentDerivatives(String),
+    /// An [`Interconnection`](crate::interconnection::Interconnection) that cannot be built
+    /// (the message names the junctions or instances involved and why).
+    #[error("invalid interconnection: {0}")]
+    InvalidInterconnection(String),
     /// Writing a trajectory failed.
     #[error("could not write the trajectory: {0}")]
     Io(String),

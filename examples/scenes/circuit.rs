@@ -1,9 +1,12 @@
 //! The seed's LC circuit: an inductor in series with C2 and (C1 ∥ C3), currents constrained by
 //! Kirchhoff's current law as one-forms; the capacitor charges carry no kinetic energy.
-//! The RLC variant adds a resistor and a voltage source on the inductor branch.
+//! The RLC variant is the same circuit interconnected with a resistor and a voltage source on
+//! its inductor branch, each a component of its own (`components.rs`); the LC circuit is also
+//! built from its two subcircuits joined by KCL.
 
 use dirac::prelude::*;
 
+use super::components::{Capacitor, Inductor, Resistor, Source};
 use super::{Report, timed};
 
 /// q = (q_l, q_c1, q_c2, q_c3); L = (l/2) q̇_l² − Σ q_ci² / (2 c_i).
@@ -21,41 +24,20 @@ pub struct LcCircuit {
     pub c3: f64,
 }
 
-/// The same circuit with a resistor `r` and a voltage source `u` on the inductor branch.
-#[dirac_system(
-    coordinates(q_l, q_c1, q_c2, q_c3),
-    lagrangian = 0.5 * l * dot(q_l).powi(2)
-        - q_c1.powi(2) / (2.0 * c1) - q_c2.powi(2) / (2.0 * c2) - q_c3.powi(2) / (2.0 * c3),
-    constraints(-dq_l + dq_c2, -dq_c1 + dq_c2 - dq_c3),
-    forces((u - r * dot(q_l)) * dq_l),
-    inputs(u),
-)]
-#[derive(Debug, Clone, Copy)]
-pub struct RlcCircuit {
-    pub l: f64,
-    pub c1: f64,
-    pub c2: f64,
-    pub c3: f64,
-    pub r: f64,
-}
-
 pub const LC: LcCircuit = LcCircuit {
     l: 1.0,
     c1: 1.0,
     c2: 1.0,
     c3: 1.0,
 };
-pub const RLC: RlcCircuit = RlcCircuit {
-    l: 1.0,
-    c1: 1.0,
-    c2: 1.0,
-    c3: 1.0,
-    r: 0.5,
-};
-
 /// Charge 1 on C2, no current.
 pub fn q0() -> SVector<f64, 4> {
     vector![0.0, 0.0, 1.0, 0.0]
+}
+
+/// The RLC scene's start: charge 1 on C2, no current (the drive's coordinates at 0).
+pub fn rlc_q0() -> SVector<f64, 6> {
+    vector![0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
 }
 
 /// q(10) of the LC circuit and the inductor current there.
@@ -121,16 +103,16 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
 pub fn rlc_report(quadrature: Quadrature) -> Result<Report, DiracError> {
     let (h, t_end) = (0.01, 10.0);
     let name = quadrature.name();
-    let mut stepper = Stepper::new(RLC, quadrature, h)?;
-    stepper.start_from_velocity(q0(), SVector::zeros())?;
+    let mut stepper = Stepper::new(rlc(LC, R)?, quadrature, h)?;
+    stepper.start_from_velocity(rlc_q0(), SVector::zeros())?;
     let (trajectory, wall) = timed(&mut stepper, t_end, 1)?;
     trajectory.save_csv(format!(
         "output/rlc_circuit_{}.csv",
         super::oscillator::file_name(&name)
     ))?;
-    let error = (stepper.q() - SVector::from(RLC_Q10)).amax();
+    let error = (stepper.q().fixed_rows::<4>(0) - SVector::from(RLC_Q10)).amax();
     Ok(Report {
-        scene: "RLC circuit",
+        scene: "RLC (LC + R + source)",
         quadrature: name,
         h,
         steps: stepper.steps(),
@@ -146,15 +128,15 @@ pub fn rlc_report(quadrature: Quadrature) -> Result<Report, DiracError> {
 /// of the source and the resistor over the step).
 pub fn driven_amplitude(h: f64) -> Result<(f64, f64, f64), DiracError> {
     let omega = 2.0;
-    let c = &RLC;
+    let (c, r) = (&LC, R);
     let inverse_c = 1.0 / c.c2 + 1.0 / (c.c1 + c.c3);
     let reactance = omega * c.l - inverse_c / omega;
-    let phasor = 1.0 / (c.r * c.r + reactance * reactance).sqrt();
-    let mut stepper = Stepper::new(*c, Quadrature::midpoint(), h)?;
-    stepper.start_from_velocity(q0(), SVector::zeros())?;
+    let phasor = 1.0 / (r * r + reactance * reactance).sqrt();
+    let mut stepper = Stepper::new(rlc(*c, r)?, Quadrature::midpoint(), h)?;
+    stepper.start_from_velocity(rlc_q0(), SVector::zeros())?;
     let (mut peak, mut balance): (f64, f64) = (0.0, 0.0);
     let mut energy = stepper.energy()?;
-    let source = stepper.input("u")?;
+    let source = stepper.input("drive.source.u")?;
     for k in 0..(80.0 / h).round() as usize {
         let u = (omega * (k as f64 + 0.5) * h).sin();
         stepper.set_input_value(source, u)?;
@@ -162,7 +144,7 @@ pub fn driven_amplitude(h: f64) -> Result<(f64, f64, f64), DiracError> {
         stepper.step()?;
         let dq = stepper.q()[0] - q_l;
         let next = stepper.energy()?;
-        balance = balance.max((next - energy - (u - c.r * dq / h) * dq).abs());
+        balance = balance.max((next - energy - (u - r * dq / h) * dq).abs());
         energy = next;
         if stepper.t() > 70.0 {
             peak = peak.max((stepper.p()[0] / c.l).abs());
@@ -186,4 +168,64 @@ pub fn driven_report() -> Result<Report, DiracError> {
             "steady amplitude {peak:.6} vs phasor {phasor:.6}; energy balance to {balance:.1e}"
         ),
     })
+}
+
+/// The LC circuit's left subcircuit: the inductor in series with C2.
+pub type SeriesLoop = Interconnection<Inductor, Capacitor, 1, 1, 2, 1>;
+/// C1 and C3, joined only through the rest of the circuit.
+pub type CapacitorPair = Interconnection<Capacitor, Capacitor, 1, 1, 2, 0>;
+/// The LC circuit built from its two subcircuits joined by Kirchhoff's current law.
+pub type LcFromSubcircuits = Interconnection<SeriesLoop, CapacitorPair, 2, 2, 4, 1>;
+
+/// The circuit `c` from five components: the loop (inductor and C2 carry one current), the pair
+/// (C1, C3), and KCL at the node where C2's current splits into C1's and C3's. Coordinates:
+/// `loop.l.q, loop.c2.q, pair.c1.q, pair.c3.q` (the monolithic circuit's `q_l, q_c2, q_c1,
+/// q_c3`).
+pub fn lc_from_subcircuits(c: &LcCircuit) -> Result<LcFromSubcircuits, DiracError> {
+    let series = Interconnection::new(
+        ("l", Inductor { l: c.l }),
+        ("c2", Capacitor { c: c.c2 }),
+        [Junction::new("series").flow("l.q", 1.0).flow("c2.q", -1.0)],
+    )?;
+    let pair = Interconnection::new(
+        ("c1", Capacitor { c: c.c1 }),
+        ("c3", Capacitor { c: c.c3 }),
+        [],
+    )?;
+    Interconnection::new(
+        ("loop", series),
+        ("pair", pair),
+        [Junction::new("kcl")
+            .flow("loop.c2.q", 1.0)
+            .flow("pair.c1.q", -1.0)
+            .flow("pair.c3.q", -1.0)],
+    )
+}
+
+/// A resistor in series with a voltage source.
+pub type Drive = Interconnection<Resistor, Source, 1, 1, 2, 1>;
+/// The RLC circuit: the LC circuit with the drive on its inductor branch.
+pub type Rlc = Interconnection<LcCircuit, Drive, 4, 2, 6, 1>;
+
+/// The resistance of the RLC scene.
+pub const R: f64 = 0.5;
+
+/// The RLC circuit built as the LC circuit plus a resistor plus a source (input
+/// `drive.source.u`), the drive carrying the inductor's current. Coordinates: the LC circuit's
+/// four, then `drive.r.q` and `drive.source.q`.
+pub fn rlc(lc: LcCircuit, r: f64) -> Result<Rlc, DiracError> {
+    let drive = Interconnection::new(
+        ("r", Resistor { r }),
+        ("source", Source),
+        [Junction::new("series")
+            .flow("r.q", 1.0)
+            .flow("source.q", -1.0)],
+    )?;
+    Interconnection::new(
+        ("lc", lc),
+        ("drive", drive),
+        [Junction::new("branch")
+            .flow("lc.q_l", 1.0)
+            .flow("drive.r.q", -1.0)],
+    )
 }

@@ -6,6 +6,7 @@ pub mod cart_pole;
 pub mod cartesian_pendulum;
 pub mod chain;
 pub mod circuit;
+pub mod components;
 pub mod double_pendulum;
 pub mod ensemble;
 pub mod figures;

@@ -3,6 +3,7 @@
 
 use dirac::prelude::*;
 
+use super::components::{MassSpring, Tethered};
 use super::{Report, timed};
 
 /// L = ½m1ẋ1² + ½m2ẋ2² − ½k1x1² − ½k2(x2 − y)², w = dy − dx1.
@@ -69,4 +70,21 @@ pub fn report(quadrature: Quadrature) -> Result<Report, DiracError> {
             trajectory.max_constraint_violation()
         ),
     })
+}
+
+/// The port scene from two components: oscillator 1 (`left`, a mass on a spring to the ground)
+/// and the tethered mass (`right`, mass 2 on a spring whose far end is the port), joined by the
+/// port junction `dright.end − dleft.x`.
+pub type FromComponents = Interconnection<MassSpring, Tethered, 1, 2, 3, 1>;
+
+/// The scene `p` built from its two components; coordinates `left.x, right.x, right.end`
+/// (today's `x1, x2, y`).
+pub fn from_components(p: &Port) -> Result<FromComponents, DiracError> {
+    Interconnection::new(
+        ("left", MassSpring { m: p.m1, k: p.k1 }),
+        ("right", Tethered { m: p.m2, k: p.k2 }),
+        [Junction::new("port")
+            .flow("right.end", 1.0)
+            .flow("left.x", -1.0)],
+    )
 }

@@ -1,6 +1,8 @@
 //! Measurements shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod monolithic_rlc;
+
 /// Least-squares slope of ln(error) against ln(h): the measured order of convergence.
 pub fn slope(hs: &[f64], errors: &[f64]) -> f64 {
     let x: Vec<f64> = hs.iter().map(|h| h.ln()).collect();

@@ -1,0 +1,554 @@
+//! Interconnection: two models written separately, joined through ports into one model.
+//!
+//! Two Lagrange–Dirac systems `(Q₁, L₁, Δ₁)` and `(Q₂, L₂, Δ₂)` interconnect to the system on
+//! `Q₁ × Q₂` with
+//!
+//! ```text
+//! L(q₁, q₂, v₁, v₂) = L₁(q₁, v₁) + L₂(q₂, v₂),      Δ = (Δ₁ × Δ₂) ∩ Δ_int,
+//! ```
+//!
+//! where `Δ_int` is cut out by the *junctions*: constant one-forms `Σ_i c_i dq_i` over both
+//! models' coordinates (Kirchhoff's current law at a node, a shared velocity at a joint, a port
+//! equating two flows). Forces, inputs and holonomic constraints are the components' own. The
+//! result is a [`DiracSystem`] like any other: it steps with every quadrature, and it can itself
+//! be a component of a larger interconnection (a hierarchy).
+//!
+//! **Ports.** On a step the junction `j` carries the impulse `μ_j` (its multiplier, a
+//! [`Stepper::multipliers`](crate::Stepper::multipliers) entry); its effort is `e_j = μ_j / h`.
+//! The work done on component `A` over the step is `W_A = Σ_j e_j ⟨c_j^A, q_{k+1}^A − q_k^A⟩`
+//! (its rows' part on `A`'s coordinates), and likewise for `B`. Since the step holds every
+//! junction, `Σ_j c_j (q_{k+1} − q_k) = 0`, Tellegen's theorem holds step by step:
+//! `W_A + W_B = Σ_j e_j c_j (q_{k+1} − q_k) = 0`. With the midpoint rule (its impulse split
+//! `σ = ½`) and components whose Lagrangians are quadratic, each component's energy then changes
+//! over the step by exactly its port work plus its own forces' work: `E_A(k+1) − E_A(k) = W_A`
+//! for a conservative component (`tests/interconnection.rs` checks both to round-off).
+//!
+//! ```
+//! use dirac_runtime::interconnection::{Interconnection, Junction};
+//! use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+//! use nalgebra::{SVector, vector};
+//!
+//! /// A mass on a spring to the ground, L = ½ m ẋ² − ½ k x².
+//! struct MassSpring { m: f64, k: f64 }
+//! impl DiracSystem<1> for MassSpring {
+//!     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+//!         v[0] * v[0] * (0.5 * self.m) - q[0] * q[0] * (0.5 * self.k)
+//!     }
+//!     fn coordinate_name(&self, _i: usize) -> String { "x".into() }
+//! }
+//!
+//! // Two masses glued together: one mass 2 on springs 1 + 1, ω = 1.
+//! let glued = Interconnection::new(
+//!     ("left", MassSpring { m: 1.0, k: 1.0 }),
+//!     ("right", MassSpring { m: 1.0, k: 1.0 }),
+//!     [Junction::new("glue").flow("left.x", 1.0).flow("right.x", -1.0)],
+//! )?;
+//! let mut stepper = Stepper::new(glued, Quadrature::galerkin(2)?, 0.1)?;
+//! stepper.start_from_velocity(vector![1.0, 1.0], vector![0.0, 0.0])?;
+//! stepper.run(10)?;
+//! assert!((stepper.q()[0] - 1.0_f64.cos()).abs() < 1e-7);
+//! assert!((stepper.q()[0] - stepper.q()[1]).abs() < 1e-14);
+//! # Ok::<(), dirac_runtime::DiracError>(())
+//! ```
+//!
+//! The coordinates are `A`'s then `B`'s, named `instance.coordinate`; the one-forms are `A`'s,
+//! then `B`'s, then the junctions; the holonomic constraints and the inputs are `A`'s then
+//! `B`'s. The number of coordinates `N` must be `NA + NB` (checked when the program is
+//! compiled); it and the number of junctions `C` are usually inferred from the state vectors
+//! and the junction array.
+
+use nalgebra::SVector;
+
+use crate::closed_form::{LagrangianGradient, LagrangianHessian};
+use crate::constraint_point::ConstraintPoint;
+use crate::error::DiracError;
+use crate::legendre;
+use crate::quadrature::Quadrature;
+use crate::scalar::Scalar;
+use crate::system::DiracSystem;
+
+/// One interconnection constraint: the one-form `Σ_i c_i dq_i` over the instances' coordinates,
+/// named as `instance.coordinate`, held at zero (`Σ_i c_i q̇_i = 0`).
+///
+/// ```
+/// use dirac_runtime::interconnection::Junction;
+/// // Kirchhoff's current law at a node: what flows in through C2 leaves through C1 and C3.
+/// let kcl = Junction::new("kcl")
+///     .flow("loop.q_c2", 1.0)
+///     .flow("parallel.q_c1", -1.0)
+///     .flow("parallel.q_c3", -1.0);
+/// assert_eq!(kcl.name(), "kcl");
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Junction {
+    name: String,
+    terms: Vec<(String, f64)>,
+}
+
+impl Junction {
+    /// A junction named `name` with no terms yet.
+    pub fn new(name: impl Into<String>) -> Self {
+        Self {
+            name: name.into(),
+            terms: Vec::new(),
+        }
+    }
+
+    /// Adds the term `coefficient · dq` of the coordinate named `coordinate`
+    /// (`instance.coordinate`).
+    pub fn flow(mut self, coordinate: impl Into<String>, coefficient: f64) -> Self {
+        self.terms.push((coordinate.into(), coefficient));
+        self
+    }
+
+    /// The junction's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+}
+
+/// The model made of the component `A` (on `R^NA`) and the component `B` (on `R^NB`) joined by
+/// `C` [`Junction`]s: a [`DiracSystem`] on `R^N`, `N = NA + NB` (see the
+/// [module](self) documentation for the mathematics and an example).
+#[derive(Debug, Clone)]
+pub struct Interconnection<A, B, const NA: usize, const NB: usize, const N: usize, const C: usize> {
+    instances: [String; 2],
+    a: A,
+    b: B,
+    junction_names: [String; C],
+    rows: [SVector<f64, N>; C],
+}
+
+/// What crossed the ports of an [`Interconnection`] over one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ports<const C: usize> {
+    /// The effort of each junction, `e_j = μ_j / h` (the constraint force along its one-form).
+    pub efforts: [f64; C],
+    /// The work done through the ports on `A` and on `B` over the step.
+    pub work: [f64; 2],
+    /// The size of the terms summed into the work, each an effort times a flow read from
+    /// positions (`|e_j c_ji| max(|q_k,i|, |q_{k+1},i|)`): the work's round-off floor is a few
+    /// ulps of this.
+    pub scale: f64,
+}
+
+impl<const C: usize> Ports<C> {
+    /// The net work through all ports over the step, `W_A + W_B`: zero by Tellegen's theorem
+    /// (to round-off of [`scale`](Self::scale) when the junctions hold).
+    pub fn net_work(&self) -> f64 {
+        self.work[0] + self.work[1]
+    }
+}
+
+impl<A, B, const NA: usize, const NB: usize, const N: usize, const C: usize>
+    Interconnection<A, B, NA, NB, N, C>
+where
+    A: DiracSystem<NA>,
+    B: DiracSystem<NB>,
+{
+    /// Joins the named instances `a` and `b` by `junctions`.
+    ///
+    /// An `Err(InvalidInterconnection)` says what is wrong, naming the junctions involved:
+    /// instance names empty, equal or containing a `.`; a term naming an unknown instance or
+    /// coordinate (the message lists the coordinates there are), naming a coordinate twice, or
+    /// with a coefficient zero or not finite; a junction without terms or with another's name;
+    /// junctions that depend on each other (one is a combination of others: the system would be
+    /// over-determined and its multipliers not unique); components that hold their one-forms
+    /// at different [`ConstraintPoint`]s.
+    pub fn new(a: (&str, A), b: (&str, B), junctions: [Junction; C]) -> Result<Self, DiracError> {
+        const {
+            assert!(
+                N == NA + NB,
+                "an interconnection of models on R^NA and R^NB is on R^(NA + NB)"
+            )
+        };
+        let invalid = |why: String| Err(DiracError::InvalidInterconnection(why));
+        let instances = [a.0.to_string(), b.0.to_string()];
+        for name in &instances {
+            if name.is_empty() || name.contains('.') {
+                return invalid(format!(
+                    "the instance name {name:?} must be non-empty and without '.'"
+                ));
+            }
+        }
+        if instances[0] == instances[1] {
+            return invalid(format!(
+                "both instances are named {:?}: name them apart",
+                instances[0]
+            ));
+        }
+        let (a, b) = (a.1, b.1);
+        if A::ONE_FORMS > 0 && B::ONE_FORMS > 0 && a.constraint_point() != b.constraint_point() {
+            return invalid(format!(
+                "{} holds its one-forms at {:?} and {} at {:?}: the interconnection needs one \
+                 constraint point",
+                instances[0],
+                a.constraint_point(),
+                instances[1],
+                b.constraint_point()
+            ));
+        }
+        let names: Vec<String> = (0..NA)
+            .map(|i| format!("{}.{}", instances[0], a.coordinate_name(i)))
+            .chain((0..NB).map(|i| format!("{}.{}", instances[1], b.coordinate_name(i))))
+            .collect();
+        let mut rows = [SVector::<f64, N>::zeros(); C];
+        for (j, junction) in junctions.iter().enumerate() {
+            if junctions[..j]
+                .iter()
+                .any(|other| other.name == junction.name)
+            {
+                return invalid(format!("two junctions are named {:?}", junction.name));
+            }
+            if junction.terms.is_empty() {
+                return invalid(format!("junction {:?} has no terms", junction.name));
+            }
+            for (coordinate, coefficient) in &junction.terms {
+                let Some(i) = names.iter().position(|n| n == coordinate) else {
+                    let instance = coordinate.split('.').next().unwrap_or_default();
+                    let known = if instances.iter().any(|n| n == instance) {
+                        format!(
+                            "{instance} has {}",
+                            names
+                                .iter()
+                                .filter(|n| n.split('.').next() == Some(instance))
+                                .cloned()
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        )
+                    } else {
+                        format!("the instances are {} and {}", instances[0], instances[1])
+                    };
+                    return invalid(format!(
+                        "junction {:?} names {coordinate:?}, which is not a coordinate of the \
+                         interconnection ({known})",
+                        junction.name
+                    ));
+                };
+                if !coefficient.is_finite() || *coefficient == 0.0 {
+                    return invalid(format!(
+                        "junction {:?} gives {coordinate} the coefficient {coefficient}: it must \
+                         be finite and nonzero",
+                        junction.name
+                    ));
+                }
+                if rows[j][i] != 0.0 {
+                    return invalid(format!(
+                        "junction {:?} names {coordinate} twice",
+                        junction.name
+                    ));
+                }
+                rows[j][i] = *coefficient;
+            }
+        }
+        let junction_names: [String; C] = std::array::from_fn(|j| junctions[j].name.clone());
+        if let Some((dependent, on)) = dependent_row(&rows) {
+            let on: Vec<&str> = on.iter().map(|&j| junction_names[j].as_str()).collect();
+            return invalid(format!(
+                "junction {:?} is a combination of {}: the junctions over-determine the \
+                 system (drop one)",
+                junction_names[dependent],
+                if on.is_empty() {
+                    "none (it is zero)".to_string()
+                } else {
+                    on.join(", ")
+                }
+            ));
+        }
+        Ok(Self {
+            instances,
+            a,
+            b,
+            junction_names,
+            rows,
+        })
+    }
+
+    /// The component `A`.
+    pub fn a(&self) -> &A {
+        &self.a
+    }
+
+    /// The component `B`.
+    pub fn b(&self) -> &B {
+        &self.b
+    }
+
+    /// The instances' names, `A`'s then `B`'s.
+    pub fn instances(&self) -> &[String; 2] {
+        &self.instances
+    }
+
+    /// The junctions' names, in the order of their multipliers.
+    pub fn junction_names(&self) -> &[String; C] {
+        &self.junction_names
+    }
+
+    /// Junction `j` as a covector on `R^N` (its coefficients).
+    pub fn junction(&self, j: usize) -> &SVector<f64, N> {
+        &self.rows[j]
+    }
+
+    /// Splits a vector of the interconnection (a position, velocity or momentum) into `A`'s
+    /// part and `B`'s part.
+    pub fn split<D: Scalar>(&self, x: &SVector<D, N>) -> (SVector<D, NA>, SVector<D, NB>) {
+        (
+            SVector::from_fn(|i, _| x[i]),
+            SVector::from_fn(|i, _| x[NA + i]),
+        )
+    }
+
+    /// Joins `A`'s part and `B`'s part into a vector of the interconnection.
+    pub fn join<D: Scalar>(&self, a: &SVector<D, NA>, b: &SVector<D, NB>) -> SVector<D, N> {
+        SVector::from_fn(|i, _| if i < NA { a[i] } else { b[i - NA] })
+    }
+
+    /// Each component's energy `E = ⟨∂L/∂v, v⟩ − L` at position `q` with velocity `v`
+    /// (the state's exact velocity is [`Stepper::v`](crate::Stepper::v)).
+    pub fn energies(&self, q: &SVector<f64, N>, v: &SVector<f64, N>) -> [f64; 2] {
+        let ((qa, qb), (va, vb)) = (self.split(q), self.split(v));
+        [
+            legendre::energy(&self.a, &qa, &va),
+            legendre::energy(&self.b, &qb, &vb),
+        ]
+    }
+
+    /// The junctions' multipliers among a stepper's `multipliers` (the last `C` of the one-form
+    /// multipliers): an `Err` for a quadrature that holds the one-forms at several nodes of a
+    /// step (the Galerkin rules), whose multipliers are one per node.
+    pub fn junction_multipliers<'m>(
+        &self,
+        multipliers: &'m [f64],
+    ) -> Result<&'m [f64], DiracError> {
+        let one_forms = <Self as DiracSystem<N>>::ONE_FORMS;
+        if multipliers.len() != one_forms + <Self as DiracSystem<N>>::HOLONOMIC {
+            return Err(DiracError::Unsupported(format!(
+                "port readings from {} multipliers: the interconnection has {} one-forms and {} \
+                 holonomic constraints, held once per step by degree-1 quadratures (midpoint, \
+                 trapezoid) only",
+                multipliers.len(),
+                one_forms,
+                <Self as DiracSystem<N>>::HOLONOMIC
+            )));
+        }
+        Ok(&multipliers[one_forms - C..one_forms])
+    }
+
+    /// What crossed the ports over the step of size `h` from `q_k` to `q_{k+1}` whose
+    /// multipliers are `multipliers` ([`Stepper::multipliers`](crate::Stepper::multipliers) after
+    /// the step): the efforts and each component's port work. An `Err` as
+    /// [`junction_multipliers`](Self::junction_multipliers).
+    pub fn ports(
+        &self,
+        q_k: &SVector<f64, N>,
+        q_next: &SVector<f64, N>,
+        multipliers: &[f64],
+        h: f64,
+    ) -> Result<Ports<C>, DiracError> {
+        let impulses = self.junction_multipliers(multipliers)?;
+        let step = q_next - q_k;
+        let mut work = [0.0; 2];
+        let mut scale: f64 = 0.0;
+        for (row, &impulse) in self.rows.iter().zip(impulses) {
+            for i in 0..N {
+                let force = impulse / h * row[i];
+                work[usize::from(i >= NA)] += force * step[i];
+                // A flow is a difference of positions: its round-off is that of the positions.
+                let size = step[i].abs().max(q_k[i].abs()).max(q_next[i].abs());
+                scale = scale.max((force * size).abs());
+            }
+        }
+        Ok(Ports {
+            efforts: std::array::from_fn(|j| impulses[j] / h),
+            work,
+            scale,
+        })
+    }
+}
+
+/// The first row of `rows` that is a combination of the rows before it (Gram–Schmidt with a
+/// second pass, relative tolerance 1e-10), with the rows it combines: `None` when they are
+/// independent.
+fn dependent_row<const N: usize>(rows: &[SVector<f64, N>]) -> Option<(usize, Vec<usize>)> {
+    let mut basis: Vec<SVector<f64, N>> = Vec::new();
+    for (j, row) in rows.iter().enumerate() {
+        let mut rest = *row;
+        for _ in 0..2 {
+            for e in &basis {
+                rest -= e * e.dot(&rest);
+            }
+        }
+        if rest.norm() <= 1e-10 * row.norm() {
+            // Which earlier rows it combines: the least-squares coefficients over them.
+            let earlier = nalgebra::DMatrix::from_fn(N, j, |i, k| rows[k][i]);
+            let target = nalgebra::DVector::from_fn(N, |i, _| row[i]);
+            let coefficients = earlier
+                .svd(true, true)
+                .solve(&target, 1e-12)
+                .unwrap_or_else(|_| nalgebra::DVector::zeros(j));
+            let largest = coefficients.amax();
+            let on = (0..j)
+                .filter(|&k| coefficients[k].abs() > 1e-9 * largest)
+                .collect();
+            return Some((j, on));
+        }
+        basis.push(rest / rest.norm());
+    }
+    None
+}
+
+impl<A, B, const NA: usize, const NB: usize, const N: usize, const C: usize> DiracSystem<N>
+    for Interconnection<A, B, NA, NB, N, C>
+where
+    A: DiracSystem<NA>,
+    B: DiracSystem<NB>,
+{
+    const ONE_FORMS: usize = A::ONE_FORMS + B::ONE_FORMS + C;
+    const HOLONOMIC: usize = A::HOLONOMIC + B::HOLONOMIC;
+    const FORCES: bool = A::FORCES || B::FORCES;
+    const INPUTS: usize = A::INPUTS + B::INPUTS;
+
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D {
+        let ((qa, qb), (va, vb)) = (self.split(q), self.split(v));
+        self.a.lagrangian(&qa, &va) + self.b.lagrangian(&qb, &vb)
+    }
+
+    fn lagrangian_gradient(
+        &self,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Option<LagrangianGradient<N>> {
+        let ((qa, qb), (va, vb)) = (self.split(q), self.split(v));
+        let (a, b) = (
+            self.a.lagrangian_gradient(&qa, &va)?,
+            self.b.lagrangian_gradient(&qb, &vb)?,
+        );
+        Some(LagrangianGradient {
+            value: a.value + b.value,
+            q: self.join(&a.q, &b.q),
+            v: self.join(&a.v, &b.v),
+        })
+    }
+
+    fn lagrangian_hessian(
+        &self,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Option<LagrangianHessian<N>> {
+        let ((qa, qb), (va, vb)) = (self.split(q), self.split(v));
+        let (a, b) = (
+            self.a.lagrangian_hessian(&qa, &va)?,
+            self.b.lagrangian_hessian(&qb, &vb)?,
+        );
+        let blocks = |x: &nalgebra::SMatrix<f64, NA, NA>, y: &nalgebra::SMatrix<f64, NB, NB>| {
+            let mut m = nalgebra::SMatrix::<f64, N, N>::zeros();
+            m.fixed_view_mut::<NA, NA>(0, 0).copy_from(x);
+            m.fixed_view_mut::<NB, NB>(NA, NA).copy_from(y);
+            m
+        };
+        Some(LagrangianHessian {
+            gradient: LagrangianGradient {
+                value: a.gradient.value + b.gradient.value,
+                q: self.join(&a.gradient.q, &b.gradient.q),
+                v: self.join(&a.gradient.v, &b.gradient.v),
+            },
+            qq: blocks(&a.qq, &b.qq),
+            qv: blocks(&a.qv, &b.qv),
+            vv: blocks(&a.vv, &b.vv),
+        })
+    }
+
+    fn one_form<D: Scalar>(&self, q: &SVector<D, N>, index: usize) -> SVector<D, N> {
+        let (qa, qb) = self.split(q);
+        if index < A::ONE_FORMS {
+            self.join(&self.a.one_form(&qa, index), &SVector::zeros())
+        } else if index < A::ONE_FORMS + B::ONE_FORMS {
+            self.join(
+                &SVector::zeros(),
+                &self.b.one_form(&qb, index - A::ONE_FORMS),
+            )
+        } else {
+            self.rows[index - A::ONE_FORMS - B::ONE_FORMS].map(D::from)
+        }
+    }
+
+    fn holonomic<D: Scalar>(&self, q: &SVector<D, N>, index: usize) -> D {
+        let (qa, qb) = self.split(q);
+        if index < A::HOLONOMIC {
+            self.a.holonomic(&qa, index)
+        } else {
+            self.b.holonomic(&qb, index - A::HOLONOMIC)
+        }
+    }
+
+    fn force<D: Scalar>(
+        &self,
+        q: &SVector<D, N>,
+        v: &SVector<D, N>,
+        t: f64,
+        inputs: &[D],
+    ) -> SVector<D, N> {
+        let ((qa, qb), (va, vb)) = (self.split(q), self.split(v));
+        let (ua, ub) = inputs.split_at(A::INPUTS);
+        let fa = if A::FORCES {
+            self.a.force(&qa, &va, t, ua)
+        } else {
+            SVector::zeros()
+        };
+        let fb = if B::FORCES {
+            self.b.force(&qb, &vb, t, ub)
+        } else {
+            SVector::zeros()
+        };
+        self.join(&fa, &fb)
+    }
+
+    fn input_name(&self, i: usize) -> String {
+        if i < A::INPUTS {
+            format!("{}.{}", self.instances[0], self.a.input_name(i))
+        } else {
+            format!("{}.{}", self.instances[1], self.b.input_name(i - A::INPUTS))
+        }
+    }
+
+    fn constraint_point(&self) -> ConstraintPoint {
+        if A::ONE_FORMS > 0 {
+            self.a.constraint_point()
+        } else {
+            self.b.constraint_point()
+        }
+    }
+
+    fn coordinate_name(&self, i: usize) -> String {
+        if i < NA {
+            format!("{}.{}", self.instances[0], self.a.coordinate_name(i))
+        } else {
+            format!("{}.{}", self.instances[1], self.b.coordinate_name(i - NA))
+        }
+    }
+
+    fn parameters(&self) -> Vec<(String, f64)> {
+        let [a, b] = &self.instances;
+        let prefixed =
+            |instance: &String, (name, value): (String, f64)| (format!("{instance}.{name}"), value);
+        (self.a.parameters().into_iter().map(|x| prefixed(a, x)))
+            .chain(self.b.parameters().into_iter().map(|x| prefixed(b, x)))
+            .collect()
+    }
+
+    /// The components' quadrature when they name the same one; an `Err` naming both otherwise
+    /// (pass one to [`Stepper::new`](crate::Stepper::new)).
+    fn quadrature(&self) -> Result<Quadrature, DiracError> {
+        let (a, b) = (self.a.quadrature()?, self.b.quadrature()?);
+        if a != b {
+            return Err(DiracError::InvalidQuadrature(format!(
+                "{} names {} and {} names {}: pass one quadrature for the interconnection",
+                self.instances[0],
+                a.name(),
+                self.instances[1],
+                b.name()
+            )));
+        }
+        Ok(a)
+    }
+}

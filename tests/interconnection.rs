@@ -1,0 +1,343 @@
+//! Interconnection: models built from separately written components through junctions equal
+//! the same models written as one struct, and the ports keep Tellegen's theorem and each
+//! component's energy balance step by step.
+
+#[path = "../examples/scenes/mod.rs"]
+mod scenes;
+mod support;
+
+use dirac::interconnection::{Interconnection, Junction};
+use dirac::prelude::*;
+use scenes::components::{Capacitor, Inductor, MassSpring, Tethered};
+use scenes::{circuit, port};
+use support::monolithic_rlc::MonolithicRlc;
+
+/// Unequal parameters, so that no symmetry hides a misplaced coordinate.
+const UNEQUAL: circuit::LcCircuit = circuit::LcCircuit {
+    l: 1.3,
+    c1: 0.7,
+    c2: 1.1,
+    c3: 2.0,
+};
+
+/// The LC circuit from its two subcircuits (inductor + C2 in series, C1 and C3) joined by KCL
+/// equals the monolithic circuit over 1 000 steps, with the midpoint rule and `galerkin(2)`:
+/// positions, momenta, and the KCL multiplier (the junction's effort), to 1e-12.
+#[test]
+fn lc_from_two_subcircuits_equals_the_monolithic_circuit() {
+    // Monolithic (q_l, q_c1, q_c2, q_c3) against interconnected (q_l, q_c2, q_c1, q_c3).
+    let order = [0, 2, 1, 3];
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let h = 0.01;
+        let q0 = vector![0.0, 0.14, 1.0, 0.4];
+        let mut monolithic = Stepper::new(UNEQUAL, quadrature.clone(), h).unwrap();
+        monolithic
+            .start_from_velocity(q0, SVector::zeros())
+            .unwrap();
+        let parts = circuit::lc_from_subcircuits(&UNEQUAL).unwrap();
+        let mut joined = Stepper::new(parts, quadrature.clone(), h).unwrap();
+        joined
+            .start_from_velocity(SVector::from_fn(|i, _| q0[order[i]]), SVector::zeros())
+            .unwrap();
+        let mut worst: f64 = 0.0;
+        for _ in 0..1000 {
+            monolithic.step().unwrap();
+            joined.step().unwrap();
+            for i in 0..4 {
+                worst = worst
+                    .max((joined.q()[i] - monolithic.q()[order[i]]).abs())
+                    .max((joined.p()[i] - monolithic.p()[order[i]]).abs());
+            }
+            if quadrature.name() == "midpoint" {
+                // KCL is the monolithic circuit's second one-form, with the same signs.
+                let kcl = joined.multipliers()[1];
+                worst = worst.max((kcl - monolithic.multipliers()[1]).abs());
+            }
+        }
+        assert!(worst < 1e-12, "{}: apart by {worst:e}", quadrature.name());
+        // The circuit is really moving: q_c2 left its start by far more than the tolerance.
+        assert!((joined.q()[1] - 1.0).abs() > 0.1);
+    }
+}
+
+/// The RLC built as LC + resistor + source equals the RLC written as one struct (driven, with
+/// `u` set through the hierarchical input name `drive.source.u`). The resistor's and the
+/// source's charges carry no kinetic energy and their forces read their velocities, so the
+/// interconnected circuit's step map has no derivatives yet: they are refused, not guessed.
+#[test]
+fn rlc_as_lc_plus_resistor_plus_source_equals_the_monolithic_rlc() {
+    let h = 0.01;
+    let reference = MonolithicRlc {
+        l: UNEQUAL.l,
+        c1: UNEQUAL.c1,
+        c2: UNEQUAL.c2,
+        c3: UNEQUAL.c3,
+        r: 0.3,
+    };
+    let mut monolithic = Stepper::new(reference, Quadrature::midpoint(), h).unwrap();
+    monolithic
+        .start_from_velocity(circuit::q0(), SVector::zeros())
+        .unwrap();
+    let rlc = circuit::rlc(UNEQUAL, 0.3).unwrap();
+    assert_eq!(
+        Stepper::new(rlc.clone(), Quadrature::midpoint(), h)
+            .unwrap()
+            .coordinate_names(),
+        [
+            "lc.q_l",
+            "lc.q_c1",
+            "lc.q_c2",
+            "lc.q_c3",
+            "drive.r.q",
+            "drive.source.q"
+        ]
+    );
+    let mut joined = Stepper::new(rlc, Quadrature::midpoint(), h).unwrap();
+    joined
+        .start_from_velocity(circuit::rlc_q0(), SVector::zeros())
+        .unwrap();
+    let mut worst: f64 = 0.0;
+    for k in 0..2000 {
+        let u = (1.7 * (k as f64 + 0.5) * h).sin();
+        monolithic.set_input("u", u).unwrap();
+        joined.set_input("drive.source.u", u).unwrap();
+        monolithic.step().unwrap();
+        joined.step().unwrap();
+        for i in 0..4 {
+            worst = worst
+                .max((joined.q()[i] - monolithic.q()[i]).abs())
+                .max((joined.p()[i] - monolithic.p()[i]).abs());
+        }
+        // The resistor and the source carry the inductor's charge.
+        worst = worst
+            .max((joined.q()[4] - joined.q()[0]).abs())
+            .max((joined.q()[5] - joined.q()[0]).abs());
+    }
+    assert!(worst < 1e-12, "apart by {worst:e}");
+    assert!(monolithic.step_linearised().is_ok());
+    assert!(matches!(
+        joined.step_linearised(),
+        Err(DiracError::Unsupported(_))
+    ));
+}
+
+/// The port scene rebuilt from two mass–spring components equals today's monolithic scene.
+#[test]
+fn port_scene_from_two_components_equals_the_monolithic_scene() {
+    let scene = port::Port {
+        m1: 1.0,
+        m2: 2.5,
+        k1: 1.5,
+        k2: 0.8,
+    };
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let h = 0.02;
+        let mut monolithic = Stepper::new(scene, quadrature.clone(), h).unwrap();
+        monolithic
+            .start_from_velocity(port::q0(), SVector::zeros())
+            .unwrap();
+        let parts = port::from_components(&scene).unwrap();
+        let mut joined = Stepper::new(parts, quadrature.clone(), h).unwrap();
+        joined
+            .start_from_velocity(port::q0(), SVector::zeros())
+            .unwrap();
+        let mut worst: f64 = 0.0;
+        for _ in 0..1000 {
+            monolithic.step().unwrap();
+            joined.step().unwrap();
+            worst = worst
+                .max((joined.q() - monolithic.q()).amax())
+                .max((joined.p() - monolithic.p()).amax());
+        }
+        assert!(worst < 1e-12, "{}: apart by {worst:e}", quadrature.name());
+    }
+}
+
+/// Tellegen's theorem and each component's discrete energy balance, at every step: on the LC
+/// circuit from its subcircuits and on the port scene from its components (midpoint rule,
+/// quadratic Lagrangians), `W_A + W_B = 0` to round-off of the work's terms and
+/// `E_A(k+1) − E_A(k) = W_A`, `E_B(k+1) − E_B(k) = W_B` to round-off of the energies.
+#[test]
+fn ports_keep_tellegen_and_each_components_energy_balance() {
+    fn check<A, B, const NA: usize, const NB: usize, const N: usize, const C: usize>(
+        what: &str,
+        system: Interconnection<A, B, NA, NB, N, C>,
+        q0: SVector<f64, N>,
+    ) where
+        A: DiracSystem<NA> + Clone,
+        B: DiracSystem<NB> + Clone,
+    {
+        let h = 0.01;
+        let mut stepper = Stepper::new(system.clone(), Quadrature::midpoint(), h).unwrap();
+        stepper.start_from_velocity(q0, SVector::zeros()).unwrap();
+        let (mut tellegen, mut balance, mut largest_work): (f64, f64, f64) = (0.0, 0.0, 0.0);
+        for _ in 0..2000 {
+            let (q, e) = (
+                stepper.q(),
+                system.energies(&stepper.q(), &stepper.v().unwrap()),
+            );
+            stepper.step().unwrap();
+            let ports = system
+                .ports(&q, &stepper.q(), stepper.multipliers(), h)
+                .unwrap();
+            tellegen = tellegen.max(ports.net_work().abs() / ports.scale.max(f64::MIN_POSITIVE));
+            let next = system.energies(&stepper.q(), &stepper.v().unwrap());
+            for c in 0..2 {
+                let scale = e[c].abs().max(next[c].abs()).max(1.0);
+                balance = balance.max((next[c] - e[c] - ports.work[c]).abs() / scale);
+                largest_work = largest_work.max(ports.work[c].abs());
+            }
+        }
+        eprintln!("{what}: Tellegen {tellegen:e}, energy balance {balance:e}");
+        assert!(
+            tellegen < 1e-13,
+            "{what}: W_A + W_B = {tellegen:e} of the terms"
+        );
+        assert!(balance < 1e-13, "{what}: energy balance off by {balance:e}");
+        // Energy really crosses the ports (the check is not vacuous).
+        assert!(
+            largest_work > 1e-4,
+            "{what}: largest port work {largest_work:e}"
+        );
+    }
+    check(
+        "LC from subcircuits",
+        circuit::lc_from_subcircuits(&UNEQUAL).unwrap(),
+        vector![0.0, 1.0, 0.14, 0.4],
+    );
+    check(
+        "port from components",
+        port::from_components(&port::SCENE).unwrap(),
+        port::q0(),
+    );
+}
+
+/// The junctions' multipliers are the ports' efforts; they are read once per step only: a
+/// Galerkin step's multipliers (one per node) are refused with an error.
+#[test]
+fn port_readings_need_one_multiplier_per_junction_and_step() {
+    let system = port::from_components(&port::SCENE).unwrap();
+    let mut stepper = Stepper::new(system.clone(), Quadrature::galerkin(2).unwrap(), 0.1).unwrap();
+    stepper
+        .start_from_velocity(port::q0(), SVector::zeros())
+        .unwrap();
+    let q = stepper.q();
+    stepper.step().unwrap();
+    let error = system
+        .ports(&q, &stepper.q(), stepper.multipliers(), 0.1)
+        .unwrap_err();
+    assert!(matches!(error, DiracError::Unsupported(_)), "{error}");
+    assert_eq!(system.junction_names(), &["port".to_string()]);
+    // The port junction's row: +1 on right.end, −1 on left.x.
+    assert_eq!(system.junction(0), &vector![-1.0, 0.0, 1.0]);
+}
+
+fn invalid<T: std::fmt::Debug>(result: Result<T, DiracError>) -> String {
+    match result {
+        Err(DiracError::InvalidInterconnection(why)) => why,
+        other => panic!("expected InvalidInterconnection, got {other:?}"),
+    }
+}
+
+/// Bad interconnections are refused before any step, naming what is wrong.
+#[test]
+fn bad_interconnections_are_refused_naming_the_junctions() {
+    let (l, c) = (Inductor { l: 1.0 }, Capacitor { c: 1.0 });
+    let join = |junctions: [Junction; 2]| {
+        Interconnection::<_, _, 1, 1, 2, 2>::new(("l", l), ("c", c), junctions)
+    };
+    let series = || Junction::new("series").flow("l.q", 1.0).flow("c.q", -1.0);
+    // Unknown instance, unknown coordinate (listing the instance's coordinates).
+    let why = invalid(join([series(), Junction::new("x").flow("r.q", 1.0)]));
+    assert!(
+        why.contains("\"r.q\"") && why.contains("instances are l and c"),
+        "{why}"
+    );
+    let why = invalid(join([series(), Junction::new("x").flow("c.charge", 1.0)]));
+    assert!(
+        why.contains("\"c.charge\"") && why.contains("c has c.q"),
+        "{why}"
+    );
+    // Dependent junctions: the second is twice the first.
+    let twice = Junction::new("twice").flow("l.q", 2.0).flow("c.q", -2.0);
+    let why = invalid(join([series(), twice]));
+    assert!(
+        why.contains("\"twice\" is a combination of series"),
+        "{why}"
+    );
+    // Repeated names, empty junctions, zero or non-finite coefficients, repeated coordinates.
+    let why = invalid(join([series(), series()]));
+    assert!(why.contains("two junctions are named \"series\""), "{why}");
+    let why = invalid(join([series(), Junction::new("empty")]));
+    assert!(why.contains("\"empty\" has no terms"), "{why}");
+    let why = invalid(join([series(), Junction::new("z").flow("l.q", 0.0)]));
+    assert!(why.contains("finite and nonzero"), "{why}");
+    let why = invalid(join([series(), Junction::new("n").flow("l.q", f64::NAN)]));
+    assert!(why.contains("finite and nonzero"), "{why}");
+    let why = invalid(join([
+        series(),
+        Junction::new("d").flow("l.q", 1.0).flow("l.q", 1.0),
+    ]));
+    assert!(why.contains("names l.q twice"), "{why}");
+    // Instance names.
+    let why = invalid(Interconnection::<_, _, 1, 1, 2, 0>::new(
+        ("x", l),
+        ("x", c),
+        [],
+    ));
+    assert!(why.contains("both instances are named \"x\""), "{why}");
+    let why = invalid(Interconnection::<_, _, 1, 1, 2, 0>::new(
+        ("a.b", l),
+        ("c", c),
+        [],
+    ));
+    assert!(why.contains("without '.'"), "{why}");
+    // Three junctions on three coordinates where one is the sum of the other two.
+    let lc = circuit::lc_from_subcircuits(&UNEQUAL).unwrap();
+    let sum = Interconnection::<_, _, 4, 1, 5, 3>::new(
+        ("lc", lc),
+        ("extra", Capacitor { c: 1.0 }),
+        [
+            Junction::new("a")
+                .flow("lc.loop.l.q", 1.0)
+                .flow("extra.q", -1.0),
+            Junction::new("b")
+                .flow("lc.pair.c1.q", 1.0)
+                .flow("extra.q", 1.0),
+            Junction::new("a+b")
+                .flow("lc.loop.l.q", 1.0)
+                .flow("lc.pair.c1.q", 1.0),
+        ],
+    );
+    let why = invalid(sum);
+    assert!(why.contains("\"a+b\" is a combination of a, b"), "{why}");
+}
+
+/// Components that name different quadratures leave the choice to the user: `from_system`
+/// refuses, naming both.
+#[test]
+fn components_naming_different_quadratures_are_refused_by_from_system() {
+    #[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), quadrature = galerkin(2))]
+    #[derive(Debug, Clone, Copy)]
+    struct Free;
+    let system = Interconnection::<_, _, 1, 1, 2, 0>::new(
+        ("free", Free),
+        ("spring", MassSpring { m: 1.0, k: 1.0 }),
+        [],
+    )
+    .unwrap();
+    let error = Stepper::from_system(system, 0.1).unwrap_err();
+    assert!(
+        matches!(&error, DiracError::InvalidQuadrature(why) if why.contains("free names galerkin(2)") && why.contains("spring names midpoint")),
+        "{error}"
+    );
+    // Closed-form derivatives of the components pass through the interconnection.
+    let joined = port::from_components(&port::SCENE).unwrap();
+    let (q, v) = (vector![0.3, -0.2, 0.5], vector![0.1, 0.7, -0.4]);
+    let gradient = joined.lagrangian_gradient(&q, &v).expect("closed forms");
+    assert!((gradient.value - joined.lagrangian(&q, &v)).abs() < 1e-15);
+    // ∂L/∂end = k2 (x2 − end) from the tethered mass; ∂L/∂x1 = −k1 x1 from the oscillator.
+    assert!((gradient.q[2] - port::SCENE.k2 * (-0.2 - 0.5)).abs() < 1e-15);
+    assert!((gradient.q[0] + port::SCENE.k1 * 0.3).abs() < 1e-15);
+    let _ = Tethered { m: 1.0, k: 1.0 };
+}
