@@ -9,7 +9,7 @@ mod support;
 use dirac::interconnection::{Interconnection, Junction};
 use dirac::prelude::*;
 use scenes::components::{Capacitor, Inductor, MassSpring, Tethered};
-use scenes::{circuit, port};
+use scenes::{circuit, port, ports};
 use support::monolithic_rlc::MonolithicRlc;
 
 /// Unequal parameters, so that no symmetry hides a misplaced coordinate.
@@ -43,10 +43,10 @@ fn lc_from_two_subcircuits_equals_the_monolithic_circuit() {
         for _ in 0..1000 {
             monolithic.step().unwrap();
             joined.step().unwrap();
-            for i in 0..4 {
+            for (i, &j) in order.iter().enumerate() {
                 worst = worst
-                    .max((joined.q()[i] - monolithic.q()[order[i]]).abs())
-                    .max((joined.p()[i] - monolithic.p()[order[i]]).abs());
+                    .max((joined.q()[i] - monolithic.q()[j]).abs())
+                    .max((joined.p()[i] - monolithic.p()[j]).abs());
             }
             if quadrature.name() == "midpoint" {
                 // KCL is the monolithic circuit's second one-form, with the same signs.
@@ -159,56 +159,29 @@ fn port_scene_from_two_components_equals_the_monolithic_scene() {
 /// `E_A(k+1) − E_A(k) = W_A`, `E_B(k+1) − E_B(k) = W_B` to round-off of the energies.
 #[test]
 fn ports_keep_tellegen_and_each_components_energy_balance() {
-    fn check<A, B, const NA: usize, const NB: usize, const N: usize, const C: usize>(
-        what: &str,
-        system: Interconnection<A, B, NA, NB, N, C>,
-        q0: SVector<f64, N>,
-    ) where
-        A: DiracSystem<NA> + Clone,
-        B: DiracSystem<NB> + Clone,
-    {
-        let h = 0.01;
-        let mut stepper = Stepper::new(system.clone(), Quadrature::midpoint(), h).unwrap();
-        stepper.start_from_velocity(q0, SVector::zeros()).unwrap();
-        let (mut tellegen, mut balance, mut largest_work): (f64, f64, f64) = (0.0, 0.0, 0.0);
-        for _ in 0..2000 {
-            let (q, e) = (
-                stepper.q(),
-                system.energies(&stepper.q(), &stepper.v().unwrap()),
-            );
-            stepper.step().unwrap();
-            let ports = system
-                .ports(&q, &stepper.q(), stepper.multipliers(), h)
-                .unwrap();
-            tellegen = tellegen.max(ports.net_work().abs() / ports.scale.max(f64::MIN_POSITIVE));
-            let next = system.energies(&stepper.q(), &stepper.v().unwrap());
-            for c in 0..2 {
-                let scale = e[c].abs().max(next[c].abs()).max(1.0);
-                balance = balance.max((next[c] - e[c] - ports.work[c]).abs() / scale);
-                largest_work = largest_work.max(ports.work[c].abs());
-            }
-        }
-        eprintln!("{what}: Tellegen {tellegen:e}, energy balance {balance:e}");
+    let check = |what: &str, found: ports::Balance| {
         assert!(
-            tellegen < 1e-13,
-            "{what}: W_A + W_B = {tellegen:e} of the terms"
+            found.tellegen < 1e-13,
+            "{what}: W_A + W_B = {:e} of the terms",
+            found.tellegen
         );
-        assert!(balance < 1e-13, "{what}: energy balance off by {balance:e}");
+        assert!(
+            found.energy < 1e-13,
+            "{what}: energy balance off by {:e}",
+            found.energy
+        );
         // Energy really crosses the ports (the check is not vacuous).
-        assert!(
-            largest_work > 1e-4,
-            "{what}: largest port work {largest_work:e}"
-        );
-    }
+        assert!(found.largest_work > 1e-4, "{what}: {found:?}");
+    };
+    let lc = circuit::lc_from_subcircuits(&UNEQUAL).unwrap();
     check(
         "LC from subcircuits",
-        circuit::lc_from_subcircuits(&UNEQUAL).unwrap(),
-        vector![0.0, 1.0, 0.14, 0.4],
+        ports::balance(&lc, vector![0.0, 1.0, 0.14, 0.4], 0.01, 2000).unwrap(),
     );
+    let port = port::from_components(&port::SCENE).unwrap();
     check(
         "port from components",
-        port::from_components(&port::SCENE).unwrap(),
-        port::q0(),
+        ports::balance(&port, port::q0(), 0.01, 2000).unwrap(),
     );
 }
 

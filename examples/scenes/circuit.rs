@@ -112,7 +112,7 @@ pub fn rlc_report(quadrature: Quadrature) -> Result<Report, DiracError> {
     ))?;
     let error = (stepper.q().fixed_rows::<4>(0) - SVector::from(RLC_Q10)).amax();
     Ok(Report {
-        scene: "RLC (LC + R + source)",
+        scene: "RLC (LC+R+u)",
         quadrature: name,
         h,
         steps: stepper.steps(),
@@ -228,4 +228,24 @@ pub fn rlc(lc: LcCircuit, r: f64) -> Result<Rlc, DiracError> {
             .flow("lc.q_l", 1.0)
             .flow("drive.r.q", -1.0)],
     )
+}
+
+/// The tour's row: the LC circuit from its subcircuits against the monolithic one to T = 10,
+/// and its ports read at every step.
+pub fn subcircuits_report() -> Result<Report, DiracError> {
+    let h = 0.01;
+    let joined = lc_from_subcircuits(&LC)?;
+    let mut parts = Stepper::new(joined.clone(), Quadrature::midpoint(), h)?;
+    let start = vector![0.0, 1.0, 0.0, 0.0];
+    parts.start_from_velocity(start, SVector::zeros())?;
+    let mut whole = Stepper::new(LC, Quadrature::midpoint(), h)?;
+    whole.start_from_velocity(q0(), SVector::zeros())?;
+    let mut gap: f64 = 0.0;
+    for _ in 0..(10.0 / h) as usize {
+        parts.step()?;
+        whole.step()?;
+        let (a, b) = (parts.q(), whole.q());
+        gap = gap.max((vector![a[0], a[2], a[1], a[3]] - b).amax());
+    }
+    super::ports::report("LC (2 parts)", &joined, start, gap)
 }

@@ -21,6 +21,7 @@ pub mod oscillator;
 pub mod peers;
 pub mod pendulum;
 pub mod port;
+pub mod ports;
 pub mod progress;
 pub mod rigid_body;
 pub mod rigid_chain;
