@@ -97,6 +97,29 @@ pub struct LagrangianHessian<const N: usize> {
     pub vv: SMatrix<f64, N, N>,
 }
 
+impl<const N: usize> LagrangianGradient<N> {
+    /// `L = 0` with zero gradient: the start of a sum over a model's parts.
+    pub fn zero() -> Self {
+        Self {
+            value: 0.0,
+            q: SVector::zeros(),
+            v: SVector::zeros(),
+        }
+    }
+}
+
+impl<const N: usize> LagrangianHessian<N> {
+    /// `L = 0` with zero derivatives: the start of a sum over a model's parts.
+    pub fn zero() -> Self {
+        Self {
+            gradient: LagrangianGradient::zero(),
+            qq: SMatrix::zeros(),
+            qv: SMatrix::zeros(),
+            vv: SMatrix::zeros(),
+        }
+    }
+}
+
 /// Relative disagreement with dual numbers beyond which closed forms are refused.
 const TOLERANCE: f64 = 1e-8;
 

@@ -62,9 +62,9 @@ use nalgebra::SVector;
 use crate::closed_form::{LagrangianGradient, LagrangianHessian};
 use crate::constraint_point::ConstraintPoint;
 use crate::error::DiracError;
-use crate::legendre;
 use crate::quadrature::Quadrature;
 use crate::scalar::Scalar;
+use crate::slot::Slot;
 use crate::system::DiracSystem;
 
 /// One interconnection constraint: the one-form `Σ_i c_i dq_i` over the instances' coordinates,
@@ -292,25 +292,21 @@ where
     /// Splits a vector of the interconnection (a position, velocity or momentum) into `A`'s
     /// part and `B`'s part.
     pub fn split<D: Scalar>(&self, x: &SVector<D, N>) -> (SVector<D, NA>, SVector<D, NB>) {
-        (
-            SVector::from_fn(|i, _| x[i]),
-            SVector::from_fn(|i, _| x[NA + i]),
-        )
+        (Self::A.part(x), Self::B.part(x))
     }
 
     /// Joins `A`'s part and `B`'s part into a vector of the interconnection.
     pub fn join<D: Scalar>(&self, a: &SVector<D, NA>, b: &SVector<D, NB>) -> SVector<D, N> {
-        SVector::from_fn(|i, _| if i < NA { a[i] } else { b[i - NA] })
+        let mut joined = SVector::from_element(D::from(0.0));
+        Self::A.place(&mut joined, a);
+        Self::B.place(&mut joined, b);
+        joined
     }
 
     /// Each component's energy `E = ⟨∂L/∂v, v⟩ − L` at position `q` with velocity `v`
     /// (the state's exact velocity is [`Stepper::v`](crate::Stepper::v)).
     pub fn energies(&self, q: &SVector<f64, N>, v: &SVector<f64, N>) -> [f64; 2] {
-        let ((qa, qb), (va, vb)) = (self.split(q), self.split(v));
-        [
-            legendre::energy(&self.a, &qa, &va),
-            legendre::energy(&self.b, &qb, &vb),
-        ]
+        [Self::A.energy(&self.a, q, v), Self::B.energy(&self.b, q, v)]
     }
 
     /// The junctions' multipliers among a stepper's `multipliers` (the last `C` of the one-form
@@ -397,6 +393,18 @@ fn dependent_row<const N: usize>(rows: &[SVector<f64, N>]) -> Option<(usize, Vec
     None
 }
 
+impl<A, B, const NA: usize, const NB: usize, const N: usize, const C: usize>
+    Interconnection<A, B, NA, NB, N, C>
+where
+    A: DiracSystem<NA>,
+    B: DiracSystem<NB>,
+{
+    /// `A`'s place among the interconnection's coordinates, one-forms, constraints, inputs.
+    const A: Slot = Slot::FIRST;
+    /// `B`'s place.
+    const B: Slot = Slot::FIRST.after::<A, NA>();
+}
+
 impl<A, B, const NA: usize, const NB: usize, const N: usize, const C: usize> DiracSystem<N>
     for Interconnection<A, B, NA, NB, N, C>
 where
@@ -409,8 +417,7 @@ where
     const INPUTS: usize = A::INPUTS + B::INPUTS;
 
     fn lagrangian<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D {
-        let ((qa, qb), (va, vb)) = (self.split(q), self.split(v));
-        self.a.lagrangian(&qa, &va) + self.b.lagrangian(&qb, &vb)
+        Self::A.lagrangian(&self.a, q, v) + Self::B.lagrangian(&self.b, q, v)
     }
 
     fn lagrangian_gradient(
@@ -418,16 +425,10 @@ where
         q: &SVector<f64, N>,
         v: &SVector<f64, N>,
     ) -> Option<LagrangianGradient<N>> {
-        let ((qa, qb), (va, vb)) = (self.split(q), self.split(v));
-        let (a, b) = (
-            self.a.lagrangian_gradient(&qa, &va)?,
-            self.b.lagrangian_gradient(&qb, &vb)?,
-        );
-        Some(LagrangianGradient {
-            value: a.value + b.value,
-            q: self.join(&a.q, &b.q),
-            v: self.join(&a.v, &b.v),
-        })
+        let mut gradient = LagrangianGradient::zero();
+        Self::A.add_gradient(&self.a, q, v, &mut gradient)?;
+        Self::B.add_gradient(&self.b, q, v, &mut gradient)?;
+        Some(gradient)
     }
 
     fn lagrangian_hessian(
@@ -435,50 +436,24 @@ where
         q: &SVector<f64, N>,
         v: &SVector<f64, N>,
     ) -> Option<LagrangianHessian<N>> {
-        let ((qa, qb), (va, vb)) = (self.split(q), self.split(v));
-        let (a, b) = (
-            self.a.lagrangian_hessian(&qa, &va)?,
-            self.b.lagrangian_hessian(&qb, &vb)?,
-        );
-        let blocks = |x: &nalgebra::SMatrix<f64, NA, NA>, y: &nalgebra::SMatrix<f64, NB, NB>| {
-            let mut m = nalgebra::SMatrix::<f64, N, N>::zeros();
-            m.fixed_view_mut::<NA, NA>(0, 0).copy_from(x);
-            m.fixed_view_mut::<NB, NB>(NA, NA).copy_from(y);
-            m
-        };
-        Some(LagrangianHessian {
-            gradient: LagrangianGradient {
-                value: a.gradient.value + b.gradient.value,
-                q: self.join(&a.gradient.q, &b.gradient.q),
-                v: self.join(&a.gradient.v, &b.gradient.v),
-            },
-            qq: blocks(&a.qq, &b.qq),
-            qv: blocks(&a.qv, &b.qv),
-            vv: blocks(&a.vv, &b.vv),
-        })
+        let mut hessian = LagrangianHessian::zero();
+        Self::A.add_hessian(&self.a, q, v, &mut hessian)?;
+        Self::B.add_hessian(&self.b, q, v, &mut hessian)?;
+        Some(hessian)
     }
 
     fn one_form<D: Scalar>(&self, q: &SVector<D, N>, index: usize) -> SVector<D, N> {
-        let (qa, qb) = self.split(q);
-        if index < A::ONE_FORMS {
-            self.join(&self.a.one_form(&qa, index), &SVector::zeros())
-        } else if index < A::ONE_FORMS + B::ONE_FORMS {
-            self.join(
-                &SVector::zeros(),
-                &self.b.one_form(&qb, index - A::ONE_FORMS),
-            )
-        } else {
-            self.rows[index - A::ONE_FORMS - B::ONE_FORMS].map(D::from)
-        }
+        Self::A
+            .one_form(&self.a, q, index)
+            .or_else(|| Self::B.one_form(&self.b, q, index))
+            .unwrap_or_else(|| self.rows[index - A::ONE_FORMS - B::ONE_FORMS].map(D::from))
     }
 
     fn holonomic<D: Scalar>(&self, q: &SVector<D, N>, index: usize) -> D {
-        let (qa, qb) = self.split(q);
-        if index < A::HOLONOMIC {
-            self.a.holonomic(&qa, index)
-        } else {
-            self.b.holonomic(&qb, index - A::HOLONOMIC)
-        }
+        Self::A
+            .holonomic(&self.a, q, index)
+            .or_else(|| Self::B.holonomic(&self.b, q, index))
+            .unwrap_or(D::from(0.0))
     }
 
     fn force<D: Scalar>(
@@ -488,27 +463,18 @@ where
         t: f64,
         inputs: &[D],
     ) -> SVector<D, N> {
-        let ((qa, qb), (va, vb)) = (self.split(q), self.split(v));
-        let (ua, ub) = inputs.split_at(A::INPUTS);
-        let fa = if A::FORCES {
-            self.a.force(&qa, &va, t, ua)
-        } else {
-            SVector::zeros()
-        };
-        let fb = if B::FORCES {
-            self.b.force(&qb, &vb, t, ub)
-        } else {
-            SVector::zeros()
-        };
-        self.join(&fa, &fb)
+        let mut force = SVector::from_element(D::from(0.0));
+        Self::A.place_force(&self.a, q, v, t, inputs, &mut force);
+        Self::B.place_force(&self.b, q, v, t, inputs, &mut force);
+        force
     }
 
     fn input_name(&self, i: usize) -> String {
-        if i < A::INPUTS {
-            format!("{}.{}", self.instances[0], self.a.input_name(i))
-        } else {
-            format!("{}.{}", self.instances[1], self.b.input_name(i - A::INPUTS))
-        }
+        let [a, b] = &self.instances;
+        Self::A
+            .input_name(&self.a, a, i)
+            .or_else(|| Self::B.input_name(&self.b, b, i))
+            .unwrap_or_else(|| format!("u{i}"))
     }
 
     fn constraint_point(&self) -> ConstraintPoint {
@@ -520,35 +486,41 @@ where
     }
 
     fn coordinate_name(&self, i: usize) -> String {
-        if i < NA {
-            format!("{}.{}", self.instances[0], self.a.coordinate_name(i))
-        } else {
-            format!("{}.{}", self.instances[1], self.b.coordinate_name(i - NA))
-        }
+        let [a, b] = &self.instances;
+        Self::A
+            .coordinate_name(&self.a, a, i)
+            .or_else(|| Self::B.coordinate_name(&self.b, b, i))
+            .unwrap_or_else(|| format!("q{i}"))
     }
 
     fn parameters(&self) -> Vec<(String, f64)> {
-        let [a, b] = &self.instances;
-        let prefixed =
-            |instance: &String, (name, value): (String, f64)| (format!("{instance}.{name}"), value);
-        (self.a.parameters().into_iter().map(|x| prefixed(a, x)))
-            .chain(self.b.parameters().into_iter().map(|x| prefixed(b, x)))
-            .collect()
+        let mut parameters = Vec::new();
+        Slot::parameters(&self.a, &self.instances[0], &mut parameters);
+        Slot::parameters(&self.b, &self.instances[1], &mut parameters);
+        parameters
     }
 
     /// The components' quadrature when they name the same one; an `Err` naming both otherwise
     /// (pass one to [`Stepper::new`](crate::Stepper::new)).
     fn quadrature(&self) -> Result<Quadrature, DiracError> {
-        let (a, b) = (self.a.quadrature()?, self.b.quadrature()?);
-        if a != b {
-            return Err(DiracError::InvalidQuadrature(format!(
-                "{} names {} and {} names {}: pass one quadrature for the interconnection",
-                self.instances[0],
-                a.name(),
-                self.instances[1],
-                b.name()
-            )));
-        }
-        Ok(a)
+        common_quadrature(&[
+            (&self.instances[0], self.a.quadrature()?),
+            (&self.instances[1], self.b.quadrature()?),
+        ])
+    }
+}
+
+/// The quadrature the named components agree on, or an `Err` naming two that differ.
+pub fn common_quadrature(named: &[(&str, Quadrature)]) -> Result<Quadrature, DiracError> {
+    let Some((first, quadrature)) = named.first() else {
+        return Ok(Quadrature::midpoint());
+    };
+    match named.iter().find(|(_, other)| other != quadrature) {
+        None => Ok(quadrature.clone()),
+        Some((other, theirs)) => Err(DiracError::InvalidQuadrature(format!(
+            "{first} names {} and {other} names {}: pass one quadrature for the interconnection",
+            quadrature.name(),
+            theirs.name()
+        ))),
     }
 }

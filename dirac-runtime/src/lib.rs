@@ -46,6 +46,7 @@ pub mod quadrature;
 pub mod rotation;
 pub mod run;
 pub mod scalar;
+pub mod slot;
 pub mod sphere;
 pub mod step_derivatives;
 pub mod step_equations;

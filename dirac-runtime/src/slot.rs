@@ -1,0 +1,229 @@
+//! A component's place in a model made of components: where its coordinates, one-forms,
+//! holonomic constraints and inputs start among the whole model's. An interconnection (the
+//! [`Interconnection`](crate::interconnection::Interconnection) type, or a struct with
+//! `#[dirac_system(subsystems(...))]`) asks each component's slot for that component's share of
+//! `L`, its one-forms, constraints and forces, read from and placed into the whole model's
+//! vectors.
+//!
+//! ```
+//! use dirac_runtime::slot::Slot;
+//! use dirac_runtime::{DiracSystem, Scalar};
+//! use nalgebra::{SVector, vector};
+//!
+//! struct Spring;
+//! impl DiracSystem<2> for Spring {
+//!     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+//!         (v[0] * v[0] + v[1] * v[1] - (q[1] - q[0]) * (q[1] - q[0])) * 0.5
+//!     }
+//! }
+//! // Two springs side by side: the second's coordinates are the whole model's 2 and 3.
+//! const SECOND: Slot = Slot::FIRST.after::<Spring, 2>();
+//! assert_eq!(SECOND.coordinate, 2);
+//! let q = vector![0.0, 0.0, 1.0, 3.0];
+//! let mine: SVector<f64, 2> = SECOND.part(&q);
+//! assert_eq!(mine, vector![1.0, 3.0]);
+//! assert_eq!(SECOND.lagrangian(&Spring, &q, &SVector::zeros()), -2.0);
+//! ```
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::closed_form::{LagrangianGradient, LagrangianHessian};
+use crate::legendre;
+use crate::scalar::Scalar;
+use crate::system::DiracSystem;
+
+/// Where a component's coordinates, one-forms, holonomic constraints and inputs start among
+/// those of the model it is part of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Slot {
+    /// Index of its first coordinate.
+    pub coordinate: usize,
+    /// Index of its first one-form.
+    pub one_form: usize,
+    /// Index of its first holonomic constraint.
+    pub holonomic: usize,
+    /// Index of its first input.
+    pub input: usize,
+}
+
+impl Slot {
+    /// The first component's slot: everything starts at 0.
+    pub const FIRST: Slot = Slot {
+        coordinate: 0,
+        one_form: 0,
+        holonomic: 0,
+        input: 0,
+    };
+
+    /// The slot of the component after one of type `S` (on `Rᴹ`) in this slot.
+    pub const fn after<S: DiracSystem<M>, const M: usize>(self) -> Slot {
+        Slot {
+            coordinate: self.coordinate + M,
+            one_form: self.one_form + S::ONE_FORMS,
+            holonomic: self.holonomic + S::HOLONOMIC,
+            input: self.input + S::INPUTS,
+        }
+    }
+
+    /// The component's part of the whole model's vector `x` (a position, velocity, momentum).
+    pub fn part<D: Scalar, const N: usize, const M: usize>(
+        &self,
+        x: &SVector<D, N>,
+    ) -> SVector<D, M> {
+        SVector::from_fn(|i, _| x[self.coordinate + i])
+    }
+
+    /// Writes the component's vector `x` into its part of the whole model's `into`.
+    pub fn place<D: Scalar, const N: usize, const M: usize>(
+        &self,
+        into: &mut SVector<D, N>,
+        x: &SVector<D, M>,
+    ) {
+        for i in 0..M {
+            into[self.coordinate + i] = x[i];
+        }
+    }
+
+    /// The component's Lagrangian at the whole model's `(q, v)`.
+    pub fn lagrangian<S: DiracSystem<M>, D: Scalar, const N: usize, const M: usize>(
+        &self,
+        component: &S,
+        q: &SVector<D, N>,
+        v: &SVector<D, N>,
+    ) -> D {
+        component.lagrangian(&self.part(q), &self.part(v))
+    }
+
+    /// The component's energy at the whole model's `(q, v)`.
+    pub fn energy<S: DiracSystem<M>, const N: usize, const M: usize>(
+        &self,
+        component: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> f64 {
+        legendre::energy(component, &self.part(q), &self.part(v))
+    }
+
+    /// Adds the component's closed-form `L` and gradient into the whole model's `into`;
+    /// `None` when the component has none.
+    pub fn add_gradient<S: DiracSystem<M>, const N: usize, const M: usize>(
+        &self,
+        component: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        into: &mut LagrangianGradient<N>,
+    ) -> Option<()> {
+        let mine = component.lagrangian_gradient(&self.part(q), &self.part(v))?;
+        into.value += mine.value;
+        self.place(&mut into.q, &mine.q);
+        self.place(&mut into.v, &mine.v);
+        Some(())
+    }
+
+    /// Adds the component's closed-form `L`, gradient and Hessian (diagonal blocks) into the
+    /// whole model's `into`; `None` when the component has none.
+    pub fn add_hessian<S: DiracSystem<M>, const N: usize, const M: usize>(
+        &self,
+        component: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        into: &mut LagrangianHessian<N>,
+    ) -> Option<()> {
+        let mine = component.lagrangian_hessian(&self.part(q), &self.part(v))?;
+        into.gradient.value += mine.gradient.value;
+        self.place(&mut into.gradient.q, &mine.gradient.q);
+        self.place(&mut into.gradient.v, &mine.gradient.v);
+        let c = self.coordinate;
+        let block = |into: &mut SMatrix<f64, N, N>, mine: &SMatrix<f64, M, M>| {
+            into.fixed_view_mut::<M, M>(c, c).copy_from(mine);
+        };
+        block(&mut into.qq, &mine.qq);
+        block(&mut into.qv, &mine.qv);
+        block(&mut into.vv, &mine.vv);
+        Some(())
+    }
+
+    /// The whole model's one-form `index` when it is one of the component's (`None` otherwise).
+    pub fn one_form<S: DiracSystem<M>, D: Scalar, const N: usize, const M: usize>(
+        &self,
+        component: &S,
+        q: &SVector<D, N>,
+        index: usize,
+    ) -> Option<SVector<D, N>> {
+        let own = index
+            .checked_sub(self.one_form)
+            .filter(|&a| a < S::ONE_FORMS)?;
+        let mut form = SVector::from_element(D::from(0.0));
+        self.place(&mut form, &component.one_form(&self.part(q), own));
+        Some(form)
+    }
+
+    /// The whole model's holonomic constraint `index` when it is one of the component's.
+    pub fn holonomic<S: DiracSystem<M>, D: Scalar, const N: usize, const M: usize>(
+        &self,
+        component: &S,
+        q: &SVector<D, N>,
+        index: usize,
+    ) -> Option<D> {
+        let own = index
+            .checked_sub(self.holonomic)
+            .filter(|&b| b < S::HOLONOMIC)?;
+        Some(component.holonomic(&self.part(q), own))
+    }
+
+    /// Writes the component's force (from its own inputs among the whole model's `inputs`)
+    /// into its part of `into`; nothing when the component has no forces.
+    #[allow(clippy::too_many_arguments)]
+    pub fn place_force<S: DiracSystem<M>, D: Scalar, const N: usize, const M: usize>(
+        &self,
+        component: &S,
+        q: &SVector<D, N>,
+        v: &SVector<D, N>,
+        t: f64,
+        inputs: &[D],
+        into: &mut SVector<D, N>,
+    ) {
+        if S::FORCES {
+            let own = &inputs[self.input..self.input + S::INPUTS];
+            self.place(into, &component.force(&self.part(q), &self.part(v), t, own));
+        }
+    }
+
+    /// The name of the whole model's input `i` when it is one of the component's:
+    /// `instance.input`.
+    pub fn input_name<S: DiracSystem<M>, const M: usize>(
+        &self,
+        component: &S,
+        instance: &str,
+        i: usize,
+    ) -> Option<String> {
+        let own = i.checked_sub(self.input).filter(|&u| u < S::INPUTS)?;
+        Some(format!("{instance}.{}", component.input_name(own)))
+    }
+
+    /// The name of the whole model's coordinate `i` when it is one of the component's:
+    /// `instance.coordinate`.
+    pub fn coordinate_name<S: DiracSystem<M>, const M: usize>(
+        &self,
+        component: &S,
+        instance: &str,
+        i: usize,
+    ) -> Option<String> {
+        let own = i.checked_sub(self.coordinate).filter(|&k| k < M)?;
+        Some(format!("{instance}.{}", component.coordinate_name(own)))
+    }
+
+    /// The component's parameters, named `instance.parameter`, appended to `into`.
+    pub fn parameters<S: DiracSystem<M>, const M: usize>(
+        component: &S,
+        instance: &str,
+        into: &mut Vec<(String, f64)>,
+    ) {
+        into.extend(
+            component
+                .parameters()
+                .into_iter()
+                .map(|(name, value)| (format!("{instance}.{name}"), value)),
+        );
+    }
+}
