@@ -37,6 +37,7 @@ pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
     };
     match validate::model(arguments, item) {
         Outcome::Valid(model) => expand(&model),
+        Outcome::Composite(composite) => crate::subsystems::expand(&composite),
         Outcome::Invalid {
             errors,
             coordinates,
@@ -203,6 +204,7 @@ fn expand(model: &Model) -> TokenStream {
     });
     let quadrature = &model.quadrature;
     let (point, tangent) = (&space.point, &space.tangent);
+    let component = component(model, &n);
     let implementation = quote! {
         #parts
 
@@ -237,9 +239,50 @@ fn expand(model: &Model) -> TokenStream {
             #dirac
             #closed_form
         }
+
+        #component
     };
     let implementation = in_scope(&model.krate, implementation);
     quote!(#item #implementation)
+}
+
+/// What a model on `Rⁿ` given by a Lagrangian offers as a subsystem of
+/// `#[dirac_system(subsystems(...))]`: its number of coordinates, and a `const fn` finding a
+/// coordinate by name (so that junctions are checked when the program compiles). Hidden.
+fn component(model: &Model, n: &TokenStream) -> TokenStream {
+    if model.hamiltonian || validate::is_product(&model.coordinates) {
+        return TokenStream::new();
+    }
+    let item = &model.item;
+    let name = &item.ident;
+    let (impl_generics, ty_generics, where_clause) = item.generics.split_for_impl();
+    let entries = model
+        .coordinates
+        .iter()
+        .zip(offsets(&model.coordinates))
+        .map(|(c, offset)| {
+            let label = c.name.to_string();
+            let length = match &c.length {
+                None => quote!(::core::option::Option::None),
+                Some(length) => {
+                    let length = length.tokens();
+                    quote!(::core::option::Option::Some(#length))
+                }
+            };
+            quote!((#label, #length, #offset))
+        });
+    quote! {
+        #[automatically_derived]
+        impl #impl_generics #name #ty_generics #where_clause {
+            #[doc(hidden)]
+            pub const __DIRAC_COORDINATES: usize = #n;
+
+            #[doc(hidden)]
+            pub const fn __dirac_coordinate(__path: &str) -> ::core::option::Option<usize> {
+                __dirac::slot::coordinate_index(__path, &[#(#entries),*])
+            }
+        }
+    }
 }
 
 /// The body of `coordinate_name`: the model's variables in the manifold's order (on a product,

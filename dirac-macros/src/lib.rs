@@ -11,6 +11,7 @@ mod expand;
 mod expression;
 mod one_form;
 mod quadrature;
+mod subsystems;
 mod symbolic;
 mod validate;
 mod vector_algebra;

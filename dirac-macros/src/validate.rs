@@ -17,8 +17,8 @@ use crate::vector_algebra::{self, Algebra};
 use crate::{expression, one_form, quadrature};
 
 const KEYS: &str = "`coordinates(...)`, `lagrangian = ...`, `hamiltonian = ...`, `quadrature = ...`, \
-     `constraints(...)`, `holonomic(...)`, `forces(...)`, `inputs(...)`, `constraint_at = ...` \
-     and `crate = ...`";
+     `constraints(...)`, `holonomic(...)`, `forces(...)`, `inputs(...)`, `constraint_at = ...`, \
+     `subsystems(...)`, `junctions(...)` and `crate = ...`";
 
 /// Every error found, each with the span of the user's tokens; reported together. Validation,
 /// the rewriter and the one-form splitter all push into one.
@@ -64,6 +64,8 @@ impl Errors {
 /// (so a stub implementation can stop the errors from cascading into the user's code).
 pub enum Outcome {
     Valid(Box<Model>),
+    /// A model made of subsystems.
+    Composite(Box<crate::subsystems::Composite>),
     Invalid {
         errors: Errors,
         coordinates: Option<Vec<Coordinate>>,
@@ -90,6 +92,8 @@ struct Entries {
     inputs: Option<Vec<Ident>>,
     constraint_at: Option<Expr>,
     krate: Option<Expr>,
+    subsystems: Option<Vec<Ident>>,
+    junctions: Option<Vec<Expr>>,
 }
 
 /// The items of `key(a, b, ...)`; `empty` is the message for an empty list.
@@ -137,16 +141,24 @@ fn entries(arguments: Arguments, errors: &mut Errors) -> Entries {
             ("holonomic", Meta::List(l)) => e.holonomic = list(&l, LEAVE_OUT, errors),
             ("forces", Meta::List(l)) => e.forces = list(&l, LEAVE_OUT, errors),
             ("inputs", Meta::List(l)) => e.inputs = list(&l, LEAVE_OUT, errors),
+            ("subsystems", Meta::List(l)) => {
+                let empty = "a model made of subsystems needs at least one, e.g. subsystems(a, b)";
+                e.subsystems = list(&l, empty, errors).or(Some(Vec::new()));
+            }
+            ("junctions", Meta::List(l)) => e.junctions = list(&l, LEAVE_OUT, errors),
             ("lagrangian", Meta::NameValue(nv)) => e.lagrangian = Some(nv.value),
             ("hamiltonian", Meta::NameValue(nv)) => e.hamiltonian = Some(nv.value),
             ("quadrature", Meta::NameValue(nv)) => e.quadrature = Some(nv.value),
             ("constraint_at", Meta::NameValue(nv)) => e.constraint_at = Some(nv.value),
             ("crate", Meta::NameValue(nv)) => e.krate = Some(nv.value),
-            ("coordinates" | "constraints" | "holonomic" | "forces" | "inputs", other) => errors
-                .push(
-                    other.span(),
-                    format!("write `{key}` as a list: {key}(a, b, ...)"),
-                ),
+            (
+                "coordinates" | "constraints" | "holonomic" | "forces" | "inputs" | "subsystems"
+                | "junctions",
+                other,
+            ) => errors.push(
+                other.span(),
+                format!("write `{key}` as a list: {key}(a, b, ...)"),
+            ),
             ("lagrangian" | "hamiltonian" | "quadrature" | "constraint_at" | "crate", other) => {
                 errors.push(other.span(), format!("write `{key} = ...`"))
             }
@@ -178,6 +190,66 @@ fn repeated_attributes(item: &mut syn::ItemStruct, errors: &mut Errors) {
     });
 }
 
+/// A model made of subsystems: the arguments of a model given by its own coordinates are
+/// refused, the rest is read by [`subsystems::model`](crate::subsystems::model).
+fn composite(
+    e: Entries,
+    subsystems: Vec<Ident>,
+    item: syn::ItemStruct,
+    krate: syn::Path,
+    mut errors: Errors,
+) -> Outcome {
+    const OWN: &str = "a model made of subsystems takes its coordinates, Lagrangian, constraints, \
+                       forces and inputs from them: leave this out";
+    let spans = [
+        e.coordinates.as_ref().map(|(span, _)| *span),
+        e.lagrangian.as_ref().map(Spanned::span),
+        e.hamiltonian.as_ref().map(Spanned::span),
+        e.constraints
+            .as_ref()
+            .and_then(|c| c.first())
+            .map(Spanned::span),
+        e.holonomic
+            .as_ref()
+            .and_then(|c| c.first())
+            .map(Spanned::span),
+        e.forces.as_ref().and_then(|c| c.first()).map(Spanned::span),
+        e.inputs.as_ref().and_then(|c| c.first()).map(Spanned::span),
+        e.constraint_at.as_ref().map(Spanned::span),
+    ];
+    for span in spans.into_iter().flatten() {
+        errors.push(span, OWN);
+    }
+    let quadrature = e
+        .quadrature
+        .and_then(|expr| match quadrature::parse(&expr) {
+            Ok(tokens) => Some(tokens),
+            Err(err) => {
+                errors.add(err);
+                None
+            }
+        });
+    let junctions = e.junctions.unwrap_or_default();
+    let composite = crate::subsystems::model(
+        &subsystems,
+        &junctions,
+        quadrature,
+        item.clone(),
+        krate.clone(),
+        &mut errors,
+    );
+    match composite {
+        Some(composite) if errors.is_empty() => Outcome::Composite(Box::new(composite)),
+        _ => Outcome::Invalid {
+            errors,
+            coordinates: None,
+            item: Box::new(item),
+            hamiltonian: false,
+            krate,
+        },
+    }
+}
+
 /// Validates the arguments against the struct.
 pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     let mut errors = Errors::default();
@@ -185,6 +257,16 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     repeated_attributes(&mut item, &mut errors);
     let mut e = entries(arguments, &mut errors);
     let krate = runtime_path(e.krate.take(), &mut errors);
+    if let Some(subsystems) = e.subsystems.take() {
+        return composite(e, subsystems, item, krate, errors);
+    }
+    if let Some(junctions) = &e.junctions {
+        let span = junctions.first().map_or(Span::call_site(), Spanned::span);
+        errors.push(
+            span,
+            "junctions(...) join subsystems: name them in subsystems(...)",
+        );
+    }
     let parameters = parameters(&item, &mut errors);
     if e.forces.is_some() {
         for p in parameters.iter().filter(|p| p.name == "t") {

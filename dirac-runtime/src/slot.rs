@@ -227,3 +227,91 @@ impl Slot {
         );
     }
 }
+
+/// The index of the coordinate named `path` (`x`, or `theta[2]` for an element of an array)
+/// among `coordinates`, each given as `(name, Some(length) for an array, index of its first
+/// element)`: `None` when there is no such coordinate. A `const fn`, so that the attribute's
+/// junctions name coordinates that are checked when the program compiles.
+///
+/// ```
+/// use dirac_runtime::slot::coordinate_index;
+/// const COORDINATES: [(&str, Option<usize>, usize); 2] = [("x", None, 0), ("theta", Some(3), 1)];
+/// assert_eq!(coordinate_index("x", &COORDINATES), Some(0));
+/// assert_eq!(coordinate_index("theta[2]", &COORDINATES), Some(3));
+/// assert_eq!(coordinate_index("theta[3]", &COORDINATES), None);
+/// assert_eq!(coordinate_index("y", &COORDINATES), None);
+/// ```
+pub const fn coordinate_index(
+    path: &str,
+    coordinates: &[(&str, Option<usize>, usize)],
+) -> Option<usize> {
+    let path = path.as_bytes();
+    let mut k = 0;
+    while k < coordinates.len() {
+        let (name, length, first) = coordinates[k];
+        let name = name.as_bytes();
+        match length {
+            None if equal(path, name) => return Some(first),
+            Some(length) if path.len() > name.len() + 2 => {
+                let (head, tail) = path.split_at(name.len());
+                if equal(head, name) && tail[0] == b'[' && tail[tail.len() - 1] == b']' {
+                    let mut element = 0usize;
+                    let mut i = 1;
+                    while i < tail.len() - 1 {
+                        if !tail[i].is_ascii_digit() || element > usize::MAX / 10 - 1 {
+                            return None;
+                        }
+                        element = element * 10 + (tail[i] - b'0') as usize;
+                        i += 1;
+                    }
+                    return if element < length {
+                        Some(first + element)
+                    } else {
+                        None
+                    };
+                }
+            }
+            _ => {}
+        }
+        k += 1;
+    }
+    None
+}
+
+/// The rest of `path` after `instance.` (`Some("r.q")` for `"drive.r.q"` and `"drive"`), or
+/// `None` when `path` does not start with that instance.
+///
+/// ```
+/// use dirac_runtime::slot::descend;
+/// assert_eq!(descend("drive.r.q", "drive"), Some("r.q"));
+/// assert_eq!(descend("driver.q", "drive"), None);
+/// ```
+pub const fn descend<'p>(path: &'p str, instance: &str) -> Option<&'p str> {
+    let (bytes, name) = (path.as_bytes(), instance.as_bytes());
+    if bytes.len() <= name.len() + 1 {
+        return None;
+    }
+    let (head, tail) = bytes.split_at(name.len());
+    if !equal(head, name) || tail[0] != b'.' {
+        return None;
+    }
+    match core::str::from_utf8(tail.split_at(1).1) {
+        Ok(rest) => Some(rest),
+        Err(_) => None,
+    }
+}
+
+/// Byte-wise equality, in a `const fn`.
+const fn equal(a: &[u8], b: &[u8]) -> bool {
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}

@@ -1,0 +1,18 @@
+use dirac::prelude::*;
+
+#[dirac_system(coordinates(q), lagrangian = 0.5 * dot(q).powi(2))]
+struct Inductor;
+
+#[dirac_system(coordinates(q), lagrangian = -0.5 * q.powi(2))]
+struct Capacitor;
+
+#[dirac_system(
+    subsystems(l, c),
+    junctions(series = l.dq - c.dq, again = 2.0 * c.dq - 2.0 * l.dq),
+)]
+struct Loop {
+    l: Inductor,
+    c: Capacitor,
+}
+
+fn main() {}
