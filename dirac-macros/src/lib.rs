@@ -37,6 +37,11 @@ mod vector_algebra;
 ///   or unit vectors `fn<D: Scalar>(&Model, &Configuration<D, K, A, B>, &Rates<D, K, A, B>) -> D`);
 /// - `quadrature = midpoint | trapezoid | galerkin(s) | galerkin(s, gauss_legendre(r)) |
 ///   galerkin(s, gauss_lobatto(r))`: the default quadrature (`midpoint` if omitted);
+/// - `subsystems(a, b, ...)` and `junctions(name = a.dx - 2.0 * b.c.dy, ...)`, instead of the
+///   arguments above: the struct's fields `a, b, ...` are `#[dirac_system]` models, and the
+///   struct is their interconnection (the sum of their Lagrangians, their constraints, forces
+///   and inputs, and the junctions: constant one-forms over `instance.dcoordinate`, written with
+///   number literals, `instance.sub.dx` inside a subsystem made of subsystems);
 /// - `crate = path`: where the generated code finds the runtime (`::dirac` by default;
 ///   `crate = dirac_runtime` for a crate that depends on `dirac-runtime` and `dirac-macros`
 ///   directly).
