@@ -46,6 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     reports.push(circuit::driven_report()?);
     reports.push(circuit::subcircuits_report()?);
     reports.push(scenes::port::components_report()?);
+    reports.push(scenes::ladder::report()?);
     // The newer model classes with the Gauss rules (the trapezoid is refused for a Lagrangian
     // linear in the velocities).
     type Newer = fn(Quadrature) -> Result<Report, DiracError>;

@@ -49,9 +49,9 @@ pub mod prelude {
     pub use dirac_runtime::{
         Configuration, ConfigurationSpace, ConstraintPoint, Crossing, DiracError, DiracSystem,
         Direction, DiscreteLagrangian, DualNum, Euclidean, Event, FirstOrderScheme,
-        HamiltonianSystem, HolonomicScheme, Input, Interconnection, Junction, ManifoldStepper,
-        NewtonOptions, Positive, Product, Progress, Quadrature, Rates, Retraction, Rule, Run,
-        Sample, Scalar, Solution, Status, Stepper, Trajectory,
+        HamiltonianSystem, HolonomicScheme, Input, Interconnected, Interconnection, Junction,
+        ManifoldStepper, NewtonOptions, Positive, Product, Progress, Quadrature, Rates, Repeated,
+        Retraction, Rule, Run, Sample, Scalar, Solution, Status, Stepper, Trajectory,
     };
 }
 

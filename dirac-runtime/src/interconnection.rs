@@ -115,28 +115,217 @@ pub struct Interconnection<A, B, const NA: usize, const NB: usize, const N: usiz
     instances: [String; 2],
     a: A,
     b: B,
-    junction_names: [String; C],
-    rows: [SVector<f64, N>; C],
+    junctions: Junctions<N, C>,
 }
 
-/// What crossed the ports of an [`Interconnection`] over one step.
+/// What crossed the `C` junctions of a model made of `K` components over one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Ports<const C: usize> {
+pub struct Ports<const C: usize, const K: usize = 2> {
     /// The effort of each junction, `e_j = μ_j / h` (the constraint force along its one-form).
     pub efforts: [f64; C],
-    /// The work done through the ports on `A` and on `B` over the step.
-    pub work: [f64; 2],
+    /// The work done through the ports on each component over the step (for an
+    /// [`Interconnection`], on `A` and on `B`).
+    pub work: [f64; K],
     /// The size of the terms summed into the work, each an effort times a flow read from
     /// positions (`|e_j c_ji| max(|q_k,i|, |q_{k+1},i|)`): the work's round-off floor is a few
     /// ulps of this.
     pub scale: f64,
 }
 
-impl<const C: usize> Ports<C> {
-    /// The net work through all ports over the step, `W_A + W_B`: zero by Tellegen's theorem
-    /// (to round-off of [`scale`](Self::scale) when the junctions hold).
+impl<const C: usize, const K: usize> Ports<C, K> {
+    /// The net work through all ports over the step, `Σ W_c`: zero by Tellegen's theorem (to
+    /// round-off of [`scale`](Self::scale) when the junctions hold).
     pub fn net_work(&self) -> f64 {
-        self.work[0] + self.work[1]
+        self.work.iter().sum()
+    }
+}
+
+/// A model on `R^N` made of `K` components joined by `C` junctions ([`Interconnection`],
+/// [`Repeated`](crate::repeated::Repeated)): each component's energy, and what crossed the
+/// ports over a step.
+pub trait Interconnected<const N: usize, const K: usize, const C: usize>: DiracSystem<N> {
+    /// The junctions.
+    fn junctions(&self) -> &Junctions<N, C>;
+
+    /// Each component's energy `E = ⟨∂L/∂v, v⟩ − L` at position `q` with velocity `v` (the
+    /// state's exact velocity is [`Stepper::v`](crate::Stepper::v)).
+    fn energies(&self, q: &SVector<f64, N>, v: &SVector<f64, N>) -> [f64; K];
+
+    /// The component of coordinate `i`.
+    fn component_of(&self, i: usize) -> usize;
+
+    /// What crossed the ports over the step of size `h` from `q_k` to `q_{k+1}` whose
+    /// multipliers are `multipliers` ([`Stepper::multipliers`](crate::Stepper::multipliers) after
+    /// the step): the efforts and each component's port work. An `Err(Unsupported)` for a
+    /// quadrature that holds the one-forms at several nodes of a step (the Galerkin rules).
+    fn ports(
+        &self,
+        q_k: &SVector<f64, N>,
+        q_next: &SVector<f64, N>,
+        multipliers: &[f64],
+        h: f64,
+    ) -> Result<Ports<C, K>, DiracError> {
+        let junctions = self.junctions();
+        let impulses = junctions.multipliers(multipliers, Self::ONE_FORMS, Self::HOLONOMIC)?;
+        Ok(junctions.ports(q_k, q_next, impulses, h, |i| self.component_of(i)))
+    }
+}
+
+/// `C` junctions resolved against the coordinates of a model on `R^N`: their names and their
+/// rows (covectors), checked (see [`Interconnection::new`] for what is refused).
+#[derive(Debug, Clone)]
+pub struct Junctions<const N: usize, const C: usize> {
+    names: [String; C],
+    rows: [SVector<f64, N>; C],
+}
+
+impl<const N: usize, const C: usize> Junctions<N, C> {
+    /// Resolves `junctions` over the coordinates named `coordinates` (`instance.coordinate`,
+    /// `N` of them) of the instances named `instances`.
+    pub fn resolve(
+        junctions: [Junction; C],
+        instances: &[String],
+        coordinates: &[String],
+    ) -> Result<Self, DiracError> {
+        let invalid = |why: String| Err(DiracError::InvalidInterconnection(why));
+        for (k, name) in instances.iter().enumerate() {
+            if name.is_empty() || name.contains('.') {
+                return invalid(format!(
+                    "the instance name {name:?} must be non-empty and without '.'"
+                ));
+            }
+            if instances[..k].contains(name) {
+                return invalid(format!("two instances are named {name:?}: name them apart"));
+            }
+        }
+        let mut rows = [SVector::<f64, N>::zeros(); C];
+        for (j, junction) in junctions.iter().enumerate() {
+            if junctions[..j]
+                .iter()
+                .any(|other| other.name == junction.name)
+            {
+                return invalid(format!("two junctions are named {:?}", junction.name));
+            }
+            if junction.terms.is_empty() {
+                return invalid(format!("junction {:?} has no terms", junction.name));
+            }
+            for (coordinate, coefficient) in &junction.terms {
+                let Some(i) = coordinates.iter().position(|n| n == coordinate) else {
+                    let instance = coordinate.split('.').next().unwrap_or_default();
+                    let known = if instances.iter().any(|n| n == instance) {
+                        let prefix = format!("{instance}.");
+                        let theirs: Vec<&str> = coordinates
+                            .iter()
+                            .filter(|n| n.starts_with(&prefix))
+                            .map(String::as_str)
+                            .collect();
+                        format!("{instance} has {}", theirs.join(", "))
+                    } else {
+                        format!("the instances are {}", instances.join(", "))
+                    };
+                    return invalid(format!(
+                        "junction {:?} names {coordinate:?}, which is not a coordinate of the \
+                         interconnection ({known})",
+                        junction.name
+                    ));
+                };
+                if !coefficient.is_finite() || *coefficient == 0.0 {
+                    return invalid(format!(
+                        "junction {:?} gives {coordinate} the coefficient {coefficient}: it must \
+                         be finite and nonzero",
+                        junction.name
+                    ));
+                }
+                if rows[j][i] != 0.0 {
+                    return invalid(format!(
+                        "junction {:?} names {coordinate} twice",
+                        junction.name
+                    ));
+                }
+                rows[j][i] = *coefficient;
+            }
+        }
+        let names: [String; C] = std::array::from_fn(|j| junctions[j].name.clone());
+        if let Some((dependent, on)) = dependent_row(&rows) {
+            let on: Vec<&str> = on.iter().map(|&j| names[j].as_str()).collect();
+            return invalid(format!(
+                "junction {:?} is a combination of {}: the junctions over-determine the \
+                 system (drop one)",
+                names[dependent],
+                if on.is_empty() {
+                    "none (it is zero)".to_string()
+                } else {
+                    on.join(", ")
+                }
+            ));
+        }
+        Ok(Self { names, rows })
+    }
+
+    /// The junctions' names, in the order of their multipliers.
+    pub fn names(&self) -> &[String; C] {
+        &self.names
+    }
+
+    /// Junction `j` as a covector on `R^N` (its coefficients).
+    pub fn row(&self, j: usize) -> &SVector<f64, N> {
+        &self.rows[j]
+    }
+
+    /// The junctions' multipliers among a stepper's `multipliers` of a model with `one_forms`
+    /// one-forms (the junctions last) and `holonomic` holonomic constraints: an `Err` for a
+    /// quadrature that holds the one-forms at several nodes of a step (the Galerkin rules),
+    /// whose multipliers are one per node.
+    pub fn multipliers<'m>(
+        &self,
+        multipliers: &'m [f64],
+        one_forms: usize,
+        holonomic: usize,
+    ) -> Result<&'m [f64], DiracError> {
+        if multipliers.len() != one_forms + holonomic {
+            return Err(DiracError::Unsupported(format!(
+                "port readings from {} multipliers: the interconnection has {one_forms} \
+                 one-forms and {holonomic} holonomic constraints, held once per step by degree-1 \
+                 quadratures (midpoint, trapezoid) only",
+                multipliers.len(),
+            )));
+        }
+        Ok(&multipliers[one_forms - C..one_forms])
+    }
+
+    /// What crossed the junctions over the step of size `h` from `q_k` to `q_{k+1}` with the
+    /// junctions' `impulses`, the work summed per component, `part(i)` the component of
+    /// coordinate `i`.
+    pub fn ports<const K: usize>(
+        &self,
+        q_k: &SVector<f64, N>,
+        q_next: &SVector<f64, N>,
+        impulses: &[f64],
+        h: f64,
+        part: impl Fn(usize) -> usize,
+    ) -> Ports<C, K> {
+        let step = q_next - q_k;
+        let mut work = [0.0; K];
+        let mut scale: f64 = 0.0;
+        for (row, &impulse) in self.rows.iter().zip(impulses) {
+            for i in (0..N).filter(|&i| row[i] != 0.0) {
+                let force = impulse / h * row[i];
+                work[part(i)] += force * step[i];
+                // A flow is a difference of positions: its round-off is that of the positions.
+                let size = step[i].abs().max(q_k[i].abs()).max(q_next[i].abs());
+                scale = scale.max((force * size).abs());
+            }
+        }
+        Ports {
+            efforts: std::array::from_fn(|j| impulses[j] / h),
+            work,
+            scale,
+        }
+    }
+
+    /// Junction `j` over the scalar `D`.
+    pub fn one_form<D: Scalar>(&self, j: usize) -> SVector<D, N> {
+        self.rows[j].map(D::from)
     }
 }
 
@@ -162,105 +351,32 @@ where
                 "an interconnection of models on R^NA and R^NB is on R^(NA + NB)"
             )
         };
-        let invalid = |why: String| Err(DiracError::InvalidInterconnection(why));
         let instances = [a.0.to_string(), b.0.to_string()];
-        for name in &instances {
-            if name.is_empty() || name.contains('.') {
-                return invalid(format!(
-                    "the instance name {name:?} must be non-empty and without '.'"
-                ));
-            }
-        }
-        if instances[0] == instances[1] {
-            return invalid(format!(
-                "both instances are named {:?}: name them apart",
-                instances[0]
-            ));
-        }
         let (a, b) = (a.1, b.1);
         if A::ONE_FORMS > 0 && B::ONE_FORMS > 0 && a.constraint_point() != b.constraint_point() {
-            return invalid(format!(
+            return Err(DiracError::InvalidInterconnection(format!(
                 "{} holds its one-forms at {:?} and {} at {:?}: the interconnection needs one \
                  constraint point",
                 instances[0],
                 a.constraint_point(),
                 instances[1],
                 b.constraint_point()
-            ));
+            )));
         }
-        let names: Vec<String> = (0..NA)
-            .map(|i| format!("{}.{}", instances[0], a.coordinate_name(i)))
-            .chain((0..NB).map(|i| format!("{}.{}", instances[1], b.coordinate_name(i))))
+        let coordinates: Vec<String> = (0..N)
+            .map(|i| {
+                Self::A
+                    .coordinate_name(&a, &instances[0], i)
+                    .or_else(|| Self::B.coordinate_name(&b, &instances[1], i))
+                    .unwrap_or_default()
+            })
             .collect();
-        let mut rows = [SVector::<f64, N>::zeros(); C];
-        for (j, junction) in junctions.iter().enumerate() {
-            if junctions[..j]
-                .iter()
-                .any(|other| other.name == junction.name)
-            {
-                return invalid(format!("two junctions are named {:?}", junction.name));
-            }
-            if junction.terms.is_empty() {
-                return invalid(format!("junction {:?} has no terms", junction.name));
-            }
-            for (coordinate, coefficient) in &junction.terms {
-                let Some(i) = names.iter().position(|n| n == coordinate) else {
-                    let instance = coordinate.split('.').next().unwrap_or_default();
-                    let known = if instances.iter().any(|n| n == instance) {
-                        format!(
-                            "{instance} has {}",
-                            names
-                                .iter()
-                                .filter(|n| n.split('.').next() == Some(instance))
-                                .cloned()
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        )
-                    } else {
-                        format!("the instances are {} and {}", instances[0], instances[1])
-                    };
-                    return invalid(format!(
-                        "junction {:?} names {coordinate:?}, which is not a coordinate of the \
-                         interconnection ({known})",
-                        junction.name
-                    ));
-                };
-                if !coefficient.is_finite() || *coefficient == 0.0 {
-                    return invalid(format!(
-                        "junction {:?} gives {coordinate} the coefficient {coefficient}: it must \
-                         be finite and nonzero",
-                        junction.name
-                    ));
-                }
-                if rows[j][i] != 0.0 {
-                    return invalid(format!(
-                        "junction {:?} names {coordinate} twice",
-                        junction.name
-                    ));
-                }
-                rows[j][i] = *coefficient;
-            }
-        }
-        let junction_names: [String; C] = std::array::from_fn(|j| junctions[j].name.clone());
-        if let Some((dependent, on)) = dependent_row(&rows) {
-            let on: Vec<&str> = on.iter().map(|&j| junction_names[j].as_str()).collect();
-            return invalid(format!(
-                "junction {:?} is a combination of {}: the junctions over-determine the \
-                 system (drop one)",
-                junction_names[dependent],
-                if on.is_empty() {
-                    "none (it is zero)".to_string()
-                } else {
-                    on.join(", ")
-                }
-            ));
-        }
+        let junctions = Junctions::resolve(junctions, &instances, &coordinates)?;
         Ok(Self {
             instances,
             a,
             b,
-            junction_names,
-            rows,
+            junctions,
         })
     }
 
@@ -279,16 +395,6 @@ where
         &self.instances
     }
 
-    /// The junctions' names, in the order of their multipliers.
-    pub fn junction_names(&self) -> &[String; C] {
-        &self.junction_names
-    }
-
-    /// Junction `j` as a covector on `R^N` (its coefficients).
-    pub fn junction(&self, j: usize) -> &SVector<f64, N> {
-        &self.rows[j]
-    }
-
     /// Splits a vector of the interconnection (a position, velocity or momentum) into `A`'s
     /// part and `B`'s part.
     pub fn split<D: Scalar>(&self, x: &SVector<D, N>) -> (SVector<D, NA>, SVector<D, NB>) {
@@ -302,63 +408,24 @@ where
         Self::B.place(&mut joined, b);
         joined
     }
+}
 
-    /// Each component's energy `E = ⟨∂L/∂v, v⟩ − L` at position `q` with velocity `v`
-    /// (the state's exact velocity is [`Stepper::v`](crate::Stepper::v)).
-    pub fn energies(&self, q: &SVector<f64, N>, v: &SVector<f64, N>) -> [f64; 2] {
+impl<A, B, const NA: usize, const NB: usize, const N: usize, const C: usize> Interconnected<N, 2, C>
+    for Interconnection<A, B, NA, NB, N, C>
+where
+    A: DiracSystem<NA>,
+    B: DiracSystem<NB>,
+{
+    fn junctions(&self) -> &Junctions<N, C> {
+        &self.junctions
+    }
+
+    fn energies(&self, q: &SVector<f64, N>, v: &SVector<f64, N>) -> [f64; 2] {
         [Self::A.energy(&self.a, q, v), Self::B.energy(&self.b, q, v)]
     }
 
-    /// The junctions' multipliers among a stepper's `multipliers` (the last `C` of the one-form
-    /// multipliers): an `Err` for a quadrature that holds the one-forms at several nodes of a
-    /// step (the Galerkin rules), whose multipliers are one per node.
-    pub fn junction_multipliers<'m>(
-        &self,
-        multipliers: &'m [f64],
-    ) -> Result<&'m [f64], DiracError> {
-        let one_forms = <Self as DiracSystem<N>>::ONE_FORMS;
-        if multipliers.len() != one_forms + <Self as DiracSystem<N>>::HOLONOMIC {
-            return Err(DiracError::Unsupported(format!(
-                "port readings from {} multipliers: the interconnection has {} one-forms and {} \
-                 holonomic constraints, held once per step by degree-1 quadratures (midpoint, \
-                 trapezoid) only",
-                multipliers.len(),
-                one_forms,
-                <Self as DiracSystem<N>>::HOLONOMIC
-            )));
-        }
-        Ok(&multipliers[one_forms - C..one_forms])
-    }
-
-    /// What crossed the ports over the step of size `h` from `q_k` to `q_{k+1}` whose
-    /// multipliers are `multipliers` ([`Stepper::multipliers`](crate::Stepper::multipliers) after
-    /// the step): the efforts and each component's port work. An `Err` as
-    /// [`junction_multipliers`](Self::junction_multipliers).
-    pub fn ports(
-        &self,
-        q_k: &SVector<f64, N>,
-        q_next: &SVector<f64, N>,
-        multipliers: &[f64],
-        h: f64,
-    ) -> Result<Ports<C>, DiracError> {
-        let impulses = self.junction_multipliers(multipliers)?;
-        let step = q_next - q_k;
-        let mut work = [0.0; 2];
-        let mut scale: f64 = 0.0;
-        for (row, &impulse) in self.rows.iter().zip(impulses) {
-            for i in 0..N {
-                let force = impulse / h * row[i];
-                work[usize::from(i >= NA)] += force * step[i];
-                // A flow is a difference of positions: its round-off is that of the positions.
-                let size = step[i].abs().max(q_k[i].abs()).max(q_next[i].abs());
-                scale = scale.max((force * size).abs());
-            }
-        }
-        Ok(Ports {
-            efforts: std::array::from_fn(|j| impulses[j] / h),
-            work,
-            scale,
-        })
+    fn component_of(&self, i: usize) -> usize {
+        usize::from(i >= NA)
     }
 }
 
@@ -446,7 +513,7 @@ where
         Self::A
             .one_form(&self.a, q, index)
             .or_else(|| Self::B.one_form(&self.b, q, index))
-            .unwrap_or_else(|| self.rows[index - A::ONE_FORMS - B::ONE_FORMS].map(D::from))
+            .unwrap_or_else(|| self.junctions.one_form(index - A::ONE_FORMS - B::ONE_FORMS))
     }
 
     fn holonomic<D: Scalar>(&self, q: &SVector<D, N>, index: usize) -> D {

@@ -65,6 +65,16 @@ impl Slot {
         }
     }
 
+    /// The slot of copy `i` of a component of type `S` (on `Rᴹ`) among copies side by side.
+    pub const fn nth<S: DiracSystem<M>, const M: usize>(i: usize) -> Slot {
+        Slot {
+            coordinate: i * M,
+            one_form: i * S::ONE_FORMS,
+            holonomic: i * S::HOLONOMIC,
+            input: i * S::INPUTS,
+        }
+    }
+
     /// The component's part of the whole model's vector `x` (a position, velocity, momentum).
     pub fn part<D: Scalar, const N: usize, const M: usize>(
         &self,

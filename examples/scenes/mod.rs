@@ -16,6 +16,7 @@ pub mod hand_written;
 pub mod hand_written_lgvi;
 pub mod kepler;
 pub mod knife_edge;
+pub mod ladder;
 pub mod lotka_volterra;
 pub mod oscillator;
 pub mod peers;

@@ -12,25 +12,24 @@ use super::Report;
 pub struct Balance {
     /// `|W_A + W_B|` relative to the size of the work's terms (Tellegen: zero to round-off).
     pub tellegen: f64,
-    /// `|E_c(k+1) − E_c(k) − W_c|` over both components `c`, relative to `max(|E_c|, 1)`.
+    /// `|E_c(k+1) − E_c(k) − W_c|` over the components `c`, relative to `max(|E_c|, 1)`.
     pub energy: f64,
     /// The largest port work on a component over a step (the identities are not vacuous).
     pub largest_work: f64,
 }
 
-/// Steps `system` from rest at `q0` with the midpoint rule `steps` times, reading the ports.
-pub fn balance<A, B, const NA: usize, const NB: usize, const N: usize, const C: usize>(
-    system: &Interconnection<A, B, NA, NB, N, C>,
-    q0: SVector<f64, N>,
+/// Steps `system` from `(q0, v0)` with the midpoint rule `steps` times, reading the ports.
+pub fn balance<S, const N: usize, const K: usize, const C: usize>(
+    system: &S,
+    (q0, v0): (SVector<f64, N>, SVector<f64, N>),
     h: f64,
     steps: usize,
 ) -> Result<Balance, DiracError>
 where
-    A: DiracSystem<NA> + Clone,
-    B: DiracSystem<NB> + Clone,
+    S: Interconnected<N, K, C> + Clone,
 {
     let mut stepper = Stepper::new(system.clone(), Quadrature::midpoint(), h)?;
-    stepper.start_from_velocity(q0, SVector::zeros())?;
+    stepper.start_from_velocity(q0, v0)?;
     let mut found = Balance {
         tellegen: 0.0,
         energy: 0.0,
@@ -44,7 +43,7 @@ where
             .tellegen
             .max(ports.net_work().abs() / ports.scale.max(f64::MIN_POSITIVE));
         let next = system.energies(&stepper.q(), &stepper.v()?);
-        for c in 0..2 {
+        for c in 0..K {
             let scale = e[c].abs().max(next[c].abs()).max(1.0);
             found.energy = found
                 .energy
@@ -55,21 +54,21 @@ where
     Ok(found)
 }
 
-/// The tour's row: `what` built from components, its ports read over `t_end / h` steps.
-pub fn report<A, B, const NA: usize, const NB: usize, const N: usize, const C: usize>(
+/// The tour's row: `scene` built from components, started at rest at `q0`, its ports read
+/// over `t_end / h` steps; `gap` is its distance to the monolithic model.
+pub fn report<S, const N: usize, const K: usize, const C: usize>(
     scene: &'static str,
-    system: &Interconnection<A, B, NA, NB, N, C>,
+    system: &S,
     q0: SVector<f64, N>,
     gap: f64,
 ) -> Result<Report, DiracError>
 where
-    A: DiracSystem<NA> + Clone,
-    B: DiracSystem<NB> + Clone,
+    S: Interconnected<N, K, C> + Clone,
 {
     let (h, t_end) = (0.01, 10.0);
     let steps = (t_end / h) as usize;
     let start = Instant::now();
-    let found = balance(system, q0, h, steps)?;
+    let found = balance(system, (q0, SVector::zeros()), h, steps)?;
     Ok(Report {
         scene,
         quadrature: "midpoint".into(),
