@@ -51,3 +51,32 @@ pub struct Tethered {
     pub m: f64,
     pub k: f64,
 }
+
+/// A DC motor: armature inductance `l` and resistance `r`, rotor inertia `j`, and the gyrator
+/// of torque constant `k` between its charge `q` and its rotor angle `theta` (back-EMF
+/// `k θ̇` against the current, torque `k q̇` on the rotor), driven by the voltage input `u`.
+#[dirac_system(
+    coordinates(q, theta),
+    lagrangian = 0.5 * l * dot(q).powi(2) + 0.5 * j * dot(theta).powi(2),
+    forces((u - r * dot(q) - k * dot(theta)) * dq + k * dot(q) * dtheta),
+    inputs(u),
+)]
+#[derive(Debug, Clone, Copy)]
+pub struct DcMotor {
+    pub l: f64,
+    pub r: f64,
+    pub k: f64,
+    pub j: f64,
+}
+
+/// A pendulum arm about a horizontal pivot: inertia `inertia` about the pivot and the moment
+/// `mgd` of its weight, L = ½ I φ̇² + m g d cos φ (φ = 0 hanging down).
+#[dirac_system(
+    coordinates(phi),
+    lagrangian = 0.5 * inertia * dot(phi).powi(2) + mgd * cos(phi),
+)]
+#[derive(Debug, Clone, Copy)]
+pub struct Arm {
+    pub inertia: f64,
+    pub mgd: f64,
+}

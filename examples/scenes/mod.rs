@@ -18,6 +18,7 @@ pub mod kepler;
 pub mod knife_edge;
 pub mod ladder;
 pub mod lotka_volterra;
+pub mod motor;
 pub mod oscillator;
 pub mod peers;
 pub mod pendulum;
