@@ -350,8 +350,69 @@ fn routes(c: &mut Criterion) {
     group.finish();
 }
 
+/// Interconnected models against the same model written as one struct (midpoint, h = 0.01;
+/// both solved monolithically): the seed's LC circuit from its two subcircuits in plain Rust
+/// and with the attribute, and the LC ladder of K cells in a ring (`Repeated`, N = 2K
+/// coordinates and K junctions) for the growth with K.
+fn interconnection(c: &mut Criterion) {
+    let mut group = c.benchmark_group("interconnection_step");
+    let q0 = vector![0.0, 1.0, 0.0, 0.0];
+    let mut whole =
+        Stepper::new(scenes::circuit::LC, Quadrature::midpoint(), 0.01).expect("valid scene");
+    whole
+        .start_from_velocity(scenes::circuit::q0(), SVector::zeros())
+        .expect("consistent start");
+    group.bench_function("lc_monolithic", |b| {
+        b.iter(|| black_box(whole.step()).expect("step"))
+    });
+    let parts = scenes::circuit::lc_from_subcircuits(&scenes::circuit::LC).expect("valid");
+    let mut plain = Stepper::new(parts, Quadrature::midpoint(), 0.01).expect("valid scene");
+    plain
+        .start_from_velocity(q0, SVector::zeros())
+        .expect("consistent start");
+    group.bench_function("lc_two_subcircuits", |b| {
+        b.iter(|| black_box(plain.step()).expect("step"))
+    });
+    let parts = scenes::circuit::LcByAttribute::of(&scenes::circuit::LC);
+    let mut attribute = Stepper::new(parts, Quadrature::midpoint(), 0.01).expect("valid scene");
+    attribute
+        .start_from_velocity(q0, SVector::zeros())
+        .expect("consistent start");
+    group.bench_function("lc_two_subcircuits_attribute", |b| {
+        b.iter(|| black_box(attribute.step()).expect("step"))
+    });
+    fn ladder<const K: usize, const N: usize>(
+        group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    ) {
+        let ring = scenes::ladder::ring::<K, N>(1.0, 1.0).expect("valid ladder");
+        let mut stepper = Stepper::new(ring, Quadrature::midpoint(), 0.01).expect("valid scene");
+        // A standing wave: charge on the capacitors only where KCL allows it (q_c = q_l − q_l').
+        let q0 = SVector::from_fn(|i, _| {
+            let j = i / 2;
+            let x = |j: usize| 0.1 * (2.0 * std::f64::consts::PI * j as f64 / K as f64).cos();
+            if i % 2 == 0 {
+                x(j)
+            } else {
+                x(j) - x((j + 1) % K)
+            }
+        });
+        stepper
+            .start_from_velocity(q0, SVector::zeros())
+            .expect("consistent start");
+        group.bench_with_input(BenchmarkId::new("ladder_cells", K), &K, |b, _| {
+            b.iter(|| black_box(stepper.step()).expect("step"))
+        });
+    }
+    ladder::<4, 8>(&mut group);
+    ladder::<8, 16>(&mut group);
+    ladder::<16, 32>(&mut group);
+    ladder::<32, 64>(&mut group);
+    group.finish();
+}
+
 criterion_group!(
     benches,
+    interconnection,
     routes,
     lie_group,
     recording,

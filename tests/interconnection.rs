@@ -10,7 +10,7 @@ use support::slope;
 
 use dirac::interconnection::{Interconnection, Junction};
 use dirac::prelude::*;
-use scenes::components::{Capacitor, Inductor, MassSpring, Resistor, Source, Tethered};
+use scenes::components::{Capacitor, DcMotor, Inductor, MassSpring, Resistor, Source, Tethered};
 use scenes::{circuit, ladder, motor, port, ports};
 use std::f64::consts::PI;
 use support::monolithic_rlc::MonolithicRlc;
@@ -324,30 +324,6 @@ fn components_naming_different_quadratures_are_refused_by_from_system() {
     let _ = Tethered { m: 1.0, k: 1.0 };
 }
 
-/// The LC circuit's loop, written with the attribute.
-#[dirac_system(subsystems(l, c2), junctions(series = l.dq - c2.dq))]
-#[derive(Debug, Clone, Copy)]
-struct Loop {
-    l: Inductor,
-    c2: Capacitor,
-}
-
-/// C1 and C3, written with the attribute.
-#[dirac_system(subsystems(c1, c3))]
-#[derive(Debug, Clone, Copy)]
-struct Pair {
-    c1: Capacitor,
-    c3: Capacitor,
-}
-
-/// The LC circuit from its subcircuits, written with the attribute (two levels).
-#[dirac_system(subsystems(loop_, pair), junctions(kcl = loop_.c2.dq - pair.c1.dq - pair.c3.dq))]
-#[derive(Debug, Clone, Copy)]
-struct LcFromParts {
-    loop_: Loop,
-    pair: Pair,
-}
-
 /// The RLC of three subsystems in one level, written with the attribute.
 #[dirac_system(subsystems(lc, r, source), junctions(lc.dq_l - r.dq, r.dq - source.dq))]
 #[derive(Debug, Clone, Copy)]
@@ -363,16 +339,7 @@ struct RlcFromParts {
 #[test]
 fn the_attributes_subsystems_equal_the_plain_rust_interconnection() {
     let c = UNEQUAL;
-    let parts = LcFromParts {
-        loop_: Loop {
-            l: Inductor { l: c.l },
-            c2: Capacitor { c: c.c2 },
-        },
-        pair: Pair {
-            c1: Capacitor { c: c.c1 },
-            c3: Capacitor { c: c.c3 },
-        },
-    };
+    let parts = circuit::LcByAttribute::of(&c);
     let (q0, v0) = (vector![0.0, 1.0, 0.14, 0.4], SVector::zeros());
     let mut attribute = Stepper::new(parts, Quadrature::galerkin(2).unwrap(), 0.01).unwrap();
     assert_eq!(
@@ -548,4 +515,113 @@ fn a_dc_motor_drives_a_pendulum_arm_with_its_energy_balanced() {
     let rest = motor::at(0.01, 40.0).unwrap();
     assert!((rest[1] - motor::rest_angle()).abs() < 1e-12, "{rest:?}");
     assert!(motor::rest_angle() > 0.5);
+}
+
+/// Copies with one-forms and inputs of their own: two loops (each with its series junction)
+/// as `Repeated` equal the same two as an `Interconnection`, bit for bit, and two driven
+/// motors name their inputs `motor[i].u` and answer to them.
+#[test]
+fn repeated_copies_keep_their_own_one_forms_and_inputs() {
+    let cell = circuit::Loop {
+        l: Inductor { l: 1.3 },
+        c2: Capacitor { c: 0.7 },
+    };
+    let link = |a: &str, b: &str| [Junction::new("link").flow(a, 1.0).flow(b, -1.0)];
+    let repeated =
+        Repeated::<_, 2, 2, 4, 1>::new("loop", [cell; 2], link("loop[0].c2.q", "loop[1].l.q"))
+            .unwrap();
+    let pair =
+        Interconnection::<_, _, 2, 2, 4, 1>::new(("a", cell), ("b", cell), link("a.c2.q", "b.l.q"))
+            .unwrap();
+    assert_eq!(
+        <Repeated<circuit::Loop, 2, 2, 4, 1> as DiracSystem<4>>::ONE_FORMS,
+        3
+    );
+    let q0 = vector![0.0, 1.0, 0.0, 0.5];
+    let mut a = Stepper::new(repeated, Quadrature::midpoint(), 0.01).unwrap();
+    let mut b = Stepper::new(pair, Quadrature::midpoint(), 0.01).unwrap();
+    a.start_from_velocity(q0, SVector::zeros()).unwrap();
+    b.start_from_velocity(q0, SVector::zeros()).unwrap();
+    for _ in 0..500 {
+        a.step().unwrap();
+        b.step().unwrap();
+        assert_eq!((a.q(), a.multipliers()), (b.q(), b.multipliers()));
+    }
+    assert!((a.q()[1] - 1.0).abs() > 0.1);
+
+    let motor = motor::MOTOR;
+    let free = |i: usize| {
+        Junction::new(format!("shaft{i}"))
+            .flow(format!("motor[{i}].theta"), 1.0)
+            .flow(format!("motor[{}].theta", i + 1), -1.0)
+    };
+    let motors = Repeated::<DcMotor, 2, 2, 4, 1>::new("motor", [motor; 2], [free(0)]).unwrap();
+    assert_eq!(
+        (0..2).map(|i| motors.input_name(i)).collect::<Vec<_>>(),
+        ["motor[0].u", "motor[1].u"]
+    );
+    let mut stepper = Stepper::new(motors, Quadrature::midpoint(), 0.01).unwrap();
+    stepper
+        .start_from_velocity(SVector::zeros(), SVector::zeros())
+        .unwrap();
+    stepper.set_input("motor[1].u", 2.0).unwrap();
+    stepper.run(100).unwrap();
+    // Only the second motor is driven; the shared shaft turns both rotors alike, and the
+    // first motor's back-EMF drives a current through its own (unpowered) armature.
+    assert!((stepper.q()[1] - stepper.q()[3]).abs() < 1e-14);
+    assert!(stepper.q()[3] > 0.0 && stepper.q()[2] > 0.0 && stepper.q()[0] < 0.0);
+}
+
+/// Edge cases are errors, not panics: two coordinates of one name, port readings with a step
+/// that is not positive or with the wrong multipliers; a coefficient of 1e200 builds (its
+/// independence is judged on the scaled row) and its step is refused as singular.
+#[test]
+fn edge_cases_are_errors_not_panics() {
+    /// Two coordinates, both named `x`.
+    #[derive(Debug, Clone, Copy)]
+    struct Twins;
+    impl DiracSystem<2> for Twins {
+        fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+            (v[0] * v[0] + v[1] * v[1]) * 0.5
+        }
+        fn coordinate_name(&self, _i: usize) -> String {
+            "x".into()
+        }
+    }
+    let junction = [Junction::new("j").flow("a.x", 1.0).flow("b.q", -1.0)];
+    let why = invalid(Interconnection::<_, _, 2, 1, 3, 1>::new(
+        ("a", Twins),
+        ("b", Inductor { l: 1.0 }),
+        junction,
+    ));
+    assert!(why.contains("both named \"a.x\""), "{why}");
+
+    let huge = [Junction::new("j").flow("l.q", 1e200).flow("c.q", -1e200)];
+    let system = Interconnection::<_, _, 1, 1, 2, 1>::new(
+        ("l", Inductor { l: 1.0 }),
+        ("c", Capacitor { c: 1.0 }),
+        huge,
+    )
+    .unwrap();
+    assert_eq!(system.junctions().row(0), &vector![1e200, -1e200]);
+    // Its step is refused as singular (the row is 1e200 times the others): an error.
+    let mut stepper = Stepper::new(system, Quadrature::midpoint(), 0.1).unwrap();
+    let refused = stepper
+        .start_from_velocity(vector![1.0, 1.0], SVector::zeros())
+        .and_then(|()| stepper.step());
+    assert!(matches!(refused, Err(DiracError::SingularJacobian { .. })), "{refused:?}");
+    let system = circuit::lc_from_subcircuits(&UNEQUAL).unwrap();
+    let mut stepper = Stepper::new(system.clone(), Quadrature::midpoint(), 0.1).unwrap();
+    stepper
+        .start_from_velocity(vector![0.0, 1.0, 0.14, 0.4], SVector::zeros())
+        .unwrap();
+    let q = stepper.q();
+    stepper.step().unwrap();
+    for h in [0.0, -0.1, f64::NAN] {
+        assert!(matches!(
+            system.ports(&q, &stepper.q(), stepper.multipliers(), h),
+            Err(DiracError::InvalidStep { .. })
+        ));
+    }
+    assert!(system.ports(&q, &stepper.q(), &[], 0.1).is_err());
 }

@@ -256,6 +256,13 @@ fn component(model: &Model, n: &TokenStream) -> TokenStream {
     let item = &model.item;
     let name = &item.ident;
     let (impl_generics, ty_generics, where_clause) = item.generics.split_for_impl();
+    let point = match (model.one_forms.is_empty(), &model.constraint_point) {
+        (true, _) => quote!(::core::option::Option::None),
+        (false, Some(point)) => quote!(::core::option::Option::Some(#point)),
+        (false, None) => quote!(::core::option::Option::Some(
+            __dirac::ConstraintPoint::Midpoint
+        )),
+    };
     let entries = model
         .coordinates
         .iter()
@@ -281,6 +288,9 @@ fn component(model: &Model, n: &TokenStream) -> TokenStream {
             pub const fn __dirac_coordinate(__path: &str) -> ::core::option::Option<usize> {
                 __dirac::slot::coordinate_index(__path, &[#(#entries),*])
             }
+
+            #[doc(hidden)]
+            pub const __DIRAC_CONSTRAINT_POINT: ::core::option::Option<__dirac::ConstraintPoint> = #point;
         }
     }
 }

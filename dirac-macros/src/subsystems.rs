@@ -335,7 +335,10 @@ fn dependent(junctions: &[Junction]) -> Option<(usize, Vec<usize>)> {
     // Orthonormal basis, each with its expression in the junctions' rows.
     let mut basis: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
     for (j, junction) in junctions.iter().enumerate() {
+        // Scaled to a largest entry of 1: no coefficient overflows or underflows.
         let original = row(junction);
+        let largest = original.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let original: Vec<f64> = original.iter().map(|x| x / largest).collect();
         let mut rest = original.clone();
         let mut expression = vec![0.0; junctions.len()];
         expression[j] = 1.0;
@@ -450,8 +453,32 @@ pub fn expand(model: &Composite) -> TokenStream {
             }
         }
     });
+    let disagreements = labels.iter().enumerate().map(|(i, label)| {
+        let message = format!(
+            "subsystem `{label}` holds its one-forms at another constraint point than the \
+             constrained subsystems before it: give them one `constraint_at`"
+        );
+        quote_spanned!(fields[i].span()=> if __i == #i { ::core::panic!(#message) })
+    });
+    let own_point = match junction_count {
+        0 => quote!(__POINT),
+        _ => quote! {
+            match __POINT {
+                ::core::option::Option::None => ::core::option::Option::Some(__dirac::ConstraintPoint::Midpoint),
+                __point => __point,
+            }
+        },
+    };
     let implementation = quote! {
         #(#size_items)*
+        const __POINT: ::core::option::Option<__dirac::ConstraintPoint> =
+            match __dirac::slot::common_point(&[#(<#types>::__DIRAC_CONSTRAINT_POINT),*]) {
+                ::core::result::Result::Ok(__point) => __point,
+                ::core::result::Result::Err(__i) => {
+                    #(#disagreements)*
+                    ::core::panic!("subsystems hold their one-forms at different constraint points")
+                }
+            };
         const __N: usize = 0usize #(+ #sizes)*;
         #(#slot_items)*
         const __END: __dirac::slot::Slot = #end;
@@ -467,6 +494,9 @@ pub fn expand(model: &Composite) -> TokenStream {
                 #(#lookups)*
                 ::core::option::Option::None
             }
+
+            #[doc(hidden)]
+            pub const __DIRAC_CONSTRAINT_POINT: ::core::option::Option<__dirac::ConstraintPoint> = #own_point;
         }
 
         #[automatically_derived]
@@ -559,12 +589,10 @@ pub fn expand(model: &Composite) -> TokenStream {
             }
 
             fn constraint_point(&self) -> __dirac::ConstraintPoint {
-                #(
-                    if #systems::ONE_FORMS > 0 {
-                        return self.#fields.constraint_point();
-                    }
-                )*
-                __dirac::ConstraintPoint::Midpoint
+                match __POINT {
+                    ::core::option::Option::Some(__point) => __point,
+                    ::core::option::Option::None => __dirac::ConstraintPoint::Midpoint,
+                }
             }
 
             fn parameters(&self) -> ::std::vec::Vec<(::std::string::String, f64)> {

@@ -167,7 +167,7 @@ pub trait Interconnected<const N: usize, const K: usize, const C: usize>: DiracS
     ) -> Result<Ports<C, K>, DiracError> {
         let junctions = self.junctions();
         let impulses = junctions.multipliers(multipliers, Self::ONE_FORMS, Self::HOLONOMIC)?;
-        Ok(junctions.ports(q_k, q_next, impulses, h, |i| self.component_of(i)))
+        junctions.ports(q_k, q_next, impulses, h, |i| self.component_of(i))
     }
 }
 
@@ -197,6 +197,17 @@ impl<const N: usize, const C: usize> Junctions<N, C> {
             if instances[..k].contains(name) {
                 return invalid(format!("two instances are named {name:?}: name them apart"));
             }
+        }
+        if let Some((k, name)) = coordinates
+            .iter()
+            .enumerate()
+            .find(|(k, name)| coordinates[..*k].contains(name))
+        {
+            let first = coordinates[..k].iter().position(|n| n == name).unwrap_or(k);
+            return invalid(format!(
+                "coordinates {first} and {k} are both named {name:?}: a junction could not tell \
+                 them apart (name a component's coordinates apart)"
+            ));
         }
         let mut rows = [SVector::<f64, N>::zeros(); C];
         for (j, junction) in junctions.iter().enumerate() {
@@ -281,8 +292,8 @@ impl<const N: usize, const C: usize> Junctions<N, C> {
         multipliers: &'m [f64],
         one_forms: usize,
         holonomic: usize,
-    ) -> Result<&'m [f64], DiracError> {
-        if multipliers.len() != one_forms + holonomic {
+    ) -> Result<&'m [f64; C], DiracError> {
+        if multipliers.len() != one_forms + holonomic || one_forms < C {
             return Err(DiracError::Unsupported(format!(
                 "port readings from {} multipliers: the interconnection has {one_forms} \
                  one-forms and {holonomic} holonomic constraints, held once per step by degree-1 \
@@ -290,20 +301,25 @@ impl<const N: usize, const C: usize> Junctions<N, C> {
                 multipliers.len(),
             )));
         }
-        Ok(&multipliers[one_forms - C..one_forms])
+        multipliers[one_forms - C..one_forms]
+            .try_into()
+            .map_err(|_| DiracError::Dimension("junction multipliers".into()))
     }
 
     /// What crossed the junctions over the step of size `h` from `q_k` to `q_{k+1}` with the
     /// junctions' `impulses`, the work summed per component, `part(i)` the component of
-    /// coordinate `i`.
+    /// coordinate `i` (below `K`); an `Err(InvalidStep)` for `h` not positive and finite.
     pub fn ports<const K: usize>(
         &self,
         q_k: &SVector<f64, N>,
         q_next: &SVector<f64, N>,
-        impulses: &[f64],
+        impulses: &[f64; C],
         h: f64,
         part: impl Fn(usize) -> usize,
-    ) -> Ports<C, K> {
+    ) -> Result<Ports<C, K>, DiracError> {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(DiracError::InvalidStep { h });
+        }
         let step = q_next - q_k;
         let mut work = [0.0; K];
         let mut scale: f64 = 0.0;
@@ -316,16 +332,19 @@ impl<const N: usize, const C: usize> Junctions<N, C> {
                 scale = scale.max((force * size).abs());
             }
         }
-        Ports {
-            efforts: std::array::from_fn(|j| impulses[j] / h),
+        Ok(Ports {
+            efforts: impulses.map(|impulse| impulse / h),
             work,
             scale,
-        }
+        })
     }
 
-    /// Junction `j` over the scalar `D`.
+    /// Junction `j` over the scalar `D` (zero for `j >= C`).
     pub fn one_form<D: Scalar>(&self, j: usize) -> SVector<D, N> {
-        self.rows[j].map(D::from)
+        match self.rows.get(j) {
+            Some(row) => row.map(D::from),
+            None => SVector::from_element(D::from(0.0)),
+        }
     }
 }
 
@@ -429,33 +448,38 @@ where
     }
 }
 
-/// The first row of `rows` that is a combination of the rows before it (Gram–Schmidt with a
-/// second pass, relative tolerance 1e-10), with the rows it combines: `None` when they are
-/// independent.
+/// The first row of `rows` that is a combination of the rows before it, with the rows it
+/// combines: `None` when they are independent. Gram–Schmidt with a second pass on the rows
+/// scaled to a largest entry of 1 (so that no coefficient overflows or underflows), each basis
+/// vector carrying its expression in the rows; a row whose remainder is below 1e-10 of its
+/// norm is dependent, on the rows of weight above 1e-9 of the largest in that remainder.
 fn dependent_row<const N: usize>(rows: &[SVector<f64, N>]) -> Option<(usize, Vec<usize>)> {
-    let mut basis: Vec<SVector<f64, N>> = Vec::new();
+    let mut basis: Vec<(SVector<f64, N>, Vec<f64>)> = Vec::new();
     for (j, row) in rows.iter().enumerate() {
-        let mut rest = *row;
+        let scaled = row / row.amax();
+        let mut rest = scaled;
+        let mut expression = vec![0.0; rows.len()];
+        expression[j] = 1.0;
         for _ in 0..2 {
-            for e in &basis {
-                rest -= e * e.dot(&rest);
+            for (e, combination) in &basis {
+                let c = e.dot(&rest);
+                rest -= e * c;
+                expression
+                    .iter_mut()
+                    .zip(combination)
+                    .for_each(|(x, y)| *x -= c * y);
             }
         }
-        if rest.norm() <= 1e-10 * row.norm() {
-            // Which earlier rows it combines: the least-squares coefficients over them.
-            let earlier = nalgebra::DMatrix::from_fn(N, j, |i, k| rows[k][i]);
-            let target = nalgebra::DVector::from_fn(N, |i, _| row[i]);
-            let coefficients = earlier
-                .svd(true, true)
-                .solve(&target, 1e-12)
-                .unwrap_or_else(|_| nalgebra::DVector::zeros(j));
-            let largest = coefficients.amax();
+        let norm = rest.norm();
+        if norm <= 1e-10 * scaled.norm() {
+            let largest = expression[..j].iter().fold(0.0f64, |m, x| m.max(x.abs()));
             let on = (0..j)
-                .filter(|&k| coefficients[k].abs() > 1e-9 * largest)
+                .filter(|&k| expression[k].abs() > 1e-9 * largest)
                 .collect();
             return Some((j, on));
         }
-        basis.push(rest / rest.norm());
+        expression.iter_mut().for_each(|x| *x /= norm);
+        basis.push((rest / norm, expression));
     }
     None
 }
@@ -513,7 +537,10 @@ where
         Self::A
             .one_form(&self.a, q, index)
             .or_else(|| Self::B.one_form(&self.b, q, index))
-            .unwrap_or_else(|| self.junctions.one_form(index - A::ONE_FORMS - B::ONE_FORMS))
+            .unwrap_or_else(|| {
+                self.junctions
+                    .one_form(index.saturating_sub(A::ONE_FORMS + B::ONE_FORMS))
+            })
     }
 
     fn holonomic<D: Scalar>(&self, q: &SVector<D, N>, index: usize) -> D {
@@ -544,11 +571,15 @@ where
             .unwrap_or_else(|| format!("u{i}"))
     }
 
+    /// The constrained components' constraint point (they agree: checked when built), or the
+    /// midpoint.
     fn constraint_point(&self) -> ConstraintPoint {
         if A::ONE_FORMS > 0 {
             self.a.constraint_point()
-        } else {
+        } else if B::ONE_FORMS > 0 {
             self.b.constraint_point()
+        } else {
+            ConstraintPoint::Midpoint
         }
     }
 

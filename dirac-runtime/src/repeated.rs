@@ -36,7 +36,7 @@ use nalgebra::SVector;
 use crate::closed_form::{LagrangianGradient, LagrangianHessian};
 use crate::constraint_point::ConstraintPoint;
 use crate::error::DiracError;
-use crate::interconnection::{Interconnected, Junction, Junctions};
+use crate::interconnection::{Interconnected, Junction, Junctions, common_quadrature};
 use crate::quadrature::Quadrature;
 use crate::scalar::Scalar;
 use crate::slot::Slot;
@@ -57,7 +57,8 @@ impl<S: DiracSystem<M>, const K: usize, const M: usize, const N: usize, const C:
     /// The copies `parts`, named `name[0]`, `name[1]`, …, joined by `junctions` over their
     /// coordinates `name[i].coordinate`; an `Err(InvalidInterconnection)` as
     /// [`Interconnection::new`](crate::interconnection::Interconnection::new) (and for a `name`
-    /// that is empty or contains `.` or `[`).
+    /// that is empty or contains `.` or `[`, and copies holding their one-forms at different
+    /// constraint points).
     pub fn new(name: &str, parts: [S; K], junctions: [Junction; C]) -> Result<Self, DiracError> {
         const { assert!(N == K * M, "K copies of a model on R^M are on R^(K M)") };
         if name.is_empty() || name.contains(['.', '[']) {
@@ -66,6 +67,17 @@ impl<S: DiracSystem<M>, const K: usize, const M: usize, const N: usize, const C:
             )));
         }
         let instances: [String; K] = std::array::from_fn(|i| format!("{name}[{i}]"));
+        let point = parts[0].constraint_point();
+        if let Some(i) = (0..K).find(|&i| S::ONE_FORMS > 0 && parts[i].constraint_point() != point)
+        {
+            return Err(DiracError::InvalidInterconnection(format!(
+                "{} holds its one-forms at {point:?} and {} at {:?}: the copies need one \
+                 constraint point",
+                instances[0],
+                instances[i],
+                parts[i].constraint_point()
+            )));
+        }
         let coordinates: Vec<String> = (0..N)
             .map(|i| {
                 format!(
@@ -162,8 +174,9 @@ impl<S: DiracSystem<M>, const K: usize, const M: usize, const N: usize, const C:
 
     fn holonomic<D: Scalar>(&self, q: &SVector<D, N>, index: usize) -> D {
         let i = index / S::HOLONOMIC.max(1);
-        Self::slot(i)
-            .holonomic(&self.parts[i], q, index)
+        self.parts
+            .get(i)
+            .and_then(|part| Self::slot(i).holonomic(part, q, index))
             .unwrap_or(D::from(0.0))
     }
 
@@ -183,19 +196,26 @@ impl<S: DiracSystem<M>, const K: usize, const M: usize, const N: usize, const C:
 
     fn input_name(&self, i: usize) -> String {
         let copy = i / S::INPUTS.max(1);
-        Self::slot(copy)
-            .input_name(&self.parts[copy], &self.instances[copy], i)
+        self.parts
+            .get(copy)
+            .and_then(|part| Self::slot(copy).input_name(part, &self.instances[copy], i))
             .unwrap_or_else(|| format!("u{i}"))
     }
 
+    /// The copies' constraint point (they agree: checked when built), or the midpoint when
+    /// they have no one-forms of their own.
     fn constraint_point(&self) -> ConstraintPoint {
-        self.parts[0].constraint_point()
+        match S::ONE_FORMS {
+            0 => ConstraintPoint::Midpoint,
+            _ => self.parts[0].constraint_point(),
+        }
     }
 
     fn coordinate_name(&self, i: usize) -> String {
         let copy = i / M;
-        Self::slot(copy)
-            .coordinate_name(&self.parts[copy], &self.instances[copy], i)
+        self.parts
+            .get(copy)
+            .and_then(|part| Self::slot(copy).coordinate_name(part, &self.instances[copy], i))
             .unwrap_or_else(|| format!("q{i}"))
     }
 
@@ -207,8 +227,14 @@ impl<S: DiracSystem<M>, const K: usize, const M: usize, const N: usize, const C:
         parameters
     }
 
-    /// The copies' quadrature.
+    /// The quadrature the copies agree on, or an `Err` naming two that differ.
     fn quadrature(&self) -> Result<Quadrature, DiracError> {
-        self.parts[0].quadrature()
+        let named = self
+            .instances
+            .iter()
+            .zip(&self.parts)
+            .map(|(name, part)| Ok((name.as_str(), part.quadrature()?)))
+            .collect::<Result<Vec<_>, DiracError>>()?;
+        common_quadrature(&named)
     }
 }

@@ -28,6 +28,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::closed_form::{LagrangianGradient, LagrangianHessian};
+use crate::constraint_point::ConstraintPoint;
 use crate::legendre;
 use crate::scalar::Scalar;
 use crate::system::DiracSystem;
@@ -324,4 +325,33 @@ const fn equal(a: &[u8], b: &[u8]) -> bool {
         i += 1;
     }
     true
+}
+
+/// The constraint point the constrained parts of a model agree on (`Ok(None)` when none has
+/// one-forms), or `Err(i)` with the first part `i` that disagrees with the constrained parts
+/// before it: a `const fn`, so that the attribute's models made of subsystems refuse
+/// disagreeing subsystems when the program compiles.
+///
+/// ```
+/// use dirac_runtime::ConstraintPoint::{End, Midpoint};
+/// use dirac_runtime::slot::common_point;
+/// assert_eq!(common_point(&[None, Some(End), Some(End)]), Ok(Some(End)));
+/// assert_eq!(common_point(&[Some(End), None, Some(Midpoint)]), Err(2));
+/// ```
+pub const fn common_point(
+    points: &[Option<ConstraintPoint>],
+) -> Result<Option<ConstraintPoint>, usize> {
+    let mut found: Option<ConstraintPoint> = None;
+    let mut i = 0;
+    while i < points.len() {
+        if let Some(point) = points[i] {
+            match found {
+                None => found = Some(point),
+                Some(first) if first as u8 != point as u8 => return Err(i),
+                Some(_) => {}
+            }
+        }
+        i += 1;
+    }
+    Ok(found)
 }

@@ -202,6 +202,46 @@ pub fn lc_from_subcircuits(c: &LcCircuit) -> Result<LcFromSubcircuits, DiracErro
     )
 }
 
+/// The LC circuit's loop, written with the attribute.
+#[dirac_system(subsystems(l, c2), junctions(series = l.dq - c2.dq))]
+#[derive(Debug, Clone, Copy)]
+pub struct Loop {
+    pub l: Inductor,
+    pub c2: Capacitor,
+}
+
+/// C1 and C3, written with the attribute.
+#[dirac_system(subsystems(c1, c3))]
+#[derive(Debug, Clone, Copy)]
+pub struct Pair {
+    pub c1: Capacitor,
+    pub c3: Capacitor,
+}
+
+/// The LC circuit from its subcircuits, written with the attribute (two levels).
+#[dirac_system(subsystems(loop_, pair), junctions(kcl = loop_.c2.dq - pair.c1.dq - pair.c3.dq))]
+#[derive(Debug, Clone, Copy)]
+pub struct LcByAttribute {
+    pub loop_: Loop,
+    pub pair: Pair,
+}
+
+impl LcByAttribute {
+    /// The circuit `c` from its parts.
+    pub fn of(c: &LcCircuit) -> Self {
+        Self {
+            loop_: Loop {
+                l: Inductor { l: c.l },
+                c2: Capacitor { c: c.c2 },
+            },
+            pair: Pair {
+                c1: Capacitor { c: c.c1 },
+                c3: Capacitor { c: c.c3 },
+            },
+        }
+    }
+}
+
 /// A resistor in series with a voltage source.
 pub type Drive = Interconnection<Resistor, Source, 1, 1, 2, 1>;
 /// The RLC circuit: the LC circuit with the drive on its inductor branch.

@@ -42,19 +42,27 @@ pub type Ladder = Repeated<LadderCell, CELLS, 2, { 2 * CELLS }, CELLS>;
 /// The chain of masses closed into a ring.
 pub type Chain = Repeated<Tethered, CELLS, 2, { 2 * CELLS }, CELLS>;
 
-/// The ladder of inductance `l` and capacitance `c` per cell.
+/// The ladder of `CELLS` cells of inductance `l` and capacitance `c`.
 pub fn ladder(l: f64, c: f64) -> Result<Ladder, DiracError> {
+    ring(l, c)
+}
+
+/// A ladder of `K` cells closed into a ring (`N = 2K` coordinates).
+pub fn ring<const K: usize, const N: usize>(
+    l: f64,
+    c: f64,
+) -> Result<Repeated<LadderCell, K, 2, N, K>, DiracError> {
     let kcl = |j: usize| {
-        Junction::new(format!("kcl{}", (j + 1) % CELLS))
+        Junction::new(format!("kcl{}", (j + 1) % K))
             .flow(format!("cell[{j}].l.q"), 1.0)
             .flow(format!("cell[{j}].c.q"), -1.0)
-            .flow(format!("cell[{}].l.q", (j + 1) % CELLS), -1.0)
+            .flow(format!("cell[{}].l.q", (j + 1) % K), -1.0)
     };
     let cell = LadderCell {
         l: Inductor { l },
         c: Capacitor { c },
     };
-    Repeated::new("cell", [cell; CELLS], std::array::from_fn(kcl))
+    Repeated::new("cell", [cell; K], std::array::from_fn(kcl))
 }
 
 /// The chain of masses `m` and springs `k`.

@@ -85,8 +85,11 @@ fn main() -> Result<(), DiracError> {
     let mut stepper = Stepper::from_system(series, 0.05)?;
     stepper.start_from_velocity(vector![0.0, 0.0, 1.0], SVector::zeros())?;
     stepper.run(200)?;
-    // Underdamped: the capacitor's charge decays as e^(−r t / 2l) (at t = 10, about 0.61).
-    let envelope = (-0.05f64 * 10.0).exp();
-    assert!(stepper.q()[2].abs() <= envelope * 1.01);
+    // The damped oscillation l q̈ + r q̇ + q/c = 0 from q = 1 at rest, at t = 10:
+    // q = e^(−αt) (cos ω t + (α/ω) sin ω t), α = r/2l, ω = √(1/lc − α²).
+    let (alpha, t) = (0.05f64, 10.0);
+    let omega = (1.0 - alpha * alpha).sqrt();
+    let exact = (-alpha * t).exp() * ((omega * t).cos() + alpha / omega * (omega * t).sin());
+    assert!((stepper.q()[2] - exact).abs() < 1e-5, "{} against {exact}", stepper.q()[2]);
     Ok(())
 }
