@@ -609,7 +609,10 @@ fn edge_cases_are_errors_not_panics() {
     let refused = stepper
         .start_from_velocity(vector![1.0, 1.0], SVector::zeros())
         .and_then(|()| stepper.step());
-    assert!(matches!(refused, Err(DiracError::SingularJacobian { .. })), "{refused:?}");
+    assert!(
+        matches!(refused, Err(DiracError::SingularJacobian { .. })),
+        "{refused:?}"
+    );
     let system = circuit::lc_from_subcircuits(&UNEQUAL).unwrap();
     let mut stepper = Stepper::new(system.clone(), Quadrature::midpoint(), 0.1).unwrap();
     stepper

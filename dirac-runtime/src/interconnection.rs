@@ -18,10 +18,12 @@
 //! The work done on component `A` over the step is `W_A = Σ_j e_j ⟨c_j^A, q_{k+1}^A − q_k^A⟩`
 //! (its rows' part on `A`'s coordinates), and likewise for `B`. Since the step holds every
 //! junction, `Σ_j c_j (q_{k+1} − q_k) = 0`, Tellegen's theorem holds step by step:
-//! `W_A + W_B = Σ_j e_j c_j (q_{k+1} − q_k) = 0`. With the midpoint rule (its impulse split
-//! `σ = ½`) and components whose Lagrangians are quadratic, each component's energy then changes
-//! over the step by exactly its port work plus its own forces' work: `E_A(k+1) − E_A(k) = W_A`
-//! for a conservative component (`tests/interconnection.rs` checks both to round-off).
+//! `W_A + W_B = Σ_j e_j c_j (q_{k+1} − q_k) = 0`. With the midpoint rule at the constraint
+//! point `Midpoint` (the impulse split `σ = ½`) and components whose Lagrangians are quadratic
+//! and who have no holonomic constraints, each component's energy then changes over the step by
+//! exactly its port work plus its own forces' work: `E_A(k+1) − E_A(k) = W_A` for a
+//! conservative component (`tests/interconnection.rs` checks both to round-off). For a
+//! nonlinear component the balance holds to the method's order.
 //!
 //! ```
 //! use dirac_runtime::interconnection::{Interconnection, Junction};
