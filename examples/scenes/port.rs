@@ -92,17 +92,7 @@ pub fn from_components(p: &Port) -> Result<FromComponents, DiracError> {
 /// The tour's row: the port scene from its components against the monolithic one to T = 10,
 /// and its ports read at every step.
 pub fn components_report() -> Result<Report, DiracError> {
-    let h = 0.01;
     let joined = from_components(&SCENE)?;
-    let mut parts = Stepper::new(joined.clone(), Quadrature::midpoint(), h)?;
-    parts.start_from_velocity(q0(), SVector::zeros())?;
-    let mut whole = Stepper::new(SCENE, Quadrature::midpoint(), h)?;
-    whole.start_from_velocity(q0(), SVector::zeros())?;
-    let mut gap: f64 = 0.0;
-    for _ in 0..(10.0 / h) as usize {
-        parts.step()?;
-        whole.step()?;
-        gap = gap.max((parts.q() - whole.q()).amax());
-    }
+    let gap = super::ports::gap_to_whole(joined.clone(), SCENE, q0(), [0, 1, 2])?;
     super::ports::report("port (2 parts)", &joined, q0(), gap)
 }

@@ -84,3 +84,27 @@ where
         ),
     })
 }
+
+/// The largest distance, over the steps to T = 10 (midpoint, h = 0.01, from rest), between the
+/// model built from `parts` started at `q0` and the same model written `whole`, its coordinate
+/// `i` the parts' coordinate `order[i]`.
+pub fn gap_to_whole<P: DiracSystem<N>, W: DiracSystem<N>, const N: usize>(
+    parts: P,
+    whole: W,
+    q0: SVector<f64, N>,
+    order: [usize; N],
+) -> Result<f64, DiracError> {
+    let h = 0.01;
+    let mut parts = Stepper::new(parts, Quadrature::midpoint(), h)?;
+    let mut whole = Stepper::new(whole, Quadrature::midpoint(), h)?;
+    parts.start_from_velocity(q0, SVector::zeros())?;
+    whole.start_from_velocity(SVector::from_fn(|i, _| q0[order[i]]), SVector::zeros())?;
+    let mut gap: f64 = 0.0;
+    for _ in 0..(10.0 / h) as usize {
+        parts.step()?;
+        whole.step()?;
+        let (a, b) = (parts.q(), whole.q());
+        gap = (0..N).fold(gap, |gap, i| gap.max((a[order[i]] - b[i]).abs()));
+    }
+    Ok(gap)
+}
