@@ -355,6 +355,15 @@ fn the_attributes_subsystems_equal_the_plain_rust_interconnection() {
         rust.step().unwrap();
         assert_eq!((attribute.q(), attribute.p()), (rust.q(), rust.p()));
     }
+    // The attribute's model reads its ports like the plain-Rust one (midpoint).
+    assert_eq!(parts.junctions().names(), &["kcl".to_string()]);
+    assert_eq!(parts.junctions().row(0), plain.junctions().row(0));
+    let found = ports::balance(&parts, (q0, v0), 0.01, 500).unwrap();
+    let reference = ports::balance(&plain, (q0, v0), 0.01, 500).unwrap();
+    assert_eq!(
+        (found.tellegen, found.energy, found.largest_work),
+        (reference.tellegen, reference.energy, reference.largest_work)
+    );
     let (q, v) = (vector![0.1, 0.9, 0.2, 0.3], vector![0.4, 0.4, 0.1, 0.3]);
     assert_eq!(
         parts.lagrangian_hessian(&q, &v),

@@ -606,10 +606,42 @@ pub fn expand(model: &Composite) -> TokenStream {
             }
         }
     };
+    let junction_names = model.junctions.iter().map(|j| j.name.as_str());
+    let indices = 0..k;
+    let interconnected = quote! {
+        #[automatically_derived]
+        impl __dirac::Interconnected<{ __N }, #k, #junction_count> for #name {
+            fn junctions(&self) -> &__dirac::Junctions<{ __N }, #junction_count> {
+                static __JUNCTIONS: ::std::sync::OnceLock<__dirac::Junctions<{ __N }, #junction_count>> =
+                    ::std::sync::OnceLock::new();
+                __JUNCTIONS.get_or_init(|| {
+                    __dirac::Junctions::from_terms(
+                        [#(::std::string::String::from(#junction_names)),*],
+                        &__TERMS,
+                    )
+                })
+            }
+
+            fn energies(&self, __q: &#real, __v: &#real) -> [f64; #k] {
+                [#(#slots.energy(&self.#fields, __q, __v)),*]
+            }
+
+            fn component_of(&self, __i: usize) -> usize {
+                let mut __c = 0;
+                #(
+                    if __i >= #slots.coordinate {
+                        __c = #indices;
+                    }
+                )*
+                __c
+            }
+        }
+    };
     let implementation = quote! {
         const _: () = {
             use #krate as __dirac;
             #implementation
+            #interconnected
         };
     };
     quote!(#item #implementation)

@@ -275,6 +275,16 @@ impl<const N: usize, const C: usize> Junctions<N, C> {
         Ok(Self { names, rows })
     }
 
+    /// Junctions given as `(junction, coordinate index, coefficient)` terms, already checked
+    /// (`#[dirac_system(subsystems(...))]` checks them when the program compiles).
+    pub fn from_terms(names: [String; C], terms: &[(usize, usize, f64)]) -> Self {
+        let mut rows = [SVector::<f64, N>::zeros(); C];
+        for &(j, i, coefficient) in terms {
+            rows[j][i] = coefficient;
+        }
+        Self { names, rows }
+    }
+
     /// The junctions' names, in the order of their multipliers.
     pub fn names(&self) -> &[String; C] {
         &self.names
