@@ -159,17 +159,18 @@ fn port_scene_from_two_components_equals_the_monolithic_scene() {
 /// Tellegen's theorem and each component's discrete energy balance, at every step: on the LC
 /// circuit from its subcircuits and on the port scene from its components (midpoint rule,
 /// quadratic Lagrangians), `W_A + W_B = 0` to round-off of the work's terms and
-/// `E_A(k+1) − E_A(k) = W_A`, `E_B(k+1) − E_B(k) = W_B` to round-off of the energies.
+/// `E_A(k+1) − E_A(k) = W_A`, `E_B(k+1) − E_B(k) = W_B` to round-off of the energies in play
+/// (measured 3e-16 and 8e-16; asserted 1e-14).
 #[test]
 fn ports_keep_tellegen_and_each_components_energy_balance() {
     let check = |what: &str, found: ports::Balance| {
         assert!(
-            found.tellegen < 1e-13,
+            found.tellegen < 1e-14,
             "{what}: W_A + W_B = {:e} of the terms",
             found.tellegen
         );
         assert!(
-            found.energy < 1e-13,
+            found.energy < 1e-14,
             "{what}: energy balance off by {:e}",
             found.energy
         );
@@ -479,9 +480,8 @@ fn the_ladders_cells_balance_their_energy_through_the_ports() {
     let wave = ladder::ladder_wave(mode, ladder::lattice_frequency(1.0, kappa));
     let system = ladder::ladder(1.0, 1.0).unwrap();
     let found = ports::balance(&system, wave, 0.05, 400).unwrap();
-    eprintln!("ladder ports: {found:?}");
-    assert!(found.tellegen < 1e-13, "{found:?}");
-    assert!(found.energy < 1e-13, "{found:?}");
+    assert!(found.tellegen < 1e-14, "{found:?}");
+    assert!(found.energy < 1e-14, "{found:?}");
     assert!(found.largest_work > 1e-5, "{found:?}");
 }
 

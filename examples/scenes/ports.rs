@@ -12,8 +12,8 @@ use super::Report;
 pub struct Balance {
     /// `|W_A + W_B|` relative to the size of the work's terms (Tellegen: zero to round-off).
     pub tellegen: f64,
-    /// `|E_c(k+1) − E_c(k) − W_c|` over the components `c`, relative to the larger of the
-    /// energies and the work's terms.
+    /// `|E_c(k+1) − E_c(k) − W_c|` over the components `c`, relative to the largest of the
+    /// components' energies and the work's terms.
     pub energy: f64,
     /// The largest port work on a component over a step (the identities are not vacuous).
     pub largest_work: f64,
@@ -44,9 +44,14 @@ where
             .tellegen
             .max(ports.net_work().abs() / ports.scale.max(f64::MIN_POSITIVE));
         let next = system.energies(&stepper.q(), &stepper.v()?);
+        // Relative to the energies in play and the work's terms: the ports move energy between
+        // the parts, so a part's balance carries the round-off of the others' (a capacitor's
+        // energy passes 0 while the inductor's is large).
+        let scale = e
+            .iter()
+            .chain(&next)
+            .fold(ports.scale, |m, x| m.max(x.abs()));
         for c in 0..K {
-            // Relative to the energies and the work's terms (a capacitor's energy passes 0).
-            let scale = e[c].abs().max(next[c].abs()).max(ports.scale);
             found.energy = found
                 .energy
                 .max((next[c] - e[c] - ports.work[c]).abs() / scale);
