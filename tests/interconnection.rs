@@ -637,3 +637,62 @@ fn edge_cases_are_errors_not_panics() {
     }
     assert!(system.ports(&q, &stepper.q(), &[], 0.1).is_err());
 }
+
+/// A model that answers `one_form_is_constant` as told, delegating the rest to `inner`.
+#[derive(Debug, Clone, Copy)]
+struct Claims<S> {
+    inner: S,
+    constant: bool,
+}
+
+impl<S: DiracSystem<N>, const N: usize> DiracSystem<N> for Claims<S> {
+    const ONE_FORMS: usize = S::ONE_FORMS;
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D {
+        self.inner.lagrangian(q, v)
+    }
+    fn one_form<D: Scalar>(&self, q: &SVector<D, N>, a: usize) -> SVector<D, N> {
+        self.inner.one_form(q, a)
+    }
+    fn one_form_is_constant(&self, _a: usize) -> bool {
+        self.constant
+    }
+}
+
+/// Constant one-forms (Kirchhoff's laws, junctions) are read without dual numbers: the steps
+/// are bit for bit those that differentiate them (the LC circuit, 1 000 steps), the attribute
+/// says which of a model's one-forms are constant, and a one-form wrongly said constant is
+/// refused at the start, naming it.
+#[test]
+fn constant_one_forms_are_read_without_differentiating_them() {
+    assert!(circuit::LC.one_form_is_constant(0) && circuit::LC.one_form_is_constant(1));
+    assert!(!scenes::knife_edge::SCENE.one_form_is_constant(0));
+    let lc = circuit::lc_from_subcircuits(&UNEQUAL).unwrap();
+    assert!((0..2).all(|a| lc.one_form_is_constant(a)));
+    let step = |constant: bool| {
+        let system = Claims {
+            inner: UNEQUAL,
+            constant,
+        };
+        let mut stepper = Stepper::new(system, Quadrature::midpoint(), 0.01).unwrap();
+        stepper
+            .start_from_velocity(vector![0.0, 0.14, 1.0, 0.4], SVector::zeros())
+            .unwrap();
+        stepper.run(1000).unwrap();
+        (stepper.q(), stepper.p())
+    };
+    assert_eq!(step(true), step(false));
+
+    let knife = Claims {
+        inner: scenes::knife_edge::SCENE,
+        constant: true,
+    };
+    let mut stepper = Stepper::new(knife, Quadrature::midpoint(), 0.01).unwrap();
+    let refused = stepper.start_from_velocity(
+        vector![0.0, 0.0, 0.3],
+        vector![0.3f64.cos(), 0.3f64.sin(), 1.0],
+    );
+    assert!(
+        matches!(&refused, Err(DiracError::InconsistentDerivatives(why)) if why.contains("one-form 0")),
+        "{refused:?}"
+    );
+}

@@ -165,6 +165,8 @@ pub struct Model {
     pub parameters: Vec<Parameter>,
     /// Constraint one-forms, each a list of terms.
     pub one_forms: Vec<Vec<Term>>,
+    /// Whether each one-form's coefficients name no coordinate (the same covector at every `q`).
+    pub constant_one_forms: Vec<bool>,
     /// Holonomic constraints `g(q)`.
     pub holonomic: Vec<TokenStream>,
     /// Terms of all force one-forms together.

@@ -461,6 +461,16 @@ fn dirac_items(
                 __w
             }
         });
+        let constant = &model.constant_one_forms;
+        // (The Hamiltonian route's trait has no such method.)
+        if !model.hamiltonian && constant.iter().any(|&c| c) {
+            items.extend(quote! {
+                fn one_form_is_constant(&self, __a: usize) -> bool {
+                    const __CONSTANT: [bool; #count] = [#(#constant),*];
+                    __a < #count && __CONSTANT[__a]
+                }
+            });
+        }
     }
     if !model.holonomic.is_empty() {
         let count = model.holonomic.len();

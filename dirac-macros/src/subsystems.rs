@@ -549,6 +549,15 @@ pub fn expand(model: &Composite) -> TokenStream {
                 __w
             }
 
+            fn one_form_is_constant(&self, __a: usize) -> bool {
+                #(
+                    if let ::core::option::Option::Some(__c) = #slots.one_form_is_constant(&self.#fields, __a) {
+                        return __c;
+                    }
+                )*
+                true
+            }
+
             fn holonomic<__D: __dirac::Scalar>(&self, __q: &#dual, __b: usize) -> __D {
                 #(
                     if let ::core::option::Option::Some(__g) = #slots.holonomic(&self.#fields, __q, __b) {

@@ -190,6 +190,28 @@ fn repeated_attributes(item: &mut syn::ItemStruct, errors: &mut Errors) {
     });
 }
 
+/// Whether `form` (a one-form in differentials) names no coordinate outside its differentials,
+/// in the expressions the attribute reads (literals, parameters, constants, arithmetic and
+/// calls of them): its coefficients are then the same at every `q`. Anything else counts as
+/// depending on `q`.
+fn names_no_coordinate(form: &Expr, coordinates: &[Coordinate]) -> bool {
+    expression::subexpressions(form).all(|e| match e {
+        Expr::Path(p) => p
+            .path
+            .get_ident()
+            .is_none_or(|name| !coordinates.iter().any(|c| c.name == *name)),
+        Expr::Lit(_)
+        | Expr::Paren(_)
+        | Expr::Group(_)
+        | Expr::Unary(_)
+        | Expr::Binary(_)
+        | Expr::Index(_) => true,
+        Expr::Call(c) => !matches!(&*c.func, Expr::Path(f) if f.path.is_ident("dot")),
+        Expr::MethodCall(_) => true,
+        _ => false,
+    })
+}
+
 /// A model made of subsystems: the arguments of a model given by its own coordinates are
 /// refused, the rest is read by [`subsystems::model`](crate::subsystems::model).
 fn composite(
@@ -361,6 +383,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         }
     });
     let fields: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
+    let mut constant_one_forms = Vec::new();
     let (one_forms, holonomic, forces) = match &coordinates {
         Some(coordinates) => {
             let product = is_product(coordinates);
@@ -386,6 +409,15 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 })
             };
             let (positions_algebra, state_algebra) = (algebra(Some(NO_VELOCITIES)), algebra(None));
+            constant_one_forms = match product {
+                true => Vec::new(),
+                false => e
+                    .constraints
+                    .iter()
+                    .flatten()
+                    .map(|form| names_no_coordinate(form, coordinates))
+                    .collect(),
+            };
             let one_forms = e
                 .constraints
                 .unwrap_or_default()
@@ -447,6 +479,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 quadrature,
                 parameters,
                 one_forms,
+                constant_one_forms,
                 holonomic,
                 forces,
                 inputs,

@@ -32,7 +32,8 @@ use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
 
 /// One-form `a` read in the chart centred at `base`, at `xi`: the row `Ã_a(ξ)` and its
-/// derivative `∂Ã_a,i/∂ξ_j` (row `i`, column `j`).
+/// derivative `∂Ã_a,i/∂ξ_j` (row `i`, column `j`), `None` for a constant one-form on a
+/// translation chart (it is zero, and the step skips it).
 pub(crate) fn one_form_in_chart<
     S: DiracSystem<N, C::Manifold>,
     C: ConfigurationSpace<N>,
@@ -43,12 +44,40 @@ pub(crate) fn one_form_in_chart<
     base: &Point<C, N, f64>,
     xi: &SVector<f64, N>,
     a: usize,
-) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
+) -> (SVector<f64, N>, Option<SMatrix<f64, N, N>>) {
+    if C::TRANSLATION && system.one_form_is_constant(a) {
+        // On Rⁿ the chart is a translation: a constant one-form reads the same in it.
+        let row = space.pull_back(base, xi, &system.one_form(&space.retract(base, xi), a));
+        return (row, None);
+    }
     let xi = lift(xi, 1.0);
     let row = space.pull_back(base, &xi, &system.one_form(&space.retract(base, &xi), a));
     let value = row.map(|x| x.re);
     let derivative = SMatrix::<f64, N, N>::from_fn(|i, j| gradient(&row[i])[j]);
-    (value, derivative)
+    (value, Some(derivative))
+}
+
+/// Refuses a one-form the model says is constant whose derivative at `q` is not zero
+/// (`InconsistentDerivatives`, naming it): the runtime would otherwise drop that derivative.
+pub(crate) fn check_constant<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+) -> Result<(), crate::error::DiracError> {
+    for a in (0..S::ONE_FORMS).filter(|&a| system.one_form_is_constant(a)) {
+        let row = system.one_form(&lift(q, 1.0), a);
+        let scale = row.iter().fold(1.0f64, |m, x| m.max(x.re.abs()));
+        let moved = row
+            .iter()
+            .flat_map(|x| gradient(x).into_iter().copied().collect::<Vec<f64>>())
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        if moved > 1e-12 * scale {
+            return Err(crate::error::DiracError::InconsistentDerivatives(format!(
+                "one-form {a} is said to be constant (one_form_is_constant), but its \
+                 coefficients change with the position by {moved:e} per unit at the start"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Holonomic constraint `b` read in the chart centred at `base`, at `xi`: `g_b(R(ξ))` and its
@@ -68,12 +97,13 @@ pub(crate) fn holonomic_in_chart<
     (g.re, gradient(&g))
 }
 
-/// One-form `a` at `q` in the model's coordinates: `A_a(q)` and `∂A_a,i/∂q_j`.
+/// One-form `a` at `q` in the model's coordinates: `A_a(q)` and `∂A_a,i/∂q_j` (`None` when
+/// the one-form is constant).
 pub(crate) fn one_form<S: DiracSystem<N>, const N: usize>(
     system: &S,
     q: &SVector<f64, N>,
     a: usize,
-) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
+) -> (SVector<f64, N>, Option<SMatrix<f64, N, N>>) {
     one_form_in_chart(system, &Euclidean, q, &SVector::zeros(), a)
 }
 
@@ -137,16 +167,23 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             for i in 0..N {
                 residual[i] += share * mu * row[i];
                 jacobian[(i, col)] += share * row[i];
-                for j in 0..N {
-                    jacobian[(i, step_col + j)] += share * theta * mu * derivative[(i, j)];
-                }
             }
             // Ã_a(ξ_c) · ξ_s and its derivative in ξ_s (ξ_c moves with ξ_s by θ).
             residual[col] = row.dot(&step);
             scale = scale.max(row.abs().dot(&step.abs()));
-            let through_point = derivative.transpose() * step * theta;
             for j in 0..N {
-                jacobian[(col, step_col + j)] = row[j] + through_point[j];
+                jacobian[(col, step_col + j)] = row[j];
+            }
+            if let Some(derivative) = derivative {
+                for i in 0..N {
+                    for j in 0..N {
+                        jacobian[(i, step_col + j)] += share * theta * mu * derivative[(i, j)];
+                    }
+                }
+                let through_point = derivative.transpose() * step * theta;
+                for j in 0..N {
+                    jacobian[(col, step_col + j)] += through_point[j];
+                }
             }
         }
         (impulse, scale)
@@ -255,6 +292,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                     for r in 0..N {
                         residual[j * N + r] += lj * mu * row[r];
                         jacobian[(j * N + r, col)] += lj * row[r];
+                        let Some(derivative) = &derivative else {
+                            continue;
+                        };
                         for k in 1..=s {
                             for m in 0..N {
                                 jacobian[(j * N + r, layout.point(k) + m)] +=
@@ -266,7 +306,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 // A_a(Q_i) · Q̇_i, scaled by h to read as a displacement.
                 residual[col] = h * row.dot(&xi_dot);
                 scale = scale.max(h * row.abs().dot(&xi_dot.abs()));
-                let turning = derivative.transpose() * xi_dot;
+                let turning = derivative.map_or_else(SVector::zeros, |d| d.transpose() * xi_dot);
                 for k in 1..=s {
                     for m in 0..N {
                         jacobian[(col, layout.point(k) + m)] =

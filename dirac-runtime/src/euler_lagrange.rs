@@ -577,7 +577,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let turning: SMatrix<f64, N, N> = one_forms
             .iter()
             .zip(&mu)
-            .map(|((_, derivative), mu)| derivative * *mu)
+            .filter_map(|((_, derivative), mu)| derivative.map(|d| d * *mu))
             .sum();
         let curvature: SMatrix<f64, N, N> = (0..S::HOLONOMIC)
             .map(|b| crate::derivatives::holonomic_hessian(system, &state.q, b) * lambda[b])
@@ -602,6 +602,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 .copy_from(force);
         }
         for (a, (_, derivative)) in one_forms.iter().enumerate() {
+            let Some(derivative) = derivative else {
+                continue;
+            };
             let row = derivative.transpose() * xi_s;
             dr.view_mut((layout.one_form(a), 0), (1, N))
                 .copy_from(&row.transpose());
@@ -852,6 +855,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             });
         }
         crate::closed_form::check(system, q, v)?;
+        constraint::check_constant(system, q)?;
         initial_state::check(system, state.t, q, v, &self.inputs, tolerance)
             .map_err(DiracError::InconsistentInitialState)?;
         let hidden = HiddenConstraints::find(system, q, v, state.t, &self.inputs);

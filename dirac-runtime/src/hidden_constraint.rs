@@ -383,8 +383,7 @@ fn constant_forms<S: DiracSystem<N>, const N: usize>(system: &S, q: &SVector<f64
         && (0..S::ONE_FORMS).all(|a| {
             constraint::one_form(system, q, a)
                 .1
-                .iter()
-                .all(|x| *x == 0.0)
+                .is_none_or(|d| d.iter().all(|x| *x == 0.0))
         })
 }
 

@@ -555,6 +555,14 @@ where
             })
     }
 
+    /// The components' answer for theirs; the junctions are constant.
+    fn one_form_is_constant(&self, index: usize) -> bool {
+        Self::A
+            .one_form_is_constant(&self.a, index)
+            .or_else(|| Self::B.one_form_is_constant(&self.b, index))
+            .unwrap_or(true)
+    }
+
     fn holonomic<D: Scalar>(&self, q: &SVector<D, N>, index: usize) -> D {
         Self::A
             .holonomic(&self.a, q, index)

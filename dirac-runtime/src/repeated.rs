@@ -172,6 +172,15 @@ impl<S: DiracSystem<M>, const K: usize, const M: usize, const N: usize, const C:
         }
     }
 
+    /// The copies' answer for theirs; the junctions are constant.
+    fn one_form_is_constant(&self, index: usize) -> bool {
+        let i = index / S::ONE_FORMS.max(1);
+        self.parts
+            .get(i)
+            .and_then(|part| Self::slot(i).one_form_is_constant(part, index))
+            .unwrap_or(true)
+    }
+
     fn holonomic<D: Scalar>(&self, q: &SVector<D, N>, index: usize) -> D {
         let i = index / S::HOLONOMIC.max(1);
         self.parts

@@ -169,6 +169,19 @@ impl Slot {
         Some(form)
     }
 
+    /// Whether the whole model's one-form `index`, when it is one of the component's, is
+    /// constant (`None` when it is not the component's).
+    pub fn one_form_is_constant<S: DiracSystem<M>, const M: usize>(
+        &self,
+        component: &S,
+        index: usize,
+    ) -> Option<bool> {
+        let own = index
+            .checked_sub(self.one_form)
+            .filter(|&a| a < S::ONE_FORMS)?;
+        Some(component.one_form_is_constant(own))
+    }
+
     /// The whole model's holonomic constraint `index` when it is one of the component's.
     pub fn holonomic<S: DiracSystem<M>, D: Scalar, const N: usize, const M: usize>(
         &self,

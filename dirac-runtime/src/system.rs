@@ -88,6 +88,16 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
         M::zero()
     }
 
+    /// Whether one-form `a` is the same covector at every `q` (Kirchhoff's laws, junctions):
+    /// the runtime then reads it in `f64` without differentiating it. `false` by default;
+    /// `#[dirac_system]` says `true` for a one-form whose coefficients name no coordinate, and
+    /// interconnections for their junctions. A stepper checks the claim at the start of every
+    /// run (a one-form said constant whose derivative is not zero there is refused).
+    fn one_form_is_constant(&self, a: usize) -> bool {
+        let _ = a;
+        false
+    }
+
     /// Holonomic constraint `b` (`0 <= b < HOLONOMIC`): the value `g_b(q)`, zero on the
     /// constraint set. Its one-form `dg_b` is derived by dual numbers.
     fn holonomic<D: Scalar>(&self, q: &M::Point<D>, b: usize) -> D {
