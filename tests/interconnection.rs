@@ -696,3 +696,41 @@ fn constant_one_forms_are_read_without_differentiating_them() {
         "{refused:?}"
     );
 }
+
+/// Constraints that depend on each other across components (a junction restating a
+/// component's own one-form) or within one model are refused at the start, naming them.
+#[test]
+fn dependent_constraints_are_refused_at_the_start_naming_them() {
+    let cell = circuit::Loop {
+        l: Inductor { l: 1.0 },
+        c2: Capacitor { c: 1.0 },
+    };
+    let again = [Junction::new("again")
+        .flow("a.l.q", 2.0)
+        .flow("a.c2.q", -2.0)];
+    let system =
+        Interconnection::<_, _, 2, 1, 3, 1>::new(("a", cell), ("b", Capacitor { c: 1.0 }), again)
+            .unwrap();
+    let mut stepper = Stepper::new(system, Quadrature::midpoint(), 0.01).unwrap();
+    let refused = stepper.start_from_velocity(vector![0.0, 1.0, 0.0], SVector::zeros());
+    let message = format!("{refused:?}");
+    assert!(
+        message.contains("junction again is a combination of junction series of a"),
+        "{message}"
+    );
+    assert_eq!(stepper.steps(), 0);
+
+    #[dirac_system(
+        coordinates(x, y),
+        lagrangian = 0.5 * (dot(x).powi(2) + dot(y).powi(2)),
+        constraints(dx - dy, 2.0 * dy - 2.0 * dx),
+    )]
+    struct Twice;
+    let mut stepper = Stepper::new(Twice, Quadrature::midpoint(), 0.01).unwrap();
+    let refused = stepper.start_from_velocity(vector![0.0, 0.0], vector![1.0, 1.0]);
+    assert!(
+        matches!(&refused, Err(DiracError::InconsistentInitialState(why))
+            if why.contains("one-form `2.0 * dy - 2.0 * dx` is a combination of one-form `dx - dy`")),
+        "{refused:?}"
+    );
+}

@@ -167,6 +167,8 @@ pub struct Model {
     pub one_forms: Vec<Vec<Term>>,
     /// Whether each one-form's coefficients name no coordinate (the same covector at every `q`).
     pub constant_one_forms: Vec<bool>,
+    /// Each one-form as written, for error messages.
+    pub one_form_names: Vec<String>,
     /// Holonomic constraints `g(q)`.
     pub holonomic: Vec<TokenStream>,
     /// Terms of all force one-forms together.

@@ -461,8 +461,20 @@ fn dirac_items(
                 __w
             }
         });
+        let names = &model.one_form_names;
+        // (The Hamiltonian route's trait has no such methods.)
+        if !model.hamiltonian {
+            items.extend(quote! {
+            fn one_form_name(&self, __a: usize) -> ::std::string::String {
+                const __NAMES: [&str; #count] = [#(#names),*];
+                match __NAMES.get(__a) {
+                    ::core::option::Option::Some(__name) => ::std::format!("one-form `{}`", __name),
+                    ::core::option::Option::None => ::std::format!("one-form {}", __a),
+                }
+            }
+            });
+        }
         let constant = &model.constant_one_forms;
-        // (The Hamiltonian route's trait has no such method.)
         if !model.hamiltonian && constant.iter().any(|&c| c) {
             items.extend(quote! {
                 fn one_form_is_constant(&self, __a: usize) -> bool {

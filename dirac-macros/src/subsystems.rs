@@ -469,6 +469,7 @@ pub fn expand(model: &Composite) -> TokenStream {
             }
         },
     };
+    let junction_labels: Vec<&str> = model.junctions.iter().map(|j| j.name.as_str()).collect();
     let implementation = quote! {
         #(#size_items)*
         const __POINT: ::core::option::Option<__dirac::ConstraintPoint> =
@@ -547,6 +548,19 @@ pub fn expand(model: &Composite) -> TokenStream {
                     }
                 }
                 __w
+            }
+
+            fn one_form_name(&self, __a: usize) -> ::std::string::String {
+                #(
+                    if let ::core::option::Option::Some(__name) = #slots.one_form_name(&self.#fields, #labels, __a) {
+                        return __name;
+                    }
+                )*
+                const __JUNCTION_NAMES: [&str; #junction_count] = [#(#junction_labels),*];
+                match __a.checked_sub(__END.one_form).and_then(|__j| __JUNCTION_NAMES.get(__j)) {
+                    ::core::option::Option::Some(__name) => ::std::format!("junction {}", __name),
+                    ::core::option::Option::None => ::std::format!("one-form {}", __a),
+                }
             }
 
             fn one_form_is_constant(&self, __a: usize) -> bool {

@@ -384,6 +384,12 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     });
     let fields: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
     let mut constant_one_forms = Vec::new();
+    let one_form_names: Vec<String> = e
+        .constraints
+        .iter()
+        .flatten()
+        .map(|form| quote!(#form).to_string())
+        .collect();
     let (one_forms, holonomic, forces) = match &coordinates {
         Some(coordinates) => {
             let product = is_product(coordinates);
@@ -480,6 +486,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 parameters,
                 one_forms,
                 constant_one_forms,
+                one_form_names,
                 holonomic,
                 forces,
                 inputs,

@@ -57,6 +57,38 @@ pub(crate) fn one_form_in_chart<
     (value, Some(derivative))
 }
 
+/// Refuses constraints that are dependent at `q` (a one-form or a holonomic constraint's
+/// differential that combines others: the multipliers would not be unique and the step's KKT
+/// matrix singular), naming them.
+pub(crate) fn check_independent<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+) -> Result<(), crate::error::DiracError> {
+    // A form that vanishes at `q` is left to the step (it may not vanish where it is held).
+    let (indices, rows): (Vec<usize>, Vec<SVector<f64, N>>) = (0..S::ONE_FORMS)
+        .map(|a| one_form(system, q, a).0)
+        .chain((0..S::HOLONOMIC).map(|b| holonomic(system, q, b).1))
+        .enumerate()
+        .filter(|(_, row)| row.amax() > 0.0)
+        .unzip();
+    let name = |k: usize| match k.checked_sub(S::ONE_FORMS) {
+        None => system.one_form_name(k),
+        Some(b) => format!("holonomic constraint {b}"),
+    };
+    match crate::interconnection::dependent_row(&rows) {
+        None => Ok(()),
+        Some((k, on)) => Err(crate::error::DiracError::InconsistentInitialState(format!(
+            "the constraints are dependent at the initial position: {} is a combination of {} \
+             (their multipliers are not unique; drop one)",
+            name(indices[k]),
+            on.iter()
+                .map(|&j| name(indices[j]))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))),
+    }
+}
+
 /// Refuses a one-form the model says is constant whose derivative at `q` is not zero
 /// (`InconsistentDerivatives`, naming it): the runtime would otherwise drop that derivative.
 pub(crate) fn check_constant<S: DiracSystem<N>, const N: usize>(

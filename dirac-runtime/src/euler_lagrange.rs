@@ -856,6 +856,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         }
         crate::closed_form::check(system, q, v)?;
         constraint::check_constant(system, q)?;
+        constraint::check_independent(system, q)?;
         initial_state::check(system, state.t, q, v, &self.inputs, tolerance)
             .map_err(DiracError::InconsistentInitialState)?;
         let hidden = HiddenConstraints::find(system, q, v, state.t, &self.inputs);

@@ -290,6 +290,14 @@ impl<const N: usize, const C: usize> Junctions<N, C> {
         &self.names
     }
 
+    /// `junction name` for junction `j`, for error messages.
+    pub fn name(&self, j: usize) -> String {
+        match self.names.get(j) {
+            Some(name) => format!("junction {name}"),
+            None => format!("junction {j}"),
+        }
+    }
+
     /// Junction `j` as a covector on `R^N` (its coefficients).
     pub fn row(&self, j: usize) -> &SVector<f64, N> {
         &self.rows[j]
@@ -465,7 +473,9 @@ where
 /// scaled to a largest entry of 1 (so that no coefficient overflows or underflows), each basis
 /// vector carrying its expression in the rows; a row whose remainder is below 1e-10 of its
 /// norm is dependent, on the rows of weight above 1e-9 of the largest in that remainder.
-fn dependent_row<const N: usize>(rows: &[SVector<f64, N>]) -> Option<(usize, Vec<usize>)> {
+pub(crate) fn dependent_row<const N: usize>(
+    rows: &[SVector<f64, N>],
+) -> Option<(usize, Vec<usize>)> {
     let mut basis: Vec<(SVector<f64, N>, Vec<f64>)> = Vec::new();
     for (j, row) in rows.iter().enumerate() {
         let scaled = row / row.amax();
@@ -552,6 +562,17 @@ where
             .unwrap_or_else(|| {
                 self.junctions
                     .one_form(index.saturating_sub(A::ONE_FORMS + B::ONE_FORMS))
+            })
+    }
+
+    fn one_form_name(&self, index: usize) -> String {
+        let [a, b] = &self.instances;
+        Self::A
+            .one_form_name(&self.a, a, index)
+            .or_else(|| Self::B.one_form_name(&self.b, b, index))
+            .unwrap_or_else(|| {
+                self.junctions
+                    .name(index.saturating_sub(A::ONE_FORMS + B::ONE_FORMS))
             })
     }
 

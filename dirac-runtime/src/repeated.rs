@@ -172,6 +172,18 @@ impl<S: DiracSystem<M>, const K: usize, const M: usize, const N: usize, const C:
         }
     }
 
+    fn one_form_name(&self, index: usize) -> String {
+        match index.checked_sub(K * S::ONE_FORMS) {
+            Some(j) => self.junctions.name(j),
+            None => {
+                let i = index / S::ONE_FORMS;
+                Self::slot(i)
+                    .one_form_name(&self.parts[i], &self.instances[i], index)
+                    .unwrap_or_else(|| format!("one-form {index}"))
+            }
+        }
+    }
+
     /// The copies' answer for theirs; the junctions are constant.
     fn one_form_is_constant(&self, index: usize) -> bool {
         let i = index / S::ONE_FORMS.max(1);

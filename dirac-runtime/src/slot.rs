@@ -169,6 +169,20 @@ impl Slot {
         Some(form)
     }
 
+    /// The name of the whole model's one-form `index` when it is one of the component's:
+    /// `name of instance`.
+    pub fn one_form_name<S: DiracSystem<M>, const M: usize>(
+        &self,
+        component: &S,
+        instance: &str,
+        index: usize,
+    ) -> Option<String> {
+        let own = index
+            .checked_sub(self.one_form)
+            .filter(|&a| a < S::ONE_FORMS)?;
+        Some(format!("{} of {instance}", component.one_form_name(own)))
+    }
+
     /// Whether the whole model's one-form `index`, when it is one of the component's, is
     /// constant (`None` when it is not the component's).
     pub fn one_form_is_constant<S: DiracSystem<M>, const M: usize>(

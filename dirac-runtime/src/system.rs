@@ -88,6 +88,12 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
         M::zero()
     }
 
+    /// The name of one-form `a`, for error messages (by default `one-form a`; the attribute
+    /// names a constraint by its text, an interconnection a junction by its name).
+    fn one_form_name(&self, a: usize) -> String {
+        format!("one-form {a}")
+    }
+
     /// Whether one-form `a` is the same covector at every `q` (Kirchhoff's laws, junctions):
     /// the runtime then reads it in `f64` without differentiating it. `false` by default;
     /// `#[dirac_system]` says `true` for a one-form whose coefficients name no coordinate, and
