@@ -10,7 +10,7 @@ use support::slope;
 
 use dirac::interconnection::{Interconnection, Junction};
 use dirac::prelude::*;
-use scenes::components::{Capacitor, DcMotor, Inductor, MassSpring, Resistor, Source, Tethered};
+use scenes::components::{Capacitor, DcMotor, Inductor, MassSpring, Resistor, Source};
 use scenes::{circuit, ladder, motor, port, ports};
 use std::f64::consts::PI;
 use support::monolithic_rlc::MonolithicRlc;
@@ -211,6 +211,11 @@ fn port_readings_need_one_multiplier_per_junction_and_step() {
         .unwrap_err();
     assert!(matches!(error, DiracError::Unsupported(_)), "{error}");
     assert_eq!(system.junctions().names(), &["port".to_string()]);
+    // Each component's part of a state: left.x, then right.x and right.end.
+    assert_eq!(
+        system.split(&vector![1.0, 2.0, 3.0]),
+        (vector![1.0], vector![2.0, 3.0])
+    );
     // The port junction's row: +1 on right.end, −1 on left.x.
     assert_eq!(system.junctions().row(0), &vector![-1.0, 0.0, 1.0]);
 }
@@ -322,7 +327,6 @@ fn components_naming_different_quadratures_are_refused_by_from_system() {
     // ∂L/∂end = k2 (x2 − end) from the tethered mass; ∂L/∂x1 = −k1 x1 from the oscillator.
     assert!((gradient.q[2] - port::SCENE.k2 * (-0.2 - 0.5)).abs() < 1e-15);
     assert!((gradient.q[0] + port::SCENE.k1 * 0.3).abs() < 1e-15);
-    let _ = Tethered { m: 1.0, k: 1.0 };
 }
 
 /// The RLC of three subsystems in one level, written with the attribute.
@@ -692,7 +696,7 @@ fn constant_one_forms_are_read_without_differentiating_them() {
         vector![0.3f64.cos(), 0.3f64.sin(), 1.0],
     );
     assert!(
-        matches!(&refused, Err(DiracError::InconsistentDerivatives(why)) if why.contains("one-form 0")),
+        matches!(&refused, Err(DiracError::InconsistentDerivatives(why)) if why.contains("one-form 0 is said to be constant")),
         "{refused:?}"
     );
 }

@@ -98,14 +98,12 @@ pub(crate) fn check_constant<S: DiracSystem<N>, const N: usize>(
     for a in (0..S::ONE_FORMS).filter(|&a| system.one_form_is_constant(a)) {
         let row = system.one_form(&lift(q, 1.0), a);
         let scale = row.iter().fold(1.0f64, |m, x| m.max(x.re.abs()));
-        let moved = row
-            .iter()
-            .flat_map(|x| gradient(x).into_iter().copied().collect::<Vec<f64>>())
-            .fold(0.0f64, |m, x| m.max(x.abs()));
+        let moved = row.iter().fold(0.0f64, |m, x| m.max(gradient(x).amax()));
         if moved > 1e-12 * scale {
             return Err(crate::error::DiracError::InconsistentDerivatives(format!(
-                "one-form {a} is said to be constant (one_form_is_constant), but its \
-                 coefficients change with the position by {moved:e} per unit at the start"
+                "{} is said to be constant (one_form_is_constant), but its coefficients \
+                 change with the position by {moved:e} per unit at the start",
+                system.one_form_name(a)
             )));
         }
     }

@@ -439,14 +439,6 @@ where
     pub fn split<D: Scalar>(&self, x: &SVector<D, N>) -> (SVector<D, NA>, SVector<D, NB>) {
         (Self::A.part(x), Self::B.part(x))
     }
-
-    /// Joins `A`'s part and `B`'s part into a vector of the interconnection.
-    pub fn join<D: Scalar>(&self, a: &SVector<D, NA>, b: &SVector<D, NB>) -> SVector<D, N> {
-        let mut joined = SVector::from_element(D::from(0.0));
-        Self::A.place(&mut joined, a);
-        Self::B.place(&mut joined, b);
-        joined
-    }
 }
 
 impl<A, B, const NA: usize, const NB: usize, const N: usize, const C: usize> Interconnected<N, 2, C>

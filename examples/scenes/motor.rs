@@ -78,8 +78,9 @@ pub fn balance(h: f64, steps: usize) -> Result<(f64, f64, f64), DiracError> {
     stepper.set_input("motor.u", U)?;
     stepper.start_from_velocity(SVector::zeros(), SVector::zeros())?;
     let (mut motor, mut tellegen, mut defect): (f64, f64, f64) = (0.0, 0.0, 0.0);
+    let mut e = system.energies(&stepper.q(), &stepper.v()?);
     for _ in 0..steps {
-        let (q, e) = (stepper.q(), system.energies(&stepper.q(), &stepper.v()?));
+        let q = stepper.q();
         stepper.step()?;
         let ports = system.ports(&q, &stepper.q(), stepper.multipliers(), h)?;
         let next = system.energies(&stepper.q(), &stepper.v()?);
@@ -93,6 +94,7 @@ pub fn balance(h: f64, steps: usize) -> Result<(f64, f64, f64), DiracError> {
         motor = motor.max((next[0] - e[0] - supplied - ports.work[0]).abs() / size);
         tellegen = tellegen.max(ports.net_work().abs() / ports.scale.max(f64::MIN_POSITIVE));
         defect += next[0] + next[1] - e[0] - e[1] - supplied;
+        e = next;
     }
     Ok((motor, tellegen, defect.abs()))
 }

@@ -36,8 +36,9 @@ where
         energy: 0.0,
         largest_work: 0.0,
     };
+    let mut e = system.energies(&q0, &stepper.v()?);
     for _ in 0..steps {
-        let (q, e) = (stepper.q(), system.energies(&stepper.q(), &stepper.v()?));
+        let q = stepper.q();
         stepper.step()?;
         let ports = system.ports(&q, &stepper.q(), stepper.multipliers(), h)?;
         found.tellegen = found
@@ -57,6 +58,7 @@ where
                 .max((next[c] - e[c] - ports.work[c]).abs() / scale);
             found.largest_work = found.largest_work.max(ports.work[c].abs());
         }
+        e = next;
     }
     Ok(found)
 }
