@@ -11,23 +11,50 @@ use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, criterion_group};
 use dirac::prelude::*;
-use scenes::{chain, double_pendulum, hand_written::HandMidpoint};
+use scenes::hand_written::{Galerkin2, HandStepper, KnifeEdgeMidpoint, Midpoint};
+use scenes::{chain, double_pendulum, knife_edge};
 
-/// Double pendulum, midpoint, h = 0.01: generated stepper vs analytic derivatives, same Newton.
+/// One step of the generated steppers against the hand-written ones (analytic derivatives, the
+/// same Newton, the same predictor; `tests/golden.rs` checks they follow the same trajectories),
+/// h = 0.01: the double pendulum under the midpoint rule and `galerkin(2)`, the knife edge under
+/// the midpoint rule with its one-form at the midpoint.
 fn generated_vs_hand(c: &mut Criterion) {
-    let mut group = c.benchmark_group("double_pendulum_midpoint_step");
+    let mut group = c.benchmark_group("generated_vs_hand_written");
     let h = 0.01;
-    let mut generated = double_pendulum::stepper(Quadrature::midpoint(), h).expect("valid scene");
-    group.bench_function("generated", |b| {
-        b.iter(|| black_box(generated.step()).expect("step"))
-    });
-    let mut hand = HandMidpoint::new(
-        double_pendulum::SCENE,
-        h,
+    let (q0, v0, scene) = (
         double_pendulum::q0(),
         double_pendulum::v0(),
+        double_pendulum::SCENE,
     );
-    group.bench_function("hand_written", |b| {
+    let mut generated = double_pendulum::stepper(Quadrature::midpoint(), h).expect("valid scene");
+    group.bench_function("double_pendulum_midpoint/generated", |b| {
+        b.iter(|| black_box(generated.step()).expect("step"))
+    });
+    let mut hand = HandStepper::new(Midpoint(scene), h, q0, v0);
+    group.bench_function("double_pendulum_midpoint/hand_written", |b| {
+        b.iter(|| black_box(hand.step()).expect("step"))
+    });
+    let galerkin = Quadrature::galerkin(2).expect("valid rule");
+    let mut generated = double_pendulum::stepper(galerkin, h).expect("valid scene");
+    group.bench_function("double_pendulum_galerkin2/generated", |b| {
+        b.iter(|| black_box(generated.step()).expect("step"))
+    });
+    let mut hand = HandStepper::new(Galerkin2(scene), h, q0, v0);
+    group.bench_function("double_pendulum_galerkin2/hand_written", |b| {
+        b.iter(|| black_box(hand.step()).expect("step"))
+    });
+    let mut generated = knife_edge::stepper(ConstraintPoint::Midpoint, h).expect("valid scene");
+    group.bench_function("knife_edge_midpoint/generated", |b| {
+        b.iter(|| black_box(generated.step()).expect("step"))
+    });
+    let v0 = SVector::from([0.0, 0.0, knife_edge::OMEGA]);
+    let mut hand = HandStepper::new(
+        KnifeEdgeMidpoint(knife_edge::SCENE),
+        h,
+        SVector::zeros(),
+        v0,
+    );
+    group.bench_function("knife_edge_midpoint/hand_written", |b| {
         b.iter(|| black_box(hand.step()).expect("step"))
     });
     group.finish();
