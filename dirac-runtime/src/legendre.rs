@@ -62,6 +62,11 @@ pub(crate) fn velocity<F: PhaseFunction<N>, const N: usize>(
     guess: &SVector<f64, N>,
     dead: &[usize],
 ) -> Result<SVector<f64, N>, NewtonFailure> {
+    if dead.is_empty()
+        && let Some(v) = chord_velocity(system, newton, q, p, guess)
+    {
+        return Ok(v);
+    }
     let x = newton.solve_from(guess.as_slice(), |x, r, j| {
         let v = SVector::<f64, N>::from_column_slice(x.as_slice());
         // The Hessian only when Newton asks for a Jacobian.
@@ -85,6 +90,36 @@ pub(crate) fn velocity<F: PhaseFunction<N>, const N: usize>(
         l.first.abs().sup(&p.abs()).amax()
     })?;
     Ok(SVector::from_column_slice(x.as_slice()))
+}
+
+/// One Newton step from `guess` with the Hessian `∂²L/∂v²` there, in fixed size, taken where
+/// `L` has closed-form second derivatives: exact for a Lagrangian quadratic in the velocities
+/// (any mechanical one), it costs a Hessian and a gradient where the general solve adds its
+/// dynamic-size bookkeeping (recorded samples solve a velocity each). The point it reaches is
+/// returned only where `newton` accepts it as it accepts a point in its own solves with a
+/// Jacobian from an earlier iterate: the residual within tolerance and the correction there at
+/// round-off. `None` sends the caller to the general solve.
+fn chord_velocity<F: PhaseFunction<N>, const N: usize>(
+    system: &F,
+    newton: &Newton,
+    q: &SVector<f64, N>,
+    p: &SVector<f64, N>,
+    guess: &SVector<f64, N>,
+) -> Option<SVector<f64, N>> {
+    let hessian = system.closed_hessian(q, guess)?;
+    let inverse = hessian.vv.try_inverse()?;
+    let v = guess - inverse * (hessian.gradient.v - p);
+    let at_v = system.closed_gradient(q, &v)?;
+    let residual = at_v.v - p;
+    let update = inverse * residual;
+    let scale = at_v.v.abs().sup(&p.abs()).amax();
+    let norm = hessian
+        .vv
+        .row_iter()
+        .map(|row| row.abs().sum())
+        .fold(0.0, f64::max);
+    let finite = v.iter().chain(residual.iter()).all(|x| x.is_finite());
+    (finite && newton.accepts(residual.amax(), scale, norm, v.amax(), update.amax())).then_some(v)
 }
 
 /// The Legendre transform of a constrained model: solves
@@ -228,4 +263,155 @@ pub(crate) fn first_order_velocity<S: DiracSystem<N>, const N: usize>(
         l.first.abs().sup(&transport.abs()).amax()
     })?;
     Ok(SVector::from_column_slice(x.as_slice()))
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{SMatrix, vector};
+
+    use super::*;
+    use crate::closed_form::{LagrangianGradient, LagrangianHessian};
+    use crate::newton::NewtonOptions;
+    use crate::scalar::Scalar;
+
+    /// `L = cosh v − q²/2`, with its derivatives in closed form: `p = sinh v`, not quadratic.
+    struct Cosh;
+
+    impl DiracSystem<1> for Cosh {
+        fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+            v[0].cosh() - q[0] * q[0] * 0.5
+        }
+        fn lagrangian_gradient(
+            &self,
+            q: &SVector<f64, 1>,
+            v: &SVector<f64, 1>,
+        ) -> Option<LagrangianGradient<1>> {
+            Some(LagrangianGradient {
+                value: self.lagrangian(q, v),
+                q: -q,
+                v: vector![v[0].sinh()],
+            })
+        }
+        fn lagrangian_hessian(
+            &self,
+            q: &SVector<f64, 1>,
+            v: &SVector<f64, 1>,
+        ) -> Option<LagrangianHessian<1>> {
+            Some(LagrangianHessian {
+                gradient: self.lagrangian_gradient(q, v)?,
+                qq: SMatrix::from_element(-1.0),
+                qv: SMatrix::zeros(),
+                vv: SMatrix::from_element(v[0].cosh()),
+            })
+        }
+    }
+
+    /// `L = ½ vᵀMv − q₀ q₁` with `M = [[2, 1], [1, 3]]` in closed form: quadratic.
+    struct Quadratic;
+
+    impl Quadratic {
+        fn mass() -> SMatrix<f64, 2, 2> {
+            SMatrix::<f64, 2, 2>::new(2.0, 1.0, 1.0, 3.0)
+        }
+    }
+
+    impl DiracSystem<2> for Quadratic {
+        fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+            (v[0] * v[0] * 2.0 + v[0] * v[1] * 2.0 + v[1] * v[1] * 3.0) * 0.5 - q[0] * q[1]
+        }
+        fn lagrangian_gradient(
+            &self,
+            q: &SVector<f64, 2>,
+            v: &SVector<f64, 2>,
+        ) -> Option<LagrangianGradient<2>> {
+            Some(LagrangianGradient {
+                value: self.lagrangian(q, v),
+                q: vector![-q[1], -q[0]],
+                v: Self::mass() * v,
+            })
+        }
+        fn lagrangian_hessian(
+            &self,
+            q: &SVector<f64, 2>,
+            v: &SVector<f64, 2>,
+        ) -> Option<LagrangianHessian<2>> {
+            Some(LagrangianHessian {
+                gradient: self.lagrangian_gradient(q, v)?,
+                qq: SMatrix::<f64, 2, 2>::new(0.0, -1.0, -1.0, 0.0),
+                qv: SMatrix::zeros(),
+                vv: Self::mass(),
+            })
+        }
+    }
+
+    fn newton(n: usize) -> Newton {
+        Newton::new(n, NewtonOptions::default()).unwrap()
+    }
+
+    #[test]
+    fn the_chord_step_inverts_a_quadratic_lagrangian_from_any_guess() {
+        let (q, p) = (vector![0.3, -0.2], vector![1.0, -2.0]);
+        let exact = Quadratic::mass().try_inverse().unwrap() * p;
+        let v = chord_velocity(&Quadratic, &newton(2), &q, &p, &vector![50.0, -70.0]).unwrap();
+        assert!((v - exact).amax() < 1e-14, "{v} against {exact}");
+    }
+
+    #[test]
+    fn the_chord_step_is_refused_where_one_step_does_not_reach_the_root() {
+        let (q, p) = (vector![0.1], vector![2.0]);
+        // From 0.44 off, one Newton step on sinh v = 2 leaves v 0.09 off: not a root.
+        assert_eq!(
+            chord_velocity(&Cosh, &newton(1), &q, &p, &vector![1.0]),
+            None
+        );
+        // The general solve takes over and finds it.
+        let v = velocity(&Cosh, &mut newton(1), &q, &p, &vector![1.0], &[]).unwrap();
+        assert!((v[0] - 2.0_f64.asinh()).abs() < 1e-15);
+        // From a guess 1e-9 off, one step is at round-off from the root: accepted.
+        let close = vector![2.0_f64.asinh() + 1e-9];
+        let v = chord_velocity(&Cosh, &newton(1), &q, &p, &close).unwrap();
+        assert!((v[0] - 2.0_f64.asinh()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_chord_step_is_refused_where_the_hessian_is_singular() {
+        // cosh″ never vanishes; a Lagrangian with ∂²L/∂v² = 0 at the guess has no inverse.
+        struct Flat;
+        impl DiracSystem<1> for Flat {
+            fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+                v[0] * v[0] * v[0] / 3.0
+            }
+            fn lagrangian_gradient(
+                &self,
+                q: &SVector<f64, 1>,
+                v: &SVector<f64, 1>,
+            ) -> Option<LagrangianGradient<1>> {
+                Some(LagrangianGradient {
+                    value: self.lagrangian(q, v),
+                    q: vector![0.0],
+                    v: vector![v[0] * v[0]],
+                })
+            }
+            fn lagrangian_hessian(
+                &self,
+                q: &SVector<f64, 1>,
+                v: &SVector<f64, 1>,
+            ) -> Option<LagrangianHessian<1>> {
+                Some(LagrangianHessian {
+                    gradient: self.lagrangian_gradient(q, v)?,
+                    qq: SMatrix::zeros(),
+                    qv: SMatrix::zeros(),
+                    vv: SMatrix::from_element(2.0 * v[0]),
+                })
+            }
+        }
+        let chord = chord_velocity(
+            &Flat,
+            &newton(1),
+            &vector![0.0],
+            &vector![4.0],
+            &vector![0.0],
+        );
+        assert_eq!(chord, None);
+    }
 }

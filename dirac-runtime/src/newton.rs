@@ -365,10 +365,13 @@ impl Newton {
             return Err(NewtonFailure::NonFinite);
         }
         if with_jacobian {
-            if !self.jacobian.iter().all(|v| v.is_finite()) {
+            self.jacobian_norm = row_sum_norm(&self.jacobian, &mut self.row_scales);
+            // A norm that is not finite has an entry that is not, or overflowed.
+            if !self.jacobian_norm.is_finite()
+                && !self.jacobian.as_slice().iter().all(|v| v.is_finite())
+            {
                 return Err(NewtonFailure::NonFinite);
             }
-            self.jacobian_norm = row_sum_norm(&self.jacobian);
             lu::factorise(
                 &mut self.jacobian,
                 &mut self.pivots,
@@ -378,13 +381,35 @@ impl Newton {
             .map_err(NewtonFailure::Singular)?;
             self.factorised = true;
         }
-        // Round-off floor: what perturbing x by a few ulps does to the residual (measured with
-        // the last Jacobian evaluated).
-        let floor = 64.0 * f64::EPSILON * self.jacobian_norm * x.amax();
         Ok(Evaluation {
             residual: self.residual.amax(),
-            tolerance: self.options.residual_tolerance * scale + floor,
+            tolerance: self.tolerance(scale, self.jacobian_norm, x.amax()),
         })
+    }
+
+    /// The tolerance of a residual whose terms have size `scale`, at a point of size `x_max`:
+    /// the relative tolerance, plus the round-off floor (what perturbing `x` by a few ulps does
+    /// to the residual, measured with a Jacobian of norm `jacobian_norm`).
+    fn tolerance(&self, scale: f64, jacobian_norm: f64, x_max: f64) -> f64 {
+        let floor = 64.0 * f64::EPSILON * jacobian_norm * x_max;
+        self.options.residual_tolerance * scale + floor
+    }
+
+    /// Whether a point of size `x_max` is accepted as a root where its residual has norm
+    /// `residual` (terms of size `scale`) and the correction a Jacobian evaluated at another
+    /// point (of norm `jacobian_norm`) gives there has norm `update`: as [`solve`](Self::solve)
+    /// accepts a point with a Jacobian from an earlier iterate, the residual within tolerance and
+    /// the correction at round-off. For solves that take such a step outside the solver (a
+    /// chord step in fixed size).
+    pub(crate) fn accepts(
+        &self,
+        residual: f64,
+        scale: f64,
+        jacobian_norm: f64,
+        x_max: f64,
+        update: f64,
+    ) -> bool {
+        residual <= self.tolerance(scale, jacobian_norm, x_max) && update <= round_off(x_max)
     }
 
     /// Armijo backtracking along the update: halves the step from `x` until the residual is
@@ -624,7 +649,7 @@ impl Newton {
             // of that step off (and that last step refines x: the midpoint rule keeps a stiff
             // spring's energy to round-off over 10⁶ steps only with it); or, with an older
             // Jacobian (a linear rate), its own correction is at round-off.
-            let round_off = 4.0 * f64::EPSILON * (1.0 + x.amax());
+            let round_off = round_off(x.amax());
             let settled = at_x.residual == 0.0
                 || if current {
                     previous.is_some_and(|before| before <= noise)
@@ -758,11 +783,28 @@ impl Newton {
     }
 }
 
-/// `‖A‖∞`, the largest absolute row sum.
-fn row_sum_norm(a: &DMatrix<f64>) -> f64 {
-    a.row_iter()
-        .map(|row| row.iter().map(|x| x.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
+/// Below this an update of a point of size `x_max` is round-off.
+fn round_off(x_max: f64) -> f64 {
+    4.0 * f64::EPSILON * (1.0 + x_max)
+}
+
+/// `‖A‖∞`, the largest absolute row sum, accumulated column by column in `sums` (scratch, a
+/// row each: the same sums in the same order as row by row). Not finite where an entry is not.
+fn row_sum_norm(a: &DMatrix<f64>, sums: &mut [f64]) -> f64 {
+    let sums = &mut sums[..a.nrows()];
+    sums.fill(0.0);
+    for column in a.as_slice().chunks_exact(a.nrows().max(1)) {
+        for (sum, x) in sums.iter_mut().zip(column) {
+            *sum += x.abs();
+        }
+    }
+    sums.iter().fold(0.0, |norm, &sum| {
+        if sum > norm || sum.is_nan() {
+            sum
+        } else {
+            norm
+        }
+    })
 }
 
 #[cfg(test)]
