@@ -74,3 +74,59 @@ fn recording_allocates_nothing_per_sample() {
         0
     );
 }
+
+/// Steps of constrained models and Galerkin rules allocate nothing either: one-forms held at the
+/// midpoint and at the Gauss nodes, SHAKE, and a Galerkin step with internal points. (Models with
+/// hidden constraints still allocate in their projection; see the README's performance section.)
+#[test]
+fn constrained_and_galerkin_steps_allocate_nothing() {
+    fn after_a_step<S: DiracSystem<N>, const N: usize>(
+        name: &str,
+        mut stepper: Stepper<S, N>,
+    ) -> (String, usize) {
+        stepper.step().unwrap();
+        let count = allocations(|| {
+            for _ in 0..100 {
+                stepper.step().unwrap();
+            }
+        });
+        (name.to_string(), count)
+    }
+    let knife = |quadrature: Quadrature| {
+        let mut stepper = Stepper::new(scenes::knife_edge::SCENE, quadrature, 0.01).unwrap();
+        stepper
+            .start_from_velocity(SVector::zeros(), vector![0.0, 0.0, 1.0])
+            .unwrap();
+        stepper
+    };
+    let mut pendulum = Stepper::new(
+        scenes::cartesian_pendulum::SCENE,
+        Quadrature::midpoint(),
+        0.01,
+    )
+    .unwrap();
+    pendulum
+        .start_from_velocity(scenes::cartesian_pendulum::q0(1.0), SVector::zeros())
+        .unwrap();
+    let mut kepler = Stepper::new(
+        scenes::kepler::SCENE,
+        Quadrature::galerkin(3).unwrap(),
+        0.01,
+    )
+    .unwrap();
+    kepler
+        .start_from_momentum(scenes::kepler::q0(), scenes::kepler::p0())
+        .unwrap();
+    let counts = [
+        after_a_step("knife edge, midpoint", knife(Quadrature::midpoint())),
+        after_a_step(
+            "knife edge, galerkin(2)",
+            knife(Quadrature::galerkin(2).unwrap()),
+        ),
+        after_a_step("Cartesian pendulum, SHAKE", pendulum),
+        after_a_step("Kepler, galerkin(3)", kepler),
+    ];
+    for (name, count) in counts {
+        assert_eq!(count, 0, "{name}: {count} allocations in 100 steps");
+    }
+}

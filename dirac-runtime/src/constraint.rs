@@ -28,7 +28,7 @@ use crate::derivatives::{gradient, lift};
 use crate::error::DiracError;
 use crate::layout::Layout;
 use crate::manifold::Vectors;
-use crate::quadrature::Quadrature;
+use crate::quadrature::{MAX_DEGREE, Quadrature};
 use crate::system::DiracSystem;
 
 /// One-form `a` read in the chart centred at `base`, at `xi`: the row `Ã_a(ξ)` and its
@@ -304,11 +304,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let mut impulse = SVector::<f64, N>::zeros();
         let mut end = SVector::<f64, N>::zeros();
         let mut scale = 0.0_f64;
-        let increments: Vec<SVector<f64, N>> = (1..=s)
-            .map(|k| x.fixed_rows::<N>(layout.point(k)).into_owned())
-            .collect();
+        // The path's increments on the stack (no allocation per evaluation).
+        let mut path = [SVector::<f64, N>::zeros(); MAX_DEGREE];
+        for (k, increment) in path.iter_mut().enumerate().take(s) {
+            *increment = x.fixed_rows::<N>(layout.point(k + 1)).into_owned();
+        }
+        let increments = &path[..s];
         for (i, &b) in quad.weights().iter().enumerate() {
-            let (xi, xi_dot) = quad.path_at(i, &increments, h);
+            let (xi, xi_dot) = quad.path_at(i, increments, h);
             let node = base + xi;
             for a in 0..S::ONE_FORMS {
                 let (row, derivative) = one_form(system, &node, a);

@@ -1101,14 +1101,17 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let violation = if S::ONE_FORMS > 0 && self.layout.points() > 1 {
             // Measured with the stored end point (after any projection).
             let s = self.layout.points();
-            let increments: Vec<SVector<f64, N>> = (1..=s)
-                .map(|j| match j {
+            // The path's increments on the stack (no allocation per step).
+            let mut path = [SVector::<f64, N>::zeros(); MAX_DEGREE];
+            for (j, increment) in path.iter_mut().enumerate().take(s).map(|(j, z)| (j + 1, z)) {
+                *increment = match j {
                     j if j == s => space.local(&state.q, &next.q).unwrap_or(xi),
                     j => x.fixed_rows::<N>(self.layout.point(j)).into_owned(),
-                })
-                .collect();
+                };
+            }
             let h = self.discrete.h();
-            constraint::node_violation(system, self.discrete.quadrature(), h, &state.q, &increments)
+            let quadrature = self.discrete.quadrature();
+            constraint::node_violation(system, quadrature, h, &state.q, &path[..s])
         } else if Self::constrained() {
             constraint::violation(system, space, self.point, &state.q, &next.q, &xi)
         } else {
