@@ -984,9 +984,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             HiddenConstraints::find(system, &state.q, &state.velocity, state.t, &self.inputs);
         self.collocated = Self::collocated_rows(system, &state.q, &state.velocity, &hidden);
         self.hidden = Some(hidden);
-        self.closed_form = system
-            .lagrangian_hessian(&state.q, &state.velocity)
-            .is_some();
+        // Closed forms serve only a translation chart (elsewhere `L` is read in the chart).
+        self.closed_form = C::TRANSLATION
+            && system
+                .lagrangian_hessian(&state.q, &state.velocity)
+                .is_some();
         // The scheme is taken up here, at the start of a run: the unknowns follow it.
         let projected =
             self.first_order() && self.first_order_scheme == FirstOrderScheme::SymmetricProjection;
@@ -1040,16 +1042,17 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// or two first-order passes (`N + 1` numbers each): `(N + 1)/2` per pass is the cautious
     /// count. Where `L` has closed-form second derivatives (and the model no forces, whose
     /// derivatives are taken by dual numbers) a Jacobian takes the closed-form Hessian where the
-    /// residual takes the gradient, at every node alike: `1 + N/5`, which leaves Newton's method
-    /// to models of up to 4 coordinates, as far as it is measured (the double pendulum, the knife
-    /// edge and the rolling disk, midpoint to `galerkin(3)`: 2 to 3 evaluations a step against 5
-    /// to 7 with a kept Jacobian, up to 2.3× less time). Collocated rows (first-order and mixed Lagrangians) take their
+    /// residual takes the gradient, at every node alike: up to 4 coordinates, as far as it is
+    /// measured (the double pendulum, the knife edge and the rolling disk, midpoint to
+    /// `galerkin(3)`: 2 to 3 evaluations a step against 5 to 7 with a kept Jacobian, up to 2.3×
+    /// less time), that is about a residual more, `1 + N/5`, and Newton's method; above, where the
+    /// factorisation weighs more and nothing is measured, the cautious count stays. Collocated rows (first-order and mixed Lagrangians) take their
     /// Jacobian with their residual, so there a Jacobian costs about a residual.
     fn jacobian_cost(&self) -> f64 {
         if self.projected() || self.first_order() || !self.collocated.is_empty() {
             return 1.0;
         }
-        if self.closed_form && !S::FORCES {
+        if self.closed_form && !S::FORCES && N <= 4 {
             return 1.0 + N as f64 / 5.0;
         }
         let passes = if self.layout.points() == 1 { 1.0 } else { 3.0 };

@@ -98,7 +98,9 @@ pub(crate) fn velocity<F: PhaseFunction<N>, const N: usize>(
 /// dynamic-size bookkeeping (recorded samples solve a velocity each). The point it reaches is
 /// returned only where `newton` accepts it as it accepts a point in its own solves with a
 /// Jacobian from an earlier iterate: the residual within tolerance and the correction there at
-/// round-off. `None` sends the caller to the general solve.
+/// round-off. A Hessian whose condition number `‖H‖∞‖H⁻¹‖∞` exceeds the inverse of the
+/// solver's singular tolerance is left to the general solve, which refuses it as singular.
+/// `None` sends the caller to the general solve.
 fn chord_velocity<F: PhaseFunction<N>, const N: usize>(
     system: &F,
     newton: &Newton,
@@ -108,18 +110,32 @@ fn chord_velocity<F: PhaseFunction<N>, const N: usize>(
 ) -> Option<SVector<f64, N>> {
     let hessian = system.closed_hessian(q, guess)?;
     let inverse = hessian.vv.try_inverse()?;
+    let norm = row_sum_norm(&hessian.vv);
+    // A condition number that is NaN or too large: not this path's to judge.
+    let condition = norm * row_sum_norm(&inverse);
+    if condition.is_nan() || condition * newton.options().singular_tolerance > 1.0 {
+        return None;
+    }
     let v = guess - inverse * (hessian.gradient.v - p);
     let at_v = system.closed_gradient(q, &v)?;
     let residual = at_v.v - p;
     let update = inverse * residual;
     let scale = at_v.v.abs().sup(&p.abs()).amax();
-    let norm = hessian
-        .vv
-        .row_iter()
-        .map(|row| row.abs().sum())
-        .fold(0.0, f64::max);
     let finite = v.iter().chain(residual.iter()).all(|x| x.is_finite());
     (finite && newton.accepts(residual.amax(), scale, norm, v.amax(), update.amax())).then_some(v)
+}
+
+/// `‖A‖∞`, the largest absolute row sum (not finite where an entry is not).
+fn row_sum_norm<const N: usize>(a: &nalgebra::SMatrix<f64, N, N>) -> f64 {
+    a.row_iter()
+        .map(|row| row.abs().sum())
+        .fold(0.0, |norm, sum| {
+            if sum > norm || sum.is_nan() {
+                sum
+            } else {
+                norm
+            }
+        })
 }
 
 /// The Legendre transform of a constrained model: solves
@@ -371,6 +387,61 @@ mod tests {
         let close = vector![2.0_f64.asinh() + 1e-9];
         let v = chord_velocity(&Cosh, &newton(1), &q, &p, &close).unwrap();
         assert!((v[0] - 2.0_f64.asinh()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_chord_step_is_refused_where_its_correction_is_not_at_round_off() {
+        let (q, p) = (vector![0.1], vector![2.0]);
+        let root = 2.0_f64.asinh();
+        // From 4.5e-7 off, one step lands about 1e-13 off: the residual (~2e-13) is within the
+        // tolerance (1e-12 of |p| = 2), but the correction there is not round-off.
+        let guess = vector![root + 4.5e-7];
+        assert_eq!(chord_velocity(&Cosh, &newton(1), &q, &p, &guess), None);
+        let one_step = guess[0] - (guess[0].sinh() - p[0]) / guess[0].cosh();
+        let residual = (one_step.sinh() - p[0]).abs();
+        assert!(
+            residual < 1e-12 * p[0] && (one_step - root).abs() > 1e-14,
+            "{residual:e}"
+        );
+    }
+
+    #[test]
+    fn the_chord_step_leaves_an_ill_conditioned_hessian_to_the_general_solve() {
+        /// `L = ½ vᵀ diag(1, 1e-14) v`: invertible, but beyond the singular tolerance.
+        struct Stiff;
+        impl DiracSystem<2> for Stiff {
+            fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+                (v[0] * v[0] + v[1] * v[1] * 1e-14) * 0.5
+            }
+            fn lagrangian_gradient(
+                &self,
+                q: &SVector<f64, 2>,
+                v: &SVector<f64, 2>,
+            ) -> Option<LagrangianGradient<2>> {
+                Some(LagrangianGradient {
+                    value: self.lagrangian(q, v),
+                    q: SVector::zeros(),
+                    v: vector![v[0], v[1] * 1e-14],
+                })
+            }
+            fn lagrangian_hessian(
+                &self,
+                q: &SVector<f64, 2>,
+                v: &SVector<f64, 2>,
+            ) -> Option<LagrangianHessian<2>> {
+                Some(LagrangianHessian {
+                    gradient: self.lagrangian_gradient(q, v)?,
+                    qq: SMatrix::zeros(),
+                    qv: SMatrix::zeros(),
+                    vv: SMatrix::<f64, 2, 2>::new(1.0, 0.0, 0.0, 1e-14),
+                })
+            }
+        }
+        let (q, p) = (vector![0.0, 0.0], vector![1.0, 1e-14]);
+        assert_eq!(
+            chord_velocity(&Stiff, &newton(2), &q, &p, &vector![0.0, 0.0]),
+            None
+        );
     }
 
     #[test]
