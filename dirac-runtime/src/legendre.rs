@@ -290,23 +290,41 @@ mod tests {
     use crate::newton::NewtonOptions;
     use crate::scalar::Scalar;
 
-    /// `L = cosh v − q²/2`, with its derivatives in closed form: `p = sinh v`, not quadratic.
-    struct Cosh;
+    /// `L = f(v) − q²/2` on one coordinate, with its derivatives in closed form.
+    #[derive(Debug, Clone, Copy)]
+    enum Speed {
+        /// `f = cosh`: `p = sinh v`, not quadratic.
+        Cosh,
+        /// `f = v³/3`: `∂²L/∂v² = 2v` vanishes at `v = 0`.
+        Cube,
+    }
 
-    impl DiracSystem<1> for Cosh {
+    impl Speed {
+        /// `(f′(v), f″(v))`.
+        fn derivatives(self, v: f64) -> (f64, f64) {
+            match self {
+                Speed::Cosh => (v.sinh(), v.cosh()),
+                Speed::Cube => (v * v, 2.0 * v),
+            }
+        }
+    }
+
+    impl DiracSystem<1> for Speed {
         fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-            v[0].cosh() - q[0] * q[0] * 0.5
+            let f = match self {
+                Speed::Cosh => v[0].cosh(),
+                Speed::Cube => v[0] * v[0] * v[0] / 3.0,
+            };
+            f - q[0] * q[0] * 0.5
         }
         fn lagrangian_gradient(
             &self,
             q: &SVector<f64, 1>,
             v: &SVector<f64, 1>,
         ) -> Option<LagrangianGradient<1>> {
-            Some(LagrangianGradient {
-                value: self.lagrangian(q, v),
-                q: -q,
-                v: vector![v[0].sinh()],
-            })
+            let value = self.lagrangian(q, v);
+            let v = vector![self.derivatives(v[0]).0];
+            Some(LagrangianGradient { value, q: -q, v })
         }
         fn lagrangian_hessian(
             &self,
@@ -317,23 +335,22 @@ mod tests {
                 gradient: self.lagrangian_gradient(q, v)?,
                 qq: SMatrix::from_element(-1.0),
                 qv: SMatrix::zeros(),
-                vv: SMatrix::from_element(v[0].cosh()),
+                vv: SMatrix::from_element(self.derivatives(v[0]).1),
             })
         }
     }
 
-    /// `L = ½ vᵀMv − q₀ q₁` with `M = [[2, 1], [1, 3]]` in closed form: quadratic.
-    struct Quadratic;
-
-    impl Quadratic {
-        fn mass() -> SMatrix<f64, 2, 2> {
-            SMatrix::<f64, 2, 2>::new(2.0, 1.0, 1.0, 3.0)
-        }
-    }
+    /// `L = ½ vᵀMv − q₀ q₁` in closed form: quadratic in the velocities.
+    struct Quadratic(SMatrix<f64, 2, 2>);
 
     impl DiracSystem<2> for Quadratic {
         fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
-            (v[0] * v[0] * 2.0 + v[0] * v[1] * 2.0 + v[1] * v[1] * 3.0) * 0.5 - q[0] * q[1]
+            let m = &self.0;
+            (v[0] * v[0] * m[(0, 0)]
+                + v[0] * v[1] * (m[(0, 1)] + m[(1, 0)])
+                + v[1] * v[1] * m[(1, 1)])
+                * 0.5
+                - q[0] * q[1]
         }
         fn lagrangian_gradient(
             &self,
@@ -343,7 +360,7 @@ mod tests {
             Some(LagrangianGradient {
                 value: self.lagrangian(q, v),
                 q: vector![-q[1], -q[0]],
-                v: Self::mass() * v,
+                v: self.0 * v,
             })
         }
         fn lagrangian_hessian(
@@ -355,7 +372,7 @@ mod tests {
                 gradient: self.lagrangian_gradient(q, v)?,
                 qq: SMatrix::<f64, 2, 2>::new(0.0, -1.0, -1.0, 0.0),
                 qv: SMatrix::zeros(),
-                vv: Self::mass(),
+                vv: self.0,
             })
         }
     }
@@ -366,10 +383,11 @@ mod tests {
 
     #[test]
     fn the_chord_step_inverts_a_quadratic_lagrangian_from_any_guess() {
+        let mass = SMatrix::<f64, 2, 2>::new(2.0, 1.0, 1.0, 3.0);
         let (q, p) = (vector![0.3, -0.2], vector![1.0, -2.0]);
-        let exact = Quadratic::mass().try_inverse().unwrap() * p;
-        let v = chord_velocity(&Quadratic, &newton(2), &q, &p, &vector![50.0, -70.0]).unwrap();
-        assert!((v - exact).amax() < 1e-14, "{v} against {exact}");
+        let exact = mass.try_inverse().unwrap() * p;
+        let v = chord_velocity(&Quadratic(mass), &newton(2), &q, &p, &vector![50.0, -70.0]);
+        assert!((v.unwrap() - exact).amax() < 1e-14, "{v:?} against {exact}");
     }
 
     #[test]
@@ -377,15 +395,15 @@ mod tests {
         let (q, p) = (vector![0.1], vector![2.0]);
         // From 0.44 off, one Newton step on sinh v = 2 leaves v 0.09 off: not a root.
         assert_eq!(
-            chord_velocity(&Cosh, &newton(1), &q, &p, &vector![1.0]),
+            chord_velocity(&Speed::Cosh, &newton(1), &q, &p, &vector![1.0]),
             None
         );
         // The general solve takes over and finds it.
-        let v = velocity(&Cosh, &mut newton(1), &q, &p, &vector![1.0], &[]).unwrap();
+        let v = velocity(&Speed::Cosh, &mut newton(1), &q, &p, &vector![1.0], &[]).unwrap();
         assert!((v[0] - 2.0_f64.asinh()).abs() < 1e-15);
         // From a guess 1e-9 off, one step is at round-off from the root: accepted.
         let close = vector![2.0_f64.asinh() + 1e-9];
-        let v = chord_velocity(&Cosh, &newton(1), &q, &p, &close).unwrap();
+        let v = chord_velocity(&Speed::Cosh, &newton(1), &q, &p, &close).unwrap();
         assert!((v[0] - 2.0_f64.asinh()).abs() < 1e-15);
     }
 
@@ -396,7 +414,10 @@ mod tests {
         // From 4.5e-7 off, one step lands about 1e-13 off: the residual (~2e-13) is within the
         // tolerance (1e-12 of |p| = 2), but the correction there is not round-off.
         let guess = vector![root + 4.5e-7];
-        assert_eq!(chord_velocity(&Cosh, &newton(1), &q, &p, &guess), None);
+        assert_eq!(
+            chord_velocity(&Speed::Cosh, &newton(1), &q, &p, &guess),
+            None
+        );
         let one_step = guess[0] - (guess[0].sinh() - p[0]) / guess[0].cosh();
         let residual = (one_step.sinh() - p[0]).abs();
         assert!(
@@ -406,83 +427,22 @@ mod tests {
     }
 
     #[test]
-    fn the_chord_step_leaves_an_ill_conditioned_hessian_to_the_general_solve() {
-        /// `L = ½ vᵀ diag(1, 1e-14) v`: invertible, but beyond the singular tolerance.
-        struct Stiff;
-        impl DiracSystem<2> for Stiff {
-            fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
-                (v[0] * v[0] + v[1] * v[1] * 1e-14) * 0.5
-            }
-            fn lagrangian_gradient(
-                &self,
-                q: &SVector<f64, 2>,
-                v: &SVector<f64, 2>,
-            ) -> Option<LagrangianGradient<2>> {
-                Some(LagrangianGradient {
-                    value: self.lagrangian(q, v),
-                    q: SVector::zeros(),
-                    v: vector![v[0], v[1] * 1e-14],
-                })
-            }
-            fn lagrangian_hessian(
-                &self,
-                q: &SVector<f64, 2>,
-                v: &SVector<f64, 2>,
-            ) -> Option<LagrangianHessian<2>> {
-                Some(LagrangianHessian {
-                    gradient: self.lagrangian_gradient(q, v)?,
-                    qq: SMatrix::zeros(),
-                    qv: SMatrix::zeros(),
-                    vv: SMatrix::<f64, 2, 2>::new(1.0, 0.0, 0.0, 1e-14),
-                })
-            }
-        }
+    fn the_chord_step_leaves_ill_conditioned_and_singular_hessians_to_the_general_solve() {
+        // ∂²L/∂v² = diag(1, 1e-14): invertible, but beyond the singular tolerance.
+        let stiff = Quadratic(SMatrix::<f64, 2, 2>::new(1.0, 0.0, 0.0, 1e-14));
         let (q, p) = (vector![0.0, 0.0], vector![1.0, 1e-14]);
         assert_eq!(
-            chord_velocity(&Stiff, &newton(2), &q, &p, &vector![0.0, 0.0]),
+            chord_velocity(&stiff, &newton(2), &q, &p, &vector![0.0, 0.0]),
             None
         );
-    }
-
-    #[test]
-    fn the_chord_step_is_refused_where_the_hessian_is_singular() {
-        // cosh″ never vanishes; a Lagrangian with ∂²L/∂v² = 0 at the guess has no inverse.
-        struct Flat;
-        impl DiracSystem<1> for Flat {
-            fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
-                v[0] * v[0] * v[0] / 3.0
-            }
-            fn lagrangian_gradient(
-                &self,
-                q: &SVector<f64, 1>,
-                v: &SVector<f64, 1>,
-            ) -> Option<LagrangianGradient<1>> {
-                Some(LagrangianGradient {
-                    value: self.lagrangian(q, v),
-                    q: vector![0.0],
-                    v: vector![v[0] * v[0]],
-                })
-            }
-            fn lagrangian_hessian(
-                &self,
-                q: &SVector<f64, 1>,
-                v: &SVector<f64, 1>,
-            ) -> Option<LagrangianHessian<1>> {
-                Some(LagrangianHessian {
-                    gradient: self.lagrangian_gradient(q, v)?,
-                    qq: SMatrix::zeros(),
-                    qv: SMatrix::zeros(),
-                    vv: SMatrix::from_element(2.0 * v[0]),
-                })
-            }
-        }
-        let chord = chord_velocity(
-            &Flat,
+        // ∂²L/∂v² = 2v vanishes at the guess v = 0: no inverse.
+        let flat = chord_velocity(
+            &Speed::Cube,
             &newton(1),
             &vector![0.0],
             &vector![4.0],
             &vector![0.0],
         );
-        assert_eq!(chord, None);
+        assert_eq!(flat, None);
     }
 }

@@ -3,6 +3,23 @@
 
 use nalgebra::{DMatrix, Dim, IsContiguous, Matrix, SMatrix, Storage, StorageMut};
 
+/// `fixed::<N>(args)` with `N = n` for `n` up to 8, `general` otherwise.
+macro_rules! by_size {
+    ($n:expr, $fixed:ident($($arg:expr),*), $general:expr) => {
+        match $n {
+            1 => $fixed::<1>($($arg),*),
+            2 => $fixed::<2>($($arg),*),
+            3 => $fixed::<3>($($arg),*),
+            4 => $fixed::<4>($($arg),*),
+            5 => $fixed::<5>($($arg),*),
+            6 => $fixed::<6>($($arg),*),
+            7 => $fixed::<7>($($arg),*),
+            8 => $fixed::<8>($($arg),*),
+            _ => $general,
+        }
+    };
+}
+
 /// Why a factorisation failed: the column whose pivot vanished, and the unknowns that a null
 /// vector of the matrix moves (the directions the equations do not determine).
 #[derive(Debug, Clone, PartialEq)]
@@ -27,17 +44,11 @@ pub(crate) fn factorise(
     // Up to eight unknowns the elimination runs on a copy of fixed size (its loops unrolled,
     // its bounds known): the same operations in the same order, 8–12 % fewer instructions per
     // step of the double pendulum, the knife edge and the LC circuit.
-    match a.nrows() {
-        1 => factorise_fixed::<1>(a, pivots, scales, tolerance),
-        2 => factorise_fixed::<2>(a, pivots, scales, tolerance),
-        3 => factorise_fixed::<3>(a, pivots, scales, tolerance),
-        4 => factorise_fixed::<4>(a, pivots, scales, tolerance),
-        5 => factorise_fixed::<5>(a, pivots, scales, tolerance),
-        6 => factorise_fixed::<6>(a, pivots, scales, tolerance),
-        7 => factorise_fixed::<7>(a, pivots, scales, tolerance),
-        8 => factorise_fixed::<8>(a, pivots, scales, tolerance),
-        _ => eliminate(a, pivots, scales, tolerance).map_err(|k| singular(a, k)),
-    }
+    by_size!(
+        a.nrows(),
+        factorise_fixed(a, pivots, scales, tolerance),
+        eliminate(a, pivots, scales, tolerance).map_err(|k| singular(a, k))
+    )
 }
 
 /// [`factorise`] of an `N × N` matrix on a copy of fixed size.
@@ -121,49 +132,20 @@ fn null_vector_support(lu: &DMatrix<f64>, k: usize) -> Vec<usize> {
 /// Solves `A x = b` in place of `b` with the factors from [`factorise`].
 pub(crate) fn solve(lu: &DMatrix<f64>, pivots: &[usize], b: &mut [f64]) {
     // Up to eight unknowns on a copy of fixed size, as in `factorise`.
-    match lu.nrows() {
-        1 => substitute(
-            &SMatrix::<f64, 1, 1>::from_column_slice(lu.as_slice()),
-            pivots,
-            b,
-        ),
-        2 => substitute(
-            &SMatrix::<f64, 2, 2>::from_column_slice(lu.as_slice()),
-            pivots,
-            b,
-        ),
-        3 => substitute(
-            &SMatrix::<f64, 3, 3>::from_column_slice(lu.as_slice()),
-            pivots,
-            b,
-        ),
-        4 => substitute(
-            &SMatrix::<f64, 4, 4>::from_column_slice(lu.as_slice()),
-            pivots,
-            b,
-        ),
-        5 => substitute(
-            &SMatrix::<f64, 5, 5>::from_column_slice(lu.as_slice()),
-            pivots,
-            b,
-        ),
-        6 => substitute(
-            &SMatrix::<f64, 6, 6>::from_column_slice(lu.as_slice()),
-            pivots,
-            b,
-        ),
-        7 => substitute(
-            &SMatrix::<f64, 7, 7>::from_column_slice(lu.as_slice()),
-            pivots,
-            b,
-        ),
-        8 => substitute(
-            &SMatrix::<f64, 8, 8>::from_column_slice(lu.as_slice()),
-            pivots,
-            b,
-        ),
-        _ => substitute(lu, pivots, b),
-    }
+    by_size!(
+        lu.nrows(),
+        solve_fixed(lu, pivots, b),
+        substitute(lu, pivots, b)
+    )
+}
+
+/// [`solve`] with `N × N` factors, on a copy of fixed size.
+fn solve_fixed<const N: usize>(lu: &DMatrix<f64>, pivots: &[usize], b: &mut [f64]) {
+    substitute(
+        &SMatrix::<f64, N, N>::from_column_slice(lu.as_slice()),
+        pivots,
+        b,
+    );
 }
 
 /// The permutation and the two triangular solves of [`solve`], on any square matrix.
