@@ -28,7 +28,7 @@ use crate::derivatives::{gradient, lift};
 use crate::error::DiracError;
 use crate::layout::Layout;
 use crate::manifold::Vectors;
-use crate::quadrature::{MAX_DEGREE, Quadrature};
+use crate::quadrature::Quadrature;
 use crate::system::DiracSystem;
 
 /// One-form `a` read in the chart centred at `base`, at `xi`: the row `Ã_a(ξ)` and its
@@ -157,6 +157,8 @@ pub(crate) struct StepConstraints<'a, S, C: ConfigurationSpace<N>, const N: usiz
     pub base: &'a Point<C, N, f64>,
     pub layout: &'a Layout,
     pub holonomic_forms: &'a [SVector<f64, N>],
+    /// The path's points `ξ_1, …, ξ_s` of the point being assembled (read from its unknowns).
+    pub increments: &'a [SVector<f64, N>],
     /// The step's quadrature and size (one-forms of a Galerkin step hold at its nodes).
     pub quadrature: &'a Quadrature,
     pub h: f64,
@@ -304,12 +306,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let mut impulse = SVector::<f64, N>::zeros();
         let mut end = SVector::<f64, N>::zeros();
         let mut scale = 0.0_f64;
-        // The path's increments on the stack (no allocation per evaluation).
-        let mut path = [SVector::<f64, N>::zeros(); MAX_DEGREE];
-        for (k, increment) in path.iter_mut().enumerate().take(s) {
-            *increment = x.fixed_rows::<N>(layout.point(k + 1)).into_owned();
-        }
-        let increments = &path[..s];
+        let increments = self.increments;
         for (i, &b) in quad.weights().iter().enumerate() {
             let (xi, xi_dot) = quad.path_at(i, increments, h);
             let node = base + xi;

@@ -731,6 +731,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 base: &state.q,
                 layout: &self.layout,
                 holonomic_forms: &self.holonomic_forms,
+                increments: &self.increments,
                 quadrature: discrete.quadrature(),
                 h: discrete.h(),
             };
@@ -1045,9 +1046,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// residual takes the gradient, at every node alike: up to 4 coordinates, as far as it is
     /// measured (the double pendulum, the knife edge and the rolling disk, midpoint to
     /// `galerkin(3)`: 2 to 3 evaluations a step against 5 to 7 with a kept Jacobian, up to 2.3×
-    /// less time), that is about a residual more, `1 + N/5`, and Newton's method; above, where the
-    /// factorisation weighs more and nothing is measured, the cautious count stays. Collocated rows (first-order and mixed Lagrangians) take their
-    /// Jacobian with their residual, so there a Jacobian costs about a residual.
+    /// less time), that is about a residual more, `1 + N/5`, and Newton's method; above, where
+    /// the factorisation weighs more and nothing is measured, the cautious count stays.
+    /// Collocated rows (first-order and mixed Lagrangians) take their Jacobian with their
+    /// residual, so there a Jacobian costs about a residual.
     fn jacobian_cost(&self) -> f64 {
         if self.projected() || self.first_order() || !self.collocated.is_empty() {
             return 1.0;
@@ -1104,14 +1106,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let violation = if S::ONE_FORMS > 0 && self.layout.points() > 1 {
             // Measured with the stored end point (after any projection).
             let s = self.layout.points();
-            // The path's increments on the stack (no allocation per step).
+            // The path of the point assembled last (x), its end the stored one; on the stack.
             let mut path = [SVector::<f64, N>::zeros(); MAX_DEGREE];
-            for (j, increment) in path.iter_mut().enumerate().take(s).map(|(j, z)| (j + 1, z)) {
-                *increment = match j {
-                    j if j == s => space.local(&state.q, &next.q).unwrap_or(xi),
-                    j => x.fixed_rows::<N>(self.layout.point(j)).into_owned(),
-                };
-            }
+            path[..s].copy_from_slice(&self.increments);
+            path[s - 1] = space.local(&state.q, &next.q).unwrap_or(xi);
             let h = self.discrete.h();
             let quadrature = self.discrete.quadrature();
             constraint::node_violation(system, quadrature, h, &state.q, &path[..s])

@@ -407,6 +407,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
                 base: &state.q,
                 layout: &self.layout,
                 holonomic_forms: &[],
+                increments: &self.increments,
                 quadrature: discrete.quadrature(),
                 h: discrete.h(),
             };

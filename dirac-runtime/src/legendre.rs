@@ -3,7 +3,7 @@
 use nalgebra::{DMatrix, DVector, SVector};
 
 use crate::derivatives::{PhaseFunction, Seed, seeded};
-use crate::newton::{Newton, NewtonFailure};
+use crate::newton::{Newton, NewtonFailure, row_sum_norm};
 use crate::system::DiracSystem;
 
 /// `p = ∂L/∂v (q, v)`.
@@ -110,9 +110,10 @@ fn chord_velocity<F: PhaseFunction<N>, const N: usize>(
 ) -> Option<SVector<f64, N>> {
     let hessian = system.closed_hessian(q, guess)?;
     let inverse = hessian.vv.try_inverse()?;
-    let norm = row_sum_norm(&hessian.vv);
+    let mut sums = [0.0; N];
+    let norm = row_sum_norm(&hessian.vv, &mut sums);
     // A condition number that is NaN or too large: not this path's to judge.
-    let condition = norm * row_sum_norm(&inverse);
+    let condition = norm * row_sum_norm(&inverse, &mut sums);
     if condition.is_nan() || condition * newton.options().singular_tolerance > 1.0 {
         return None;
     }
@@ -123,19 +124,6 @@ fn chord_velocity<F: PhaseFunction<N>, const N: usize>(
     let scale = at_v.v.abs().sup(&p.abs()).amax();
     let finite = v.iter().chain(residual.iter()).all(|x| x.is_finite());
     (finite && newton.accepts(residual.amax(), scale, norm, v.amax(), update.amax())).then_some(v)
-}
-
-/// `‖A‖∞`, the largest absolute row sum (not finite where an entry is not).
-fn row_sum_norm<const N: usize>(a: &nalgebra::SMatrix<f64, N, N>) -> f64 {
-    a.row_iter()
-        .map(|row| row.abs().sum())
-        .fold(0.0, |norm, sum| {
-            if sum > norm || sum.is_nan() {
-                sum
-            } else {
-                norm
-            }
-        })
 }
 
 /// The Legendre transform of a constrained model: solves

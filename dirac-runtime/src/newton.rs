@@ -1,6 +1,6 @@
 //! Newton's method with an exact Jacobian and an LU solve, on a preallocated workspace.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Dim, IsContiguous, Matrix, Storage};
 
 use crate::error::DiracError;
 use crate::lu::{self, SingularPivot};
@@ -790,7 +790,10 @@ fn round_off(x_max: f64) -> f64 {
 
 /// `‖A‖∞`, the largest absolute row sum, accumulated column by column in `sums` (scratch, a
 /// row each: the same sums in the same order as row by row). Not finite where an entry is not.
-fn row_sum_norm(a: &DMatrix<f64>, sums: &mut [f64]) -> f64 {
+pub(crate) fn row_sum_norm<R: Dim, C: Dim, S: Storage<f64, R, C> + IsContiguous>(
+    a: &Matrix<f64, R, C, S>,
+    sums: &mut [f64],
+) -> f64 {
     let sums = &mut sums[..a.nrows()];
     sums.fill(0.0);
     for column in a.as_slice().chunks_exact(a.nrows().max(1)) {

@@ -154,6 +154,13 @@ impl Slot {
         Some(())
     }
 
+    /// The component's own index of the whole model's one-form `index`, when it is one of its.
+    fn own_one_form<S: DiracSystem<M>, const M: usize>(&self, index: usize) -> Option<usize> {
+        index
+            .checked_sub(self.one_form)
+            .filter(|&a| a < S::ONE_FORMS)
+    }
+
     /// The whole model's one-form `index` when it is one of the component's (`None` otherwise).
     pub fn one_form<S: DiracSystem<M>, D: Scalar, const N: usize, const M: usize>(
         &self,
@@ -161,9 +168,7 @@ impl Slot {
         q: &SVector<D, N>,
         index: usize,
     ) -> Option<SVector<D, N>> {
-        let own = index
-            .checked_sub(self.one_form)
-            .filter(|&a| a < S::ONE_FORMS)?;
+        let own = self.own_one_form::<S, M>(index)?;
         let mut form = SVector::from_element(D::from(0.0));
         self.place(&mut form, &component.one_form(&self.part(q), own));
         Some(form)
@@ -177,9 +182,7 @@ impl Slot {
         instance: &str,
         index: usize,
     ) -> Option<String> {
-        let own = index
-            .checked_sub(self.one_form)
-            .filter(|&a| a < S::ONE_FORMS)?;
+        let own = self.own_one_form::<S, M>(index)?;
         Some(format!("{} of {instance}", component.one_form_name(own)))
     }
 
@@ -190,9 +193,7 @@ impl Slot {
         component: &S,
         index: usize,
     ) -> Option<bool> {
-        let own = index
-            .checked_sub(self.one_form)
-            .filter(|&a| a < S::ONE_FORMS)?;
+        let own = self.own_one_form::<S, M>(index)?;
         Some(component.one_form_is_constant(own))
     }
 

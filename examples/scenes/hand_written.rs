@@ -21,8 +21,8 @@ pub trait HandEquations<const N: usize> {
     /// The momentum `∂L/∂v` at `(q, v)`.
     fn momentum(&self, q: &SVector<N>, v: &SVector<N>) -> SVector<N>;
 
-    /// The residual at `x` of the step from `(q0, p0)` over `h`, with its Jacobian when asked
-    /// for; writes `p_{k+1}` into `p1` and returns the size of the residual's terms.
+    /// The residual at `x` of the step from `(q0, p0)` over `h`, with its Jacobian (added into
+    /// the zeroed matrix Newton hands over) when asked for; writes `p_{k+1}` into `p1` and returns the size of the residual's terms.
     #[allow(clippy::too_many_arguments)]
     fn assemble(
         &self,
@@ -220,9 +220,6 @@ impl HandEquations<2> for Galerkin2 {
         // D_j L_d for j = 0, 1, 2, and the size of their terms.
         let mut slots = [SVector::<2>::zeros(); 3];
         let mut size = p0.amax();
-        if let Some(j) = j.as_deref_mut() {
-            j.fill(0.0);
-        }
         for c in Self::NODES {
             let phi = Self::basis(c);
             let q = q0 + xi[0] * phi[1].0 + xi[1] * phi[2].0;
@@ -292,7 +289,7 @@ impl HandEquations<3> for KnifeEdgeMidpoint {
             .copy_from(&(p0 + lq * (0.5 * h) - mv + impulse));
         r[3] = a.dot(&xi);
         if let Some(j) = j {
-            j.fill(0.0);
+            // Newton hands the Jacobian over zeroed.
             let masses = [s.m, s.m, s.j];
             // ∂A/∂φ = (cos φ, sin φ, 0), at the midpoint: half of it per unit of ξ_φ.
             let da = SVector::<3>::new(cos, sin, 0.0);
