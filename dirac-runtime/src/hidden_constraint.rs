@@ -231,7 +231,6 @@ impl HiddenConstraints {
     ) -> (DVector<f64>, DMatrix<f64>, DMatrix<f64>, f64) {
         let qq = seeded(system, q, v, Seed::POSITION, Seed::POSITION);
         let qv = seeded(system, q, v, Seed::POSITION, Seed::VELOCITY).mixed;
-        let transport = qv.transpose() * v;
         let (mut force, mut force_q, mut force_v) =
             (SVector::zeros(), SMatrix::zeros(), SMatrix::zeros());
         if S::FORCES {
@@ -239,24 +238,51 @@ impl HiddenConstraints {
             force_v = force_jacobian(system, q, v, t, inputs, Seed::VELOCITY).1;
         }
         let d = &self.dead;
-        let value = DVector::from_iterator(
-            d.len(),
-            d.iter().map(|&i| qq.first[i] + force[i] - transport[i]),
-        );
+        let (value, scale) = self.terms(&qq.first, &qv, &force, v);
+        let value = DVector::from_iterator(d.len(), value.iter().take(d.len()).copied());
         let by_v = DMatrix::from_fn(d.len(), N, |r, c| {
             qv[(d[r], c)] - qv[(c, d[r])] + force_v[(d[r], c)]
         });
         let by_q = DMatrix::from_fn(d.len(), N, |r, c| qq.mixed[(d[r], c)] + force_q[(d[r], c)]);
-        let scale = d
-            .iter()
-            .map(|&i| {
-                qq.first[i]
-                    .abs()
-                    .max(force[i].abs())
-                    .max(transport[i].abs())
-            })
-            .fold(0.0, f64::max);
         (value, by_v, by_q, scale)
+    }
+
+    /// `R_D(q, v, t)` (its first `|D|` entries) and the size of its terms, as
+    /// [`rows`](Self::rows) finds them, without their Jacobians: on the stack.
+    fn rows_at<S: DiracSystem<N>, const N: usize>(
+        &self,
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        t: f64,
+        inputs: &[f64],
+    ) -> (SVector<f64, N>, f64) {
+        let l = seeded(system, q, v, Seed::POSITION, Seed::VELOCITY);
+        let force = if S::FORCES {
+            system.force(q, v, t, inputs)
+        } else {
+            SVector::zeros()
+        };
+        self.terms(&l.first, &l.mixed, &force, v)
+    }
+
+    /// `R_D = ∂L/∂q + F − (∂²L/∂q∂v)ᵀ v` on the degenerate coordinates (its first `|D|`
+    /// entries) and the size of its terms.
+    fn terms<const N: usize>(
+        &self,
+        lq: &SVector<f64, N>,
+        qv: &SMatrix<f64, N, N>,
+        force: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> (SVector<f64, N>, f64) {
+        let transport = qv.transpose() * v;
+        let mut value = SVector::zeros();
+        let mut scale: f64 = 0.0;
+        for (r, &i) in self.dead.iter().enumerate() {
+            value[r] = lq[i] + force[i] - transport[i];
+            scale = scale.max(lq[i].abs().max(force[i].abs()).max(transport[i].abs()));
+        }
+        (value, scale)
     }
 
     /// The algebraic combinations `G = W U` of the degenerate rows (columns), the free
@@ -343,13 +369,23 @@ impl HiddenConstraints {
             return Ok(());
         }
         let mut last = f64::INFINITY;
+        let settled = |residual: f64, scale: f64, last: f64| {
+            if !residual.is_finite() {
+                return Err("a hidden constraint is not finite at the step's end".to_string());
+            }
+            Ok(residual <= ROUND_OFF * scale || residual >= 0.5 * last)
+        };
         for _ in 0..MAX_ITERATIONS {
+            // Where G is fixed, c alone first: a step that holds c to round-off (a circuit's,
+            // whose hidden constraints are linear) is accepted without the differential.
+            if let Some((residual, scale)) = self.fixed_residual(system, q, v, t, inputs)
+                && settled(residual, scale, last)?
+            {
+                return self.accept(residual, scale);
+            }
             let e = self.evaluate(system, q, v, t, inputs)?;
             let residual = e.value.amax();
-            if !residual.is_finite() {
-                return Err("a hidden constraint is not finite at the step's end".into());
-            }
-            if residual <= ROUND_OFF * e.scale || residual >= 0.5 * last {
+            if settled(residual, e.scale, last)? {
                 return self.accept(residual, e.scale);
             }
             last = residual;
@@ -362,6 +398,36 @@ impl HiddenConstraints {
         }
         let e = self.evaluate(system, q, v, t, inputs)?;
         self.accept(e.value.amax(), e.scale)
+    }
+
+    /// `max_k |c_k(q)|` and the size of the terms summed into `c`, as [`evaluate`](Self::evaluate)
+    /// finds them, where `G` is fixed (else `None`): on the stack, without the differential and
+    /// the free directions.
+    fn fixed_residual<S: DiracSystem<N>, const N: usize>(
+        &self,
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+        t: f64,
+        inputs: &[f64],
+    ) -> Option<(f64, f64)> {
+        let (g, _) = self.fixed.as_ref()?;
+        if g.ncols() != self.count || !constant_forms(system, q) {
+            return None;
+        }
+        let (value, scale) = self.rows_at(system, q, v, t, inputs);
+        // c = Gᵀ R_D, summed over the rows in order as the matrix product sums them.
+        let residual = g
+            .column_iter()
+            .map(|column| {
+                let mut c = 0.0;
+                for (r, &x) in column.iter().enumerate() {
+                    c += x * value[r];
+                }
+                c.abs()
+            })
+            .fold(0.0, f64::max);
+        Some((residual, scale))
     }
 
     fn accept(&self, residual: f64, scale: f64) -> Result<(), String> {
