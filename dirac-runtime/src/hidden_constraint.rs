@@ -234,7 +234,9 @@ impl HiddenConstraints {
         let (mut force, mut force_q, mut force_v) =
             (SVector::zeros(), SMatrix::zeros(), SMatrix::zeros());
         if S::FORCES {
-            (force, force_q) = force_jacobian(system, q, v, t, inputs, Seed::POSITION);
+            // The value as `rows_at` takes it (in f64), its Jacobians by dual numbers.
+            force = system.force(q, v, t, inputs);
+            force_q = force_jacobian(system, q, v, t, inputs, Seed::POSITION).1;
             force_v = force_jacobian(system, q, v, t, inputs, Seed::VELOCITY).1;
         }
         let d = &self.dead;
@@ -384,7 +386,7 @@ impl HiddenConstraints {
                 return self.accept(residual, scale);
             }
             let e = self.evaluate(system, q, v, t, inputs)?;
-            let residual = e.value.amax();
+            let residual = largest(e.value.iter().copied());
             if settled(residual, e.scale, last)? {
                 return self.accept(residual, e.scale);
             }
@@ -397,7 +399,7 @@ impl HiddenConstraints {
             *q += SVector::<f64, N>::from_fn(|i, _| step[i]);
         }
         let e = self.evaluate(system, q, v, t, inputs)?;
-        self.accept(e.value.amax(), e.scale)
+        self.accept(largest(e.value.iter().copied()), e.scale)
     }
 
     /// `max_k |c_k(q)|` and the size of the terms summed into `c`, as [`evaluate`](Self::evaluate)
@@ -417,16 +419,13 @@ impl HiddenConstraints {
         }
         let (value, scale) = self.rows_at(system, q, v, t, inputs);
         // c = Gᵀ R_D, summed over the rows in order as the matrix product sums them.
-        let residual = g
-            .column_iter()
-            .map(|column| {
-                let mut c = 0.0;
-                for (r, &x) in column.iter().enumerate() {
-                    c += x * value[r];
-                }
-                c.abs()
-            })
-            .fold(0.0, f64::max);
+        let residual = largest(g.column_iter().map(|column| {
+            let mut c = 0.0;
+            for (r, &x) in column.iter().enumerate() {
+                c += x * value[r];
+            }
+            c
+        }));
         Some((residual, scale))
     }
 
@@ -451,6 +450,18 @@ fn constant_forms<S: DiracSystem<N>, const N: usize>(system: &S, q: &SVector<f64
                 .1
                 .is_none_or(|d| d.iter().all(|x| *x == 0.0))
         })
+}
+
+/// The largest magnitude among `values`, or NaN where one is NaN (which `f64::max` and
+/// nalgebra's `amax` would pass over).
+fn largest(values: impl Iterator<Item = f64>) -> f64 {
+    values.fold(0.0, |m: f64, x| {
+        if m.is_nan() || x.is_nan() {
+            f64::NAN
+        } else {
+            m.max(x.abs())
+        }
+    })
 }
 
 /// Iterations of the projection (a linear hidden constraint needs one).
@@ -482,7 +493,48 @@ pub(crate) fn null_space(m: &DMatrix<f64>) -> DMatrix<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::dmatrix;
+    use crate::scalar::Scalar;
+    use nalgebra::{dmatrix, vector};
+
+    /// A mass `x` driving two capacitors in series with it and in parallel with each other,
+    /// `ȧ + ḃ = ẋ`, one of them nonlinear with energy `(1 + b)^{3/2}`: the hidden constraint
+    /// `∂L/∂a = ∂L/∂b`, `a = 1.5 √(1 + b)`, whose row is not finite for `b < −1`.
+    struct Parallel;
+    impl DiracSystem<3> for Parallel {
+        const ONE_FORMS: usize = 1;
+        fn lagrangian<D: Scalar>(&self, q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+            v[0] * v[0] * 0.5 - q[1] * q[1] * 0.5 - (q[2] + 1.0).powf(1.5)
+        }
+        fn one_form<D: Scalar>(&self, _q: &SVector<D, 3>, _a: usize) -> SVector<D, 3> {
+            SVector::from([D::from(-1.0), D::from(1.0), D::from(1.0)])
+        }
+        fn one_form_is_constant(&self, _a: usize) -> bool {
+            true
+        }
+    }
+
+    #[test]
+    fn a_hidden_constraint_that_is_not_finite_is_refused_not_accepted() {
+        let (q, v) = (vector![0.0, 1.5, 0.0], vector![1.0, 0.5, 0.5]);
+        let hidden = HiddenConstraints::find(&Parallel, &q, &v, 0.0, &[]);
+        assert_eq!((hidden.coordinates(), hidden.count()), (&[1, 2][..], 1));
+        assert!(hidden.is_fixed());
+        // On the constraint it is held as it is; off it, q moves onto it.
+        let mut on = q;
+        hidden.project(&Parallel, &mut on, &v, 0.0, &[]).unwrap();
+        assert_eq!(on, q);
+        let mut off = vector![0.0, 1.0, 0.0];
+        hidden.project(&Parallel, &mut off, &v, 0.0, &[]).unwrap();
+        assert!((off[1] - 1.5 * (1.0 + off[2]).sqrt()).abs() < 1e-12, "{off:?}");
+        assert_eq!(off[0], 0.0);
+        // Outside the Lagrangian's domain the constraint is NaN: an error, q as it was.
+        let mut outside = vector![0.0, 1.5, -2.0];
+        let err = hidden
+            .project(&Parallel, &mut outside, &v, 0.0, &[])
+            .unwrap_err();
+        assert!(err.contains("not finite"), "{err}");
+        assert_eq!(outside, vector![0.0, 1.5, -2.0]);
+    }
 
     #[test]
     fn null_space_of_a_rank_one_matrix() {
