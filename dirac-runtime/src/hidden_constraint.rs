@@ -525,7 +525,10 @@ mod tests {
         assert_eq!(on, q);
         let mut off = vector![0.0, 1.0, 0.0];
         hidden.project(&Parallel, &mut off, &v, 0.0, &[]).unwrap();
-        assert!((off[1] - 1.5 * (1.0 + off[2]).sqrt()).abs() < 1e-12, "{off:?}");
+        assert!(
+            (off[1] - 1.5 * (1.0 + off[2]).sqrt()).abs() < 1e-12,
+            "{off:?}"
+        );
         assert_eq!(off[0], 0.0);
         // Outside the Lagrangian's domain the constraint is NaN: an error, q as it was.
         let mut outside = vector![0.0, 1.5, -2.0];
