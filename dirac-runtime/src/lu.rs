@@ -3,7 +3,7 @@
 
 use nalgebra::{DMatrix, Dim, IsContiguous, Matrix, SMatrix, Storage, StorageMut};
 
-/// `fixed::<N>(args)` with `N = n` for `n` up to 8, `general` otherwise.
+/// `fixed::<N>(args)` with `N = n` for `n` up to 20, `general` otherwise.
 macro_rules! by_size {
     ($n:expr, $fixed:ident($($arg:expr),*), $general:expr) => {
         match $n {
@@ -15,6 +15,18 @@ macro_rules! by_size {
             6 => $fixed::<6>($($arg),*),
             7 => $fixed::<7>($($arg),*),
             8 => $fixed::<8>($($arg),*),
+            9 => $fixed::<9>($($arg),*),
+            10 => $fixed::<10>($($arg),*),
+            11 => $fixed::<11>($($arg),*),
+            12 => $fixed::<12>($($arg),*),
+            13 => $fixed::<13>($($arg),*),
+            14 => $fixed::<14>($($arg),*),
+            15 => $fixed::<15>($($arg),*),
+            16 => $fixed::<16>($($arg),*),
+            17 => $fixed::<17>($($arg),*),
+            18 => $fixed::<18>($($arg),*),
+            19 => $fixed::<19>($($arg),*),
+            20 => $fixed::<20>($($arg),*),
             _ => $general,
         }
     };
@@ -210,7 +222,7 @@ mod tests {
 
     #[test]
     fn the_fixed_size_path_factorises_and_solves_bit_for_bit_as_the_general_one() {
-        for n in 1..=12 {
+        for n in 1..=24 {
             let a = scrambled(n);
             let (mut fixed, mut general) = (a.clone(), a.clone());
             let (mut p_fixed, mut p_general) = (vec![0; n], vec![0; n]);
