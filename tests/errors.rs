@@ -390,3 +390,39 @@ fn an_invalid_quadrature_of_a_model_is_an_error() {
         Err(DiracError::InvalidQuadrature(_))
     ));
 }
+
+/// A free particle on the plane held to move radially, `A(q) = q/|q|`: the one-form is not
+/// finite at the origin.
+struct Radial;
+
+impl DiracSystem<2> for Radial {
+    const ONE_FORMS: usize = 1;
+    fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+        (v[0] * v[0] + v[1] * v[1]) * 0.5
+    }
+    fn one_form<D: Scalar>(&self, q: &SVector<D, 2>, _a: usize) -> SVector<D, 2> {
+        let r = (q[0] * q[0] + q[1] * q[1]).sqrt();
+        SVector::from([q[1] / r, -q[0] / r])
+    }
+}
+
+/// A start where a constraint is not finite is refused, not stepped from: the midpoint rule
+/// holds the one-form away from the start, where it is finite, so nothing else would notice.
+#[test]
+fn a_constraint_that_is_not_finite_at_the_start_is_refused() {
+    let mut stepper = Stepper::new(Radial, Quadrature::midpoint(), 0.1).unwrap();
+    let err = stepper
+        .start_from_velocity(SVector::zeros(), vector![1.0, 0.0])
+        .unwrap_err();
+    assert!(
+        matches!(&err, DiracError::InconsistentInitialState(why) if why.contains("not finite")),
+        "{err}"
+    );
+    assert_eq!(stepper.energy(), Err(DiracError::NotStarted));
+    // Away from the origin the same model starts and keeps its constraint.
+    stepper
+        .start_from_velocity(vector![1.0, 0.0], vector![1.0, 0.0])
+        .unwrap();
+    stepper.run(10).unwrap();
+    assert!(stepper.q()[1].abs() < 1e-12, "{}", stepper.q());
+}

@@ -32,7 +32,7 @@ use crate::initial_state;
 use crate::layout::Layout;
 use crate::legendre;
 use crate::manifold::Vectors;
-use crate::newton::{Newton, NewtonFailure};
+use crate::newton::{Newton, NewtonFailure, exceeds, largest};
 use crate::quadrature::MAX_DEGREE;
 use crate::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step_equations::{State, StepEquations};
@@ -965,7 +965,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                     continue;
                 }
                 for t in [-1.0, 0.371, 1.13, 2.9, 17.3].map(|offset| state.t + offset) {
-                    if (at(&point, t)?.value - &here.value).amax() > 1e-12 * here.scale {
+                    let change = largest((at(&point, t)?.value - &here.value).iter().copied());
+                    if exceeds(change, 1e-12 * here.scale) {
                         return Err(DiracError::Unsupported(format!(
                             "a hidden constraint of the coordinates without kinetic energy ({}) \
                              that depends on time explicitly (a force on them that depends on t)",

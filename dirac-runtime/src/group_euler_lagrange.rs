@@ -35,7 +35,7 @@ use crate::error::DiracError;
 use crate::layout::Layout;
 use crate::legendre;
 use crate::manifold::Manifold;
-use crate::newton::{Newton, NewtonFailure};
+use crate::newton::{Newton, NewtonFailure, exceeds};
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
 
@@ -185,7 +185,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             let row = forms.row(a);
             let rate = (row * xi_dot)[0];
             let size = row.abs().dot(&xi_dot.abs().transpose());
-            if rate.abs() > tolerance * size.max(f64::MIN_POSITIVE) {
+            if exceeds(rate.abs(), tolerance * size.max(f64::MIN_POSITIVE)) {
                 return Err(DiracError::InconsistentInitialState(format!(
                     "the initial velocity violates one-form {a}: A·v = {rate:.3e}"
                 )));

@@ -70,7 +70,7 @@ use crate::error::DiracError;
 use crate::hamiltonian_system::HamiltonianSystem;
 use crate::lu;
 use crate::manifold::Vectors;
-use crate::newton::{Newton, NewtonFailure};
+use crate::newton::{Newton, NewtonFailure, exceeds};
 use crate::quadrature::{Quadrature, Rule};
 use crate::step_derivatives::StepDerivatives;
 use crate::step_equations::{State, StepEquations};
@@ -635,13 +635,19 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         for b in 0..S::HOLONOMIC {
             let (g, form, _) =
                 derivatives::scalar_hessian(&state.q, |q| self.system.holonomic(q, b));
-            if g.abs() > tolerance * form.abs().dot(&state.q.abs()).max(f64::MIN_POSITIVE) {
+            if exceeds(
+                g.abs(),
+                tolerance * form.abs().dot(&state.q.abs()).max(f64::MIN_POSITIVE),
+            ) {
                 return Err(DiracError::InconsistentInitialState(format!(
                     "the initial position violates holonomic constraint {b}: g = {g:.3e}"
                 )));
             }
             let rate = form.dot(&v);
-            if rate.abs() > tolerance * form.abs().dot(&v.abs()).max(f64::MIN_POSITIVE) {
+            if exceeds(
+                rate.abs(),
+                tolerance * form.abs().dot(&v.abs()).max(f64::MIN_POSITIVE),
+            ) {
                 return Err(DiracError::InconsistentInitialState(format!(
                     "holonomic constraint {b} at the initial state: no momentum p + dg(q)ᵀν \
                      gives a velocity ∂H/∂p tangent to it (dg(q) ∂H/∂p = {rate:.3e})"
@@ -652,7 +658,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
             let form = self.system.one_form(&state.q, a);
             let scale = form.abs().dot(&v.abs()).max(form.amax() * v.amax());
             let value = form.dot(&v);
-            if value.abs() > tolerance * scale.max(f64::MIN_POSITIVE) && value.abs() > 0.0 {
+            if exceeds(value.abs(), tolerance * scale.max(f64::MIN_POSITIVE)) && value != 0.0 {
                 return Err(DiracError::InconsistentInitialState(format!(
                     "one-form {a} at the initial state: no momentum p + C(q)ᵀν gives a velocity \
                      ∂H/∂p the one-forms allow (A(q) ∂H/∂p = {value:e})"
@@ -729,6 +735,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
             });
         }
         next.velocity = self.velocity_at(&next.q, &next.p);
+        // ∂H/∂p can leave its domain where H does not (|p| at p = 0).
+        finite("new velocity ∂H/∂p", &next.velocity)?;
         Ok((next, self.violation(state, x)))
     }
 
@@ -832,7 +840,12 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         p: &SVector<f64, N>,
         _guess: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, NewtonFailure> {
-        Ok(self.velocity_at(q, p))
+        let v = self.velocity_at(q, p);
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(v)
+        } else {
+            Err(NewtonFailure::NonFinite)
+        }
     }
 
     /// The momentum whose velocity `∂H/∂p(q, p)` is `v`, by Newton's method on the Legendre

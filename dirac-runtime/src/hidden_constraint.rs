@@ -39,6 +39,7 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::constraint;
 use crate::derivatives::{Seed, degenerate, degenerate_at, force_jacobian, seeded};
+use crate::newton::largest;
 use crate::system::DiracSystem;
 
 /// The degenerate coordinates of a model and the number of its hidden constraints, found at the
@@ -450,18 +451,6 @@ fn constant_forms<S: DiracSystem<N>, const N: usize>(system: &S, q: &SVector<f64
                 .1
                 .is_none_or(|d| d.iter().all(|x| *x == 0.0))
         })
-}
-
-/// The largest magnitude among `values`, or NaN where one is NaN (which `f64::max` and
-/// nalgebra's `amax` would pass over).
-fn largest(values: impl Iterator<Item = f64>) -> f64 {
-    values.fold(0.0, |m: f64, x| {
-        if m.is_nan() || x.is_nan() {
-            f64::NAN
-        } else {
-            m.max(x.abs())
-        }
-    })
 }
 
 /// Iterations of the projection (a linear hidden constraint needs one).

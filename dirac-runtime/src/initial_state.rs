@@ -6,6 +6,7 @@ use nalgebra::{DMatrix, SVector};
 
 use crate::constraint;
 use crate::hidden_constraint::HiddenConstraints;
+use crate::newton::{exceeds, largest};
 use crate::system::DiracSystem;
 
 /// Checks `(q0, v0)` against the holonomic constraints `g(q0) = 0`, `dg(q0) v0 = 0`, the one-forms
@@ -15,7 +16,8 @@ use crate::system::DiracSystem;
 ///
 /// Each residual is compared with `tolerance` times the size of the terms it sums
 /// (`Σ_i |∂g/∂q_i q_i|` for `g`, `Σ_i |A_i v_i|` for `A v`, the largest term of a balance): the
-/// check is independent of the units, and a state a stepper produced passes it.
+/// check is independent of the units, and a state a stepper produced passes it. A constraint,
+/// form or balance that is not finite at the state is a violation (a NaN passes no test).
 pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
     system: &S,
     t0: f64,
@@ -27,13 +29,19 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
     let name = |i: usize| system.coordinate_name(i);
     for b in 0..S::HOLONOMIC {
         let (g, form) = constraint::holonomic(system, q0, b);
-        if g.abs() > tolerance * size(&form, q0) {
+        if !(g.is_finite() && form.iter().all(|x| x.is_finite())) {
+            return Err(format!(
+                "holonomic constraint {b} or its differential is not finite at the initial \
+                 position (g = {g:.3e})"
+            ));
+        }
+        if exceeds(g.abs(), tolerance * size(&form, q0)) {
             return Err(format!(
                 "the initial position violates holonomic constraint {b}: g = {g:.3e}"
             ));
         }
         let rate = form.dot(v0);
-        if rate.abs() > tolerance * size(&form, v0) {
+        if exceeds(rate.abs(), tolerance * size(&form, v0)) {
             return Err(format!(
                 "the initial velocity is not tangent to holonomic constraint {b}: dg·v = {rate:.3e}"
             ));
@@ -43,8 +51,14 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
         .map(|a| constraint::one_form(system, q0, a).0)
         .collect();
     for (a, form) in forms.iter().enumerate() {
+        if !form.iter().all(|x| x.is_finite()) {
+            return Err(format!(
+                "constraint one-form {a} ({}) is not finite at the initial position",
+                system.one_form_name(a)
+            ));
+        }
         let rate = form.dot(v0);
-        if rate.abs() > tolerance * size(form, v0) {
+        if exceeds(rate.abs(), tolerance * size(form, v0)) {
             return Err(format!(
                 "the initial velocity violates constraint one-form {a}: A·v = {rate:.3e}"
             ));
@@ -58,16 +72,23 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
     let (unbalanced, _, size) = rows.rows_in_velocity(system, q0, v0, t0, inputs);
     let (dead, forms) = (rows.coordinates(), HiddenConstraints::forms(system, q0));
     let matrix = DMatrix::from_fn(dead.len(), forms.nrows(), |r, c| forms[(c, dead[r])]);
+    if !unbalanced.iter().all(|x| x.is_finite()) {
+        return Err(
+            "the Euler–Lagrange rows of the coordinates without kinetic energy are not finite \
+             at the initial state"
+                .to_string(),
+        );
+    }
     let residual = if forms.nrows() == 0 {
-        unbalanced.amax()
+        largest(unbalanced.iter().copied())
     } else {
         let svd = matrix.clone().svd(true, true);
         let cutoff = 1e-12 * svd.singular_values.amax();
         let rhs = -&unbalanced;
         let multipliers = svd.solve(&rhs, cutoff).map_err(|e| e.to_string())?;
-        (matrix * multipliers - &rhs).amax()
+        largest((matrix * multipliers - &rhs).iter().copied())
     };
-    if residual > tolerance * size {
+    if exceeds(residual, tolerance * size) {
         let names: Vec<String> = dead.iter().map(|&i| name(i)).collect();
         return Err(format!(
             "the initial state violates a hidden constraint of the coordinates without kinetic \

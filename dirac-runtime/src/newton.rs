@@ -788,6 +788,24 @@ fn round_off(x_max: f64) -> f64 {
     4.0 * f64::EPSILON * (1.0 + x_max)
 }
 
+/// Whether the error measure `x` exceeds `bound`, or either is NaN: a test that a NaN (a
+/// constraint or balance that is not finite) cannot pass.
+pub(crate) fn exceeds(x: f64, bound: f64) -> bool {
+    x.is_nan() || bound.is_nan() || x > bound
+}
+
+/// The largest magnitude among `values`, or NaN where one is NaN (which `f64::max` and
+/// nalgebra's `amax` pass over): an error measure that a NaN cannot make look small.
+pub(crate) fn largest(values: impl IntoIterator<Item = f64>) -> f64 {
+    values.into_iter().fold(0.0, |m: f64, x| {
+        if m.is_nan() || x.is_nan() {
+            f64::NAN
+        } else {
+            m.max(x.abs())
+        }
+    })
+}
+
 /// `‖A‖∞`, the largest absolute row sum, accumulated column by column in `sums` (scratch, a
 /// row each: the same sums in the same order as row by row). Not finite where an entry is not.
 pub(crate) fn row_sum_norm<R: Dim, C: Dim, S: Storage<f64, R, C> + IsContiguous>(
@@ -813,6 +831,20 @@ pub(crate) fn row_sum_norm<R: Dim, C: Dim, S: Storage<f64, R, C> + IsContiguous>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn error_measures_do_not_pass_over_nan() {
+        assert_eq!(largest([1.0, -3.0, 2.0]), 3.0);
+        assert_eq!(largest(std::iter::empty()), 0.0);
+        for at in 0..3 {
+            let mut values = [1.0, -3.0, 2.0];
+            values[at] = f64::NAN;
+            // nalgebra's amax passes over a NaN that a larger entry follows.
+            assert!(largest(values).is_nan(), "NaN at {at}");
+        }
+        assert!(!exceeds(1.0, 1.0) && exceeds(1.5, 1.0));
+        assert!(exceeds(f64::NAN, 1.0) && exceeds(0.0, f64::NAN));
+    }
 
     #[test]
     fn converges_quadratically_on_a_coupled_system() {

@@ -21,6 +21,7 @@ use std::time::Instant;
 
 use crate::dense_output::Sample;
 use crate::error::DiracError;
+use crate::newton::largest;
 use crate::quadrature::Quadrature;
 use crate::run::Run;
 use crate::stepper::Stepper;
@@ -263,6 +264,17 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
                     "the reference's error estimate must be finite and not negative, got {error}"
                 ));
             }
+            if !reference
+                .q
+                .iter()
+                .chain(&reference.p)
+                .all(|x| x.is_finite())
+            {
+                return invalid(format!(
+                    "the reference state must be finite, got q = {}, p = {}",
+                    reference.q, reference.p
+                ));
+            }
             // The start function sets the time the horizon counts from.
             let t0 = self.stepper(&self.quadratures[0], self.steps[0])?.t();
             let t_end = t0 + self.horizon;
@@ -305,7 +317,7 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
                 .and_then(|a| Ok((a, self.solution(&quadrature, fine)?)));
             match runs {
                 Ok((a, b)) => {
-                    let difference = (a.q - b.q).amax().max((a.p - b.p).amax());
+                    let difference = distance(&a, &b);
                     let method = format!("{} at h = {fine}", quadrature.name());
                     return Ok((b, method, difference));
                 }
@@ -331,9 +343,7 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
         });
         let solution = stepper.solve(run)?;
         let end = stepper.interpolate(t_end)?;
-        let error = (end.q - reference.q)
-            .amax()
-            .max((end.p - reference.p).amax());
+        let error = distance(&end, reference);
         let trajectory = &solution.trajectory;
         let steps = stepper.steps();
         let mut fastest = f64::INFINITY;
@@ -354,6 +364,12 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
             seconds_per_unit_time: fastest / self.horizon,
         })
     }
+}
+
+/// The largest difference between two states' positions and momenta (NaN where one is: a
+/// run that left its domain cannot meet a target).
+fn distance<const N: usize>(a: &Sample<N>, b: &Sample<N>) -> f64 {
+    largest((a.q - b.q).iter().chain((a.p - b.p).iter()).copied())
 }
 
 impl<const N: usize> WorkPrecision<N> {

@@ -173,9 +173,26 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         theta: f64,
     ) -> Result<Sample<N, E::Manifold>, DiracError> {
         let x = self.predictor.last().ok_or(DiracError::NotStarted)?;
-        self.equations
+        let sample = self
+            .equations
             .dense([a, b], x, theta)
-            .ok_or_else(|| DiracError::Unsupported(format!("dense output of {}", E::NAME)))
+            .ok_or_else(|| DiracError::Unsupported(format!("dense output of {}", E::NAME)))?;
+        // The path between two good steps can leave the Lagrangian's domain, where the momentum
+        // ∂L/∂v is not finite.
+        let components = E::Manifold::point_components(&sample.q)
+            .into_iter()
+            .chain(E::Manifold::tangent_components(&sample.v))
+            .chain(E::Manifold::tangent_components(&sample.p));
+        if let Some(value) = components.into_iter().find(|x| !x.is_finite()) {
+            return Err(DiracError::NonFinite {
+                what: format!(
+                    "the dense output at fraction {theta} of the step ending at t = {}",
+                    b.t
+                ),
+                value,
+            });
+        }
+        Ok(sample)
     }
 
     /// The run's loop; `solution` keeps what was saved whatever happens.
