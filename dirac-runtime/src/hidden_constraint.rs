@@ -393,6 +393,14 @@ impl HiddenConstraints {
             }
             last = residual;
             let reduced = &e.differential * &e.free;
+            // nalgebra's SVD does not return on a matrix with an entry that is not finite.
+            if !reduced.iter().all(|x| x.is_finite()) {
+                return Err(
+                    "the hidden constraints' differential is not finite at the step's \
+                            end"
+                    .into(),
+                );
+            }
             let svd = reduced.svd(true, true);
             let cutoff = 1e-12 * svd.singular_values.amax();
             let alpha = svd.solve(&(-&e.value), cutoff).map_err(|m| m.to_string())?;
@@ -462,9 +470,14 @@ const TOLERANCE: f64 = 1e-10;
 
 /// An orthonormal basis (columns) of `{x : m x = 0}`, by the singular value decomposition of
 /// `m` padded with zero rows to a square matrix: singular values below `1e-10` of the largest
-/// count as zero.
+/// count as zero. A matrix with an entry that is not finite (on which nalgebra's SVD does not
+/// return) gives `n` columns of NaN, so that whatever is built from them is not finite and is
+/// refused there.
 pub(crate) fn null_space(m: &DMatrix<f64>) -> DMatrix<f64> {
     let n = m.ncols();
+    if !m.iter().all(|x| x.is_finite()) {
+        return DMatrix::from_element(n, n, f64::NAN);
+    }
     if n == 0 || m.nrows() == 0 || m.amax() == 0.0 {
         return DMatrix::identity(n, n);
     }
@@ -538,5 +551,8 @@ mod tests {
         assert_eq!(null_space(&DMatrix::zeros(0, 3)).ncols(), 3);
         assert_eq!(null_space(&DMatrix::identity(2, 2)).ncols(), 0);
         assert_eq!(null_space(&DMatrix::zeros(2, 0)).ncols(), 0);
+        // Not finite in, not finite out (the SVD would not return).
+        let z = null_space(&dmatrix![f64::NAN, 1.0, 0.0; 2.0, 4.0, 0.0]);
+        assert!(z.ncols() == 3 && z.iter().all(|x| x.is_nan()));
     }
 }
