@@ -342,6 +342,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             // branch) fix their velocities through the dynamics, not through p.
             let forms = HiddenConstraints::forms(system, q);
             let (reached, unreached) = hidden.reach(system, q);
+            // Forms that are not finite here (NaN bases) fix no velocity: not the
+            // unconstrained one either.
+            let finite = |m: &DMatrix<f64>| m.iter().all(|x| x.is_finite());
+            if !(finite(&forms) && finite(&reached) && finite(&unreached)) {
+                return Err(NewtonFailure::NonFinite);
+            }
             if reached.ncols() + unreached.ncols() == hidden.coordinates().len() {
                 let newton = sized(newton, N + forms.nrows(), &mut spare)?;
                 let rows =
@@ -917,10 +923,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 return Err(DiracError::InvalidQuadrature(why));
             }
             let theta = legendre::momentum(system, q, v);
-            let size = theta.amax().max(p.amax());
+            let size = largest(theta.iter().chain(p.iter()).copied());
             if collocated
                 .iter()
-                .any(|&d| (p[d] - theta[d]).abs() > tolerance * size)
+                .any(|&d| exceeds((p[d] - theta[d]).abs(), tolerance * size))
             {
                 let names: Vec<String> = collocated
                     .iter()
@@ -953,6 +959,16 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                     .map_err(DiracError::InconsistentInitialState)
             };
             let start = at(q, state.t)?;
+            if let Some(&value) = start.value.iter().find(|c| !c.is_finite()) {
+                return Err(DiracError::NonFinite {
+                    what: format!(
+                        "a hidden constraint of the coordinates without kinetic energy ({}) at \
+                         the initial state",
+                        hidden.names(system)
+                    ),
+                    value,
+                });
+            }
             let moved = q + start.free()
                 * DVector::from_element(start.free().ncols(), 1.0)
                 * (1e-2 * (1.0 + q.amax()));

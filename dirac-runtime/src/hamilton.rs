@@ -504,6 +504,11 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
             .map(|b| derivatives::scalar_hessian(q, |q| self.system.holonomic(q, b)).1)
             .chain((0..S::ONE_FORMS).map(|a| self.system.one_form(q, a)))
             .collect();
+        if forms.iter().any(|f| !f.iter().all(|x| x.is_finite())) {
+            // A constraint form that is not finite here allows no momentum: NaN, which the
+            // velocity's finite checks refuse.
+            return SVector::from_element(f64::NAN);
+        }
         let hamiltonian = Hamiltonian(&self.system);
         let mut allowed = *p;
         for _ in 0..20 {
