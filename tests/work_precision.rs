@@ -191,4 +191,9 @@ fn an_invalid_study_is_refused() {
             Study::new(Oscillator, 1.0, start).reference_with_error(oscillator_at(1.0), bad)
         ));
     }
+    // A reference that is not finite is refused (its NaN component would drop out of the
+    // errors, and a run could seem to meet a target it does not).
+    let mut nan = oscillator_at(1.0);
+    nan.p[0] = f64::NAN;
+    assert!(invalid(Study::new(Oscillator, 1.0, start).reference(nan)));
 }
