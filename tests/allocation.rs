@@ -62,6 +62,24 @@ fn recording_allocates_nothing_per_sample() {
     let (short, long) = (count(10), count(10_000));
     println!("run(10): {short} allocations, run(10 000): {long}");
     assert_eq!(short, long, "allocations grow with the number of samples");
+    // Samples at given times come from the dense output, which allocates nothing either.
+    let saved = |n: usize| {
+        let mut stepper = double_pendulum::stepper(Quadrature::midpoint(), 0.01).unwrap();
+        stepper.step().unwrap();
+        let times: Vec<f64> = (1..=n).map(|i| 0.01 + 0.005 * i as f64 + 0.0013).collect();
+        let t_end = times[n - 1] + 0.01;
+        let run = Run::until(t_end).saveat(times);
+        allocations(|| {
+            let solution = stepper.solve(run).unwrap();
+            assert_eq!(solution.trajectory.len(), n);
+        })
+    };
+    let (short, long) = (saved(10), saved(10_000));
+    println!("saveat 10 times: {short} allocations, 10 000 times: {long}");
+    assert_eq!(
+        short, long,
+        "allocations grow with the number of saved times"
+    );
     // The bare steps allocate nothing at all.
     let mut stepper = double_pendulum::stepper(Quadrature::galerkin(2).unwrap(), 0.01).unwrap();
     stepper.step().unwrap();

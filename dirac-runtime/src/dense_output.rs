@@ -26,7 +26,7 @@ use nalgebra::SVector;
 
 use crate::configuration_space::ConfigurationSpace;
 use crate::manifold::{Manifold, Vectors};
-use crate::quadrature::Quadrature;
+use crate::quadrature::{MAX_DEGREE, Quadrature};
 
 /// The solution at one time: position, velocity and momentum.
 ///
@@ -81,12 +81,19 @@ pub(crate) fn chart_path<C: ConfigurationSpace<N>, const N: usize>(
 ) -> Option<ChartPath<N>> {
     let [a, b] = ends;
     let end = space.local(&a.q, &b.q)?;
-    let points: Vec<SVector<f64, N>> = internal.chain(std::iter::once(end)).collect();
-    let (_, start_rate) = quadrature.path_through(0.0, &points, h);
-    let (_, end_rate) = quadrature.path_through(1.0, &points, h);
+    // The path's points, on the stack (a step has at most MAX_DEGREE).
+    let mut stack = [SVector::<f64, N>::zeros(); MAX_DEGREE];
+    let mut count = 0;
+    for (slot, point) in stack.iter_mut().zip(internal.chain(std::iter::once(end))) {
+        *slot = point;
+        count += 1;
+    }
+    let points = &stack[..count];
+    let (_, start_rate) = quadrature.path_through(0.0, points, h);
+    let (_, end_rate) = quadrature.path_through(1.0, points, h);
     let d0 = space.chart_velocity(&a.q, &a.v)? - start_rate;
     let d1 = space.chart_rate(&a.q, &end, &b.v)? - end_rate;
-    let (path, rate) = quadrature.path_through(theta, &points, h);
+    let (path, rate) = quadrature.path_through(theta, points, h);
     let (correction, rate_correction) = end_slope_correction(theta, h, points.len(), &d0, &d1);
     Some(ChartPath {
         xi: path + correction,

@@ -239,14 +239,17 @@ impl Quadrature {
         points: &[SVector<f64, N>],
         h: f64,
     ) -> (SVector<f64, N>, SVector<f64, N>) {
-        let grid: Vec<f64> = (0..=self.degree)
-            .map(|j| j as f64 / self.degree as f64)
-            .collect();
+        // The equispaced grid, on the stack.
+        let mut grid = [0.0; MAX_DEGREE + 1];
+        for (j, x) in grid.iter_mut().enumerate().take(self.degree + 1) {
+            *x = j as f64 / self.degree as f64;
+        }
+        let grid = &grid[..=self.degree];
         let mut xi = SVector::zeros();
         let mut rate = SVector::zeros();
         for (j, z) in points.iter().enumerate() {
-            xi += z * lagrange(&grid, j + 1, theta);
-            rate += z * (lagrange_derivative(&grid, j + 1, theta) / h);
+            xi += z * lagrange(grid, j + 1, theta);
+            rate += z * (lagrange_derivative(grid, j + 1, theta) / h);
         }
         (xi, rate)
     }

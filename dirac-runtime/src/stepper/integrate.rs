@@ -178,18 +178,20 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             .dense([a, b], x, theta)
             .ok_or_else(|| DiracError::Unsupported(format!("dense output of {}", E::NAME)))?;
         // The path between two good steps can leave the Lagrangian's domain, where the momentum
-        // ∂L/∂v is not finite.
-        let components = E::Manifold::point_components(&sample.q)
-            .into_iter()
-            .chain(E::Manifold::tangent_components(&sample.v))
-            .chain(E::Manifold::tangent_components(&sample.p));
-        if let Some(value) = components.into_iter().find(|x| !x.is_finite()) {
+        // ∂L/∂v is not finite. Without allocating: paired with zero, a tangent vector gives
+        // exactly 0 where its entries are finite and NaN where one is not.
+        let pairing = |x: &<E::Manifold as Manifold<N>>::Tangent<f64>| {
+            E::Manifold::pair(x, &E::Manifold::zero())
+        };
+        let (v, p) = (pairing(&sample.v), pairing(&sample.p));
+        if v != 0.0 || p != 0.0 {
             return Err(DiracError::NonFinite {
                 what: format!(
-                    "the dense output at fraction {theta} of the step ending at t = {}",
+                    "the {} of the dense output at fraction {theta} of the step ending at t = {}",
+                    if v != 0.0 { "velocity" } else { "momentum" },
                     b.t
                 ),
-                value,
+                value: if v != 0.0 { v } else { p },
             });
         }
         Ok(sample)
