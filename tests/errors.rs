@@ -391,8 +391,8 @@ fn an_invalid_quadrature_of_a_model_is_an_error() {
     ));
 }
 
-/// A free particle on the plane held to move radially, `A(q) = q/|q|`: the one-form is not
-/// finite at the origin.
+/// A free particle on the plane held to move radially, `A(q) = (q₂, −q₁)/|q|`: the one-form is
+/// not finite at the origin.
 struct Radial;
 
 impl DiracSystem<2> for Radial {
@@ -406,8 +406,8 @@ impl DiracSystem<2> for Radial {
     }
 }
 
-/// A start where a constraint is not finite is refused, not stepped from: the midpoint rule
-/// holds the one-form away from the start, where it is finite, so nothing else would notice.
+/// A start where a constraint is not finite is refused there, naming it (the start check passed
+/// it before, and the first step failed with a singular Jacobian that named no cause).
 #[test]
 fn a_constraint_that_is_not_finite_at_the_start_is_refused() {
     let mut stepper = Stepper::new(Radial, Quadrature::midpoint(), 0.1).unwrap();

@@ -395,11 +395,7 @@ impl HiddenConstraints {
             let reduced = &e.differential * &e.free;
             // nalgebra's SVD does not return on a matrix with an entry that is not finite.
             if !reduced.iter().all(|x| x.is_finite()) {
-                return Err(
-                    "the hidden constraints' differential is not finite at the step's \
-                            end"
-                    .into(),
-                );
+                return Err("the hidden constraints' differential is not finite".into());
             }
             let svd = reduced.svd(true, true);
             let cutoff = 1e-12 * svd.singular_values.amax();

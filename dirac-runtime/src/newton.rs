@@ -819,13 +819,7 @@ pub(crate) fn row_sum_norm<R: Dim, C: Dim, S: Storage<f64, R, C> + IsContiguous>
             *sum += x.abs();
         }
     }
-    sums.iter().fold(0.0, |norm, &sum| {
-        if sum > norm || sum.is_nan() {
-            sum
-        } else {
-            norm
-        }
-    })
+    largest(sums.iter().copied())
 }
 
 #[cfg(test)]
