@@ -12,6 +12,8 @@
 //! model has them (`#[dirac_system]` derives them at compile time), else by dual numbers.
 #![warn(missing_docs)]
 
+mod banded;
+mod bordered;
 pub mod closed_form;
 pub mod configuration_space;
 pub mod constraint;
@@ -33,6 +35,7 @@ mod holonomic_scheme;
 mod initial_state;
 mod input;
 pub mod interconnection;
+pub mod jacobian;
 mod layout;
 pub mod legendre;
 mod lu;

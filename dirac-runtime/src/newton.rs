@@ -3,7 +3,8 @@
 use nalgebra::{DMatrix, DVector, Dim, IsContiguous, Matrix, Storage};
 
 use crate::error::DiracError;
-use crate::lu::{self, SingularPivot};
+use crate::jacobian::{Dense, Jacobian};
+use crate::lu::SingularPivot;
 
 /// Tolerances, iteration cap and root-acceptance rule of Newton's method.
 ///
@@ -187,14 +188,16 @@ pub enum NewtonFailure {
 /// assert!((x[0] - 2f64.sqrt()).abs() < 1e-15);
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
+///
+/// The Jacobian is [`Dense`] unless named: a solve by blocks (a [`Jacobian`] of another shape,
+/// e.g. [`Bordered`](crate::jacobian::Bordered)) takes the same iteration, tolerances and
+/// root-acceptance rule.
 #[derive(Debug, Clone)]
-pub struct Newton {
+pub struct Newton<J: Jacobian = Dense> {
     options: NewtonOptions,
     residual: DVector<f64>,
-    jacobian: DMatrix<f64>,
-    pivots: Vec<usize>,
-    /// The rows' scales while the Jacobian is factorised (scratch).
-    row_scales: Vec<f64>,
+    /// The Jacobian, factorised in place.
+    jacobian: J,
     /// The Newton update `J⁻¹ F`, kept apart from the residual for the line search.
     update: DVector<f64>,
     /// The trial point of the line search.
@@ -211,7 +214,7 @@ pub struct Newton {
     jacobian_cost: f64,
     /// The factorisation a solve began with, kept aside while it evaluates its own: a failed
     /// solve puts it back, so that a failure changes nothing a later solve would see.
-    kept: Kept,
+    kept: Kept<J>,
     /// `(‖J‖∞, factorised)` of the factorisation parked in `kept` while `jacobian` holds the
     /// one at the last root (see [`Newton::factorise_at`]).
     parked: Option<(f64, bool)>,
@@ -224,9 +227,8 @@ pub struct Newton {
 
 /// A factorised Jacobian set aside (see [`Newton::solve`]).
 #[derive(Debug, Clone)]
-struct Kept {
-    jacobian: DMatrix<f64>,
-    pivots: Vec<usize>,
+struct Kept<J> {
+    jacobian: J,
     norm: f64,
     /// The solve in progress began with a reusable factorisation that is still in `jacobian`
     /// of the solver (not yet set aside).
@@ -243,15 +245,37 @@ struct Evaluation {
 }
 
 impl Newton {
-    /// A solver for `n` unknowns; fails on options out of range.
+    /// A solver for `n` unknowns with a dense Jacobian; fails on options out of range.
     pub fn new(n: usize, options: NewtonOptions) -> Result<Self, DiracError> {
+        Self::with_jacobian(Dense::new(n), options)
+    }
+
+    /// `max |u_ii| / min |u_ii|` over the pivots of the Jacobian factorised at the last
+    /// successful solve's root: a lower bound of its condition number (infinite before any).
+    pub(crate) fn pivot_ratio(&self) -> f64 {
+        if !self.at_root {
+            return f64::INFINITY;
+        }
+        self.jacobian.pivot_ratio()
+    }
+}
+
+impl<J: Jacobian> Newton<J> {
+    /// A solver whose Jacobian has the shape of `jacobian` (its size is the number of
+    /// unknowns); fails on options out of range.
+    pub fn with_jacobian(jacobian: J, options: NewtonOptions) -> Result<Self, DiracError> {
         options.validate()?;
+        let n = jacobian.size();
         Ok(Self {
             options,
             residual: DVector::zeros(n),
-            jacobian: DMatrix::zeros(n, n),
-            pivots: vec![0; n],
-            row_scales: vec![0.0; n],
+            kept: Kept {
+                jacobian: jacobian.clone(),
+                norm: 0.0,
+                pending: false,
+                holding: false,
+            },
+            jacobian,
             update: DVector::zeros(n),
             trial: DVector::zeros(n),
             root: DVector::zeros(n),
@@ -259,13 +283,6 @@ impl Newton {
             factorised: false,
             jacobian_norm: 0.0,
             jacobian_cost: 1.0,
-            kept: Kept {
-                jacobian: DMatrix::zeros(n, n),
-                pivots: vec![0; n],
-                norm: 0.0,
-                pending: false,
-                holding: false,
-            },
             parked: None,
             jacobian_at_root: false,
             iterate: DVector::zeros(n),
@@ -276,8 +293,7 @@ impl Newton {
     /// of the last successful [`solve`](Self::solve) (the implicit function theorem's solves
     /// reuse it); `None` otherwise (no solve yet, a failed one since, or another point).
     pub(crate) fn solve_factorised(&self, root: &DVector<f64>, b: &mut DVector<f64>) -> Option<()> {
-        (self.at_root && &self.root == root)
-            .then(|| lu::solve(&self.jacobian, &self.pivots, b.as_mut_slice()))
+        (self.at_root && &self.root == root).then(|| self.jacobian.solve(b.as_mut_slice()))
     }
 
     /// The implicit function theorem's `∂x/∂z = −J⁻¹ ∂R/∂z`, in place of `∂R/∂z` (`n` rows, a
@@ -288,29 +304,15 @@ impl Newton {
         root: &DVector<f64>,
         b: &mut DMatrix<f64>,
     ) -> Option<()> {
-        if !(self.at_root && &self.root == root) || b.nrows() != self.jacobian.nrows() {
+        let n = self.jacobian.size();
+        if !(self.at_root && &self.root == root) || b.nrows() != n {
             return None;
         }
-        for column in b
-            .as_mut_slice()
-            .chunks_exact_mut(self.jacobian.nrows().max(1))
-        {
+        for column in b.as_mut_slice().chunks_exact_mut(n.max(1)) {
             column.iter_mut().for_each(|v| *v = -*v);
-            lu::solve(&self.jacobian, &self.pivots, column);
+            self.jacobian.solve(column);
         }
         Some(())
-    }
-
-    /// `max |u_ii| / min |u_ii|` over the pivots of the Jacobian factorised at the last
-    /// successful solve's root: a lower bound of its condition number (infinite before any).
-    pub(crate) fn pivot_ratio(&self) -> f64 {
-        if !self.at_root {
-            return f64::INFINITY;
-        }
-        let (largest, smallest) = (0..self.jacobian.nrows())
-            .map(|i| self.jacobian[(i, i)].abs())
-            .fold((0.0_f64, f64::INFINITY), |(l, s), u| (l.max(u), s.min(u)));
-        largest / smallest
     }
 
     /// The number of unknowns the solver is sized for.
@@ -334,28 +336,27 @@ impl Newton {
         with_jacobian: bool,
     ) -> Result<Evaluation, NewtonFailure>
     where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
     {
         let n = x.len();
         let scale = if with_jacobian {
             if std::mem::take(&mut self.kept.pending) {
                 // Set the factorisation the solve began with aside (buffers swap, no copy).
                 std::mem::swap(&mut self.jacobian, &mut self.kept.jacobian);
-                std::mem::swap(&mut self.pivots, &mut self.kept.pivots);
                 self.kept.norm = self.jacobian_norm;
                 self.kept.holding = true;
             }
             // The buffer no longer holds a factorisation, whatever happens next.
             self.factorised = false;
-            self.jacobian.fill(0.0);
-            evaluate(x, &mut self.residual, Some(&mut self.jacobian))
+            self.jacobian.clear();
+            evaluate(x, &mut self.residual, Some(self.jacobian.matrix()))
         } else {
             evaluate(x, &mut self.residual, None)
         };
-        if self.residual.len() != n || self.jacobian.shape() != (n, n) {
+        if self.residual.len() != n || !self.jacobian.fits(n) {
             let got = self.residual.len();
             self.residual = DVector::zeros(n);
-            self.jacobian = DMatrix::zeros(n, n);
+            self.jacobian.restore(n);
             self.factorised = false;
             self.kept.holding = false;
             return Err(NewtonFailure::Dimension { expected: n, got });
@@ -365,20 +366,14 @@ impl Newton {
             return Err(NewtonFailure::NonFinite);
         }
         if with_jacobian {
-            self.jacobian_norm = row_sum_norm(&self.jacobian, &mut self.row_scales);
+            self.jacobian_norm = self.jacobian.norm();
             // A norm that is not finite has an entry that is not, or overflowed.
-            if !self.jacobian_norm.is_finite()
-                && !self.jacobian.as_slice().iter().all(|v| v.is_finite())
-            {
+            if !self.jacobian_norm.is_finite() && !self.jacobian.is_finite() {
                 return Err(NewtonFailure::NonFinite);
             }
-            lu::factorise(
-                &mut self.jacobian,
-                &mut self.pivots,
-                &mut self.row_scales,
-                self.options.singular_tolerance,
-            )
-            .map_err(NewtonFailure::Singular)?;
+            self.jacobian
+                .factorise(self.options.singular_tolerance)
+                .map_err(NewtonFailure::Singular)?;
             self.factorised = true;
         }
         Ok(Evaluation {
@@ -423,7 +418,7 @@ impl Newton {
         evaluate: &mut F,
     ) -> Result<Option<(Evaluation, f64)>, NewtonFailure>
     where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
     {
         let mut length = 1.0;
         while length >= 1e-10 {
@@ -485,7 +480,7 @@ impl Newton {
         evaluate: F,
     ) -> Result<&DVector<f64>, NewtonFailure>
     where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
     {
         let mut x = std::mem::take(&mut self.iterate);
         if x.len() != start.len() {
@@ -532,7 +527,7 @@ impl Newton {
         mut evaluate: F,
     ) -> Result<(), NewtonFailure>
     where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
     {
         if x.len() != self.root.len() {
             return Err(NewtonFailure::Dimension {
@@ -545,7 +540,6 @@ impl Newton {
         }
         self.unpark();
         std::mem::swap(&mut self.jacobian, &mut self.kept.jacobian);
-        std::mem::swap(&mut self.pivots, &mut self.kept.pivots);
         self.parked = Some((self.jacobian_norm, self.factorised));
         if let Err(failure) = self.evaluate(x, &mut evaluate, true) {
             self.unpark();
@@ -560,7 +554,6 @@ impl Newton {
     fn unpark(&mut self) {
         if let Some((norm, factorised)) = self.parked.take() {
             std::mem::swap(&mut self.jacobian, &mut self.kept.jacobian);
-            std::mem::swap(&mut self.pivots, &mut self.kept.pivots);
             self.jacobian_norm = norm;
             self.factorised = factorised;
             self.at_root = false;
@@ -596,7 +589,7 @@ impl Newton {
         mut evaluate: F,
     ) -> Result<NewtonReport, NewtonFailure>
     where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
     {
         if x.len() != self.residual.len() {
             return Err(NewtonFailure::Dimension {
@@ -634,7 +627,7 @@ impl Newton {
         loop {
             // The correction at x, with the factorised Jacobian: x's distance from the root.
             self.update.copy_from(&self.residual);
-            lu::solve(&self.jacobian, &self.pivots, self.update.as_mut_slice());
+            self.jacobian.solve(self.update.as_mut_slice());
             if !self.update.iter().all(|u| u.is_finite()) {
                 return Err(self.failed(NewtonFailure::NonFinite));
             }
@@ -763,7 +756,7 @@ impl Newton {
         evaluate: &mut F,
     ) -> Result<Evaluation, NewtonFailure>
     where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut DMatrix<f64>>) -> f64,
+        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
     {
         self.evaluate(x, evaluate, true).map_err(|f| self.failed(f))
     }
@@ -772,7 +765,6 @@ impl Newton {
     fn failed(&mut self, failure: NewtonFailure) -> NewtonFailure {
         if std::mem::take(&mut self.kept.holding) {
             std::mem::swap(&mut self.jacobian, &mut self.kept.jacobian);
-            std::mem::swap(&mut self.pivots, &mut self.kept.pivots);
             self.jacobian_norm = self.kept.norm;
             self.factorised = true;
         } else if !std::mem::take(&mut self.kept.pending) {
