@@ -50,8 +50,8 @@ pub mod prelude {
         Configuration, ConfigurationSpace, ConstraintPoint, Crossing, DiracError, DiracSystem,
         Direction, DiscreteLagrangian, DualNum, Euclidean, Event, FirstOrderScheme,
         HamiltonianSystem, HolonomicScheme, Input, Interconnected, Interconnection, Junction,
-        ManifoldStepper, NewtonOptions, Positive, Product, Progress, Quadrature, Rates, Repeated,
-        Retraction, Rule, Run, Sample, Scalar, Solution, Status, Stepper, Trajectory,
+        ManifoldStepper, Modular, NewtonOptions, Positive, Product, Progress, Quadrature, Rates,
+        Repeated, Retraction, Rule, Run, Sample, Scalar, Solution, Status, Stepper, Trajectory,
     };
 }
 

@@ -115,9 +115,10 @@ impl Banded {
             }
         }
         for k in (0..m).rev() {
+            let end = (k + upper + lower).min(m - 1);
             let mut sum = b[k];
-            for j in k + 1..=(k + upper + lower).min(m - 1) {
-                sum -= self.data[self.index(k, j)] * b[j];
+            for (j, bj) in b.iter().enumerate().take(end + 1).skip(k + 1) {
+                sum -= self.data[self.index(k, j)] * bj;
             }
             b[k] = sum / self.data[self.index(k, k)];
         }

@@ -95,6 +95,9 @@ pub struct EulerLagrange<S, const N: usize, C> {
     /// Where the rows other than the discrete Euler–Lagrange ones put their Jacobian when Newton
     /// asks for the residual alone (their derivatives are first-order and cheap).
     scratch: DMatrix<f64>,
+    /// The impulse of the junctions on a component of a modular interconnection (see
+    /// [`set_coupling`](Self::set_coupling)), `None` for a model stepped on its own.
+    coupling: Option<SVector<f64, N>>,
 }
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
@@ -149,6 +152,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             covectors: StepCovectors::zero(),
             covectors_pending: false,
             scratch: DMatrix::zeros(0, 0),
+            coupling: None,
             discrete,
         })
     }
@@ -265,6 +269,99 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         }
         self.inputs.copy_from_slice(values);
         Ok(())
+    }
+
+    /// What a run takes up at its start besides the degenerate coordinates: closed forms and
+    /// the first-order scheme.
+    fn begin_run(&mut self, state: &State<N>) {
+        let system = self.discrete.system();
+        // Closed forms serve only a translation chart (elsewhere `L` is read in the chart).
+        self.closed_form = C::TRANSLATION
+            && system
+                .lagrangian_hessian(&state.q, &state.velocity)
+                .is_some();
+        // The scheme is taken up here, at the start of a run: the unknowns follow it.
+        let projected =
+            self.first_order() && self.first_order_scheme == FirstOrderScheme::SymmetricProjection;
+        self.layout = self.layout.with_projection(if projected { N } else { 0 });
+    }
+
+    /// Begins a run of the model as a component of a modular interconnection: its degenerate
+    /// coordinates are left to the junctions (the interconnection examines them as a whole), so
+    /// no hidden constraints or collocated rows of its own.
+    pub(crate) fn begin_as_component(&mut self, state: &State<N>) {
+        self.hidden = Some(HiddenConstraints::none());
+        self.collocated = Vec::new();
+        self.begin_run(state);
+    }
+
+    /// The junctions' impulse `ι = Σ_j μ_j a_j` on this component over the next step (a covector
+    /// of its coordinates): its share `σ ι` enters the rows of `p_k`'s equation and the rest the
+    /// momentum `p_{k+1}`, as a constant constraint one-form's impulse would.
+    pub(crate) fn set_coupling(&mut self, impulse: &SVector<f64, N>) {
+        self.coupling = Some(*impulse);
+    }
+
+    /// The checks of a start that do not depend on the model's degenerate coordinates: finite,
+    /// in the configuration space and the Lagrangian's domain, closed forms and constant
+    /// one-forms as claimed, independent constraints.
+    fn check_state(&self, state: &State<N>) -> Result<(), DiracError> {
+        let system = self.discrete.system();
+        if S::ONE_FORMS > 0 && self.layout.points() > 1 && self.point != ConstraintPoint::Midpoint {
+            return Err(DiracError::InvalidQuadrature(format!(
+                "{} holds the one-forms at its Gauss nodes, so it has no constraint point; \
+                 {:?} applies to degree-1 quadratures only (leave the default, Midpoint)",
+                self.discrete.quadrature().name(),
+                self.point
+            )));
+        }
+        let (q, p, v) = (&state.q, &state.p, &state.velocity);
+        check_finite(system, "initial position", q)?;
+        let space = self.discrete.space();
+        if !space.contains(q) {
+            return Err(DiracError::InconsistentInitialState(format!(
+                "the initial position {:?} is not a point of the configuration space {space:?}",
+                q.as_slice()
+            )));
+        }
+        check_finite(system, "initial momentum", p)?;
+        check_finite(system, "initial velocity", v)?;
+        let lagrangian = system.lagrangian(q, v);
+        if !lagrangian.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: "the Lagrangian at the initial state (is (q0, v0) in its domain?)".into(),
+                value: lagrangian,
+            });
+        }
+        let energy = legendre::energy(system, q, v);
+        if !energy.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: "the initial energy".into(),
+                value: energy,
+            });
+        }
+        crate::closed_form::check(system, q, v)?;
+        constraint::check_constant(system, q)?;
+        constraint::check_independent(system, q)?;
+        Ok(())
+    }
+
+    /// [`StepEquations::check_start`] of the model as a component of a modular interconnection:
+    /// its own constraints, not its degenerate rows (the junctions balance them; the
+    /// interconnection examines them as a whole).
+    pub(crate) fn check_component_start(
+        &self,
+        state: &State<N>,
+        tolerance: f64,
+    ) -> Result<(), DiracError> {
+        self.check_state(state)?;
+        initial_state::check_constraints(
+            self.discrete.system(),
+            &state.q,
+            &state.velocity,
+            tolerance,
+        )
+        .map_err(DiracError::InconsistentInitialState)
     }
 
     fn constrained() -> bool {
@@ -745,6 +842,16 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             covectors += impulses;
             scale = scale.max(size);
         }
+        if let Some(impulse) = self.coupling {
+            let share = self.point.share();
+            for i in 0..N {
+                residual[i] += share * impulse[i];
+            }
+            covectors += StepCovectors {
+                impulse,
+                end: impulse * (1.0 - share),
+            };
+        }
         self.covectors = covectors;
         scale
     }
@@ -831,43 +938,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// `L` and the energy finite at `(q, v)`, and the constraints, their velocity form and the
     /// hidden constraints of coordinates without kinetic energy satisfied.
     fn check_start(&self, state: &State<N>, tolerance: f64) -> Result<(), DiracError> {
+        self.check_state(state)?;
         let system = self.discrete.system();
-        if S::ONE_FORMS > 0 && self.layout.points() > 1 && self.point != ConstraintPoint::Midpoint {
-            return Err(DiracError::InvalidQuadrature(format!(
-                "{} holds the one-forms at its Gauss nodes, so it has no constraint point; \
-                 {:?} applies to degree-1 quadratures only (leave the default, Midpoint)",
-                self.discrete.quadrature().name(),
-                self.point
-            )));
-        }
         let (q, p, v) = (&state.q, &state.p, &state.velocity);
-        check_finite(system, "initial position", q)?;
-        let space = self.discrete.space();
-        if !space.contains(q) {
-            return Err(DiracError::InconsistentInitialState(format!(
-                "the initial position {:?} is not a point of the configuration space {space:?}",
-                q.as_slice()
-            )));
-        }
-        check_finite(system, "initial momentum", p)?;
-        check_finite(system, "initial velocity", v)?;
-        let lagrangian = system.lagrangian(q, v);
-        if !lagrangian.is_finite() {
-            return Err(DiracError::NonFinite {
-                what: "the Lagrangian at the initial state (is (q0, v0) in its domain?)".into(),
-                value: lagrangian,
-            });
-        }
-        let energy = legendre::energy(system, q, v);
-        if !energy.is_finite() {
-            return Err(DiracError::NonFinite {
-                what: "the initial energy".into(),
-                value: energy,
-            });
-        }
-        crate::closed_form::check(system, q, v)?;
-        constraint::check_constant(system, q)?;
-        constraint::check_independent(system, q)?;
         initial_state::check(system, state.t, q, v, &self.inputs, tolerance)
             .map_err(DiracError::InconsistentInitialState)?;
         let hidden = HiddenConstraints::find(system, q, v, state.t, &self.inputs);
@@ -1002,17 +1075,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             HiddenConstraints::find(system, &state.q, &state.velocity, state.t, &self.inputs);
         self.collocated = Self::collocated_rows(system, &state.q, &state.velocity, &hidden);
         self.hidden = Some(hidden);
-        // Closed forms serve only a translation chart (elsewhere `L` is read in the chart).
-        self.closed_form = C::TRANSLATION
-            && system
-                .lagrangian_hessian(&state.q, &state.velocity)
-                .is_some();
-        // The scheme is taken up here, at the start of a run: the unknowns follow it.
-        let projected =
-            self.first_order() && self.first_order_scheme == FirstOrderScheme::SymmetricProjection;
-        self.layout = self.layout.with_projection(if projected { N } else { 0 });
+        self.begin_run(state);
     }
-
     /// The stepper's prediction from the last steps (their solutions extrapolated), or the path
     /// `ξ_j = c_j h ξ̇` along the state's velocity with zero multipliers.
     fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>) {

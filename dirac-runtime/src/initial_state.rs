@@ -27,6 +27,52 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
     tolerance: f64,
 ) -> Result<(), String> {
     let name = |i: usize| system.coordinate_name(i);
+    check_constraints(system, q0, v0, tolerance)?;
+    let rows = HiddenConstraints::rows_of(system, q0, v0);
+    if rows.coordinates().is_empty() {
+        return Ok(());
+    }
+    // Rows D of  ∂L/∂q + F − d/dt ∂L/∂v + Aᵀμ + dgᵀλ = 0, with d/dt ∂L/∂v_D = Σ_j ∂²L/∂q_j∂v_D v_j.
+    let (unbalanced, _, size) = rows.rows_in_velocity(system, q0, v0, t0, inputs);
+    let (dead, forms) = (rows.coordinates(), HiddenConstraints::forms(system, q0));
+    let matrix = DMatrix::from_fn(dead.len(), forms.nrows(), |r, c| forms[(c, dead[r])]);
+    if !unbalanced.iter().all(|x| x.is_finite()) {
+        return Err(
+            "the Euler–Lagrange rows of the coordinates without kinetic energy are not finite \
+             at the initial state"
+                .to_string(),
+        );
+    }
+    let residual = if forms.nrows() == 0 {
+        largest(unbalanced.iter().copied())
+    } else {
+        let svd = matrix.clone().svd(true, true);
+        let cutoff = 1e-12 * svd.singular_values.amax();
+        let rhs = -&unbalanced;
+        let multipliers = svd.solve(&rhs, cutoff).map_err(|e| e.to_string())?;
+        largest((matrix * multipliers - &rhs).iter().copied())
+    };
+    if exceeds(residual, tolerance * size) {
+        let names: Vec<String> = dead.iter().map(|&i| name(i)).collect();
+        return Err(format!(
+            "the initial state violates a hidden constraint of the coordinates without kinetic \
+             energy ({}): their forces are not balanced by any constraint force (residual \
+             {residual:.3e}); e.g. charges on parallel capacitors must have equal voltages",
+            names.join(", ")
+        ));
+    }
+    Ok(())
+}
+
+/// Checks `(q0, v0)` against the holonomic constraints `g(q0) = 0`, `dg(q0) v0 = 0` and the
+/// one-forms `A(q0) v0 = 0` alone (a component of a modular interconnection, whose degenerate
+/// coordinates the junctions balance); returns what is violated.
+pub(crate) fn check_constraints<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q0: &SVector<f64, N>,
+    v0: &SVector<f64, N>,
+    tolerance: f64,
+) -> Result<(), String> {
     for b in 0..S::HOLONOMIC {
         let (g, form) = constraint::holonomic(system, q0, b);
         if !(g.is_finite() && form.iter().all(|x| x.is_finite())) {
@@ -63,39 +109,6 @@ pub(crate) fn check<S: DiracSystem<N>, const N: usize>(
                 "the initial velocity violates constraint one-form {a}: A·v = {rate:.3e}"
             ));
         }
-    }
-    let rows = HiddenConstraints::rows_of(system, q0, v0);
-    if rows.coordinates().is_empty() {
-        return Ok(());
-    }
-    // Rows D of  ∂L/∂q + F − d/dt ∂L/∂v + Aᵀμ + dgᵀλ = 0, with d/dt ∂L/∂v_D = Σ_j ∂²L/∂q_j∂v_D v_j.
-    let (unbalanced, _, size) = rows.rows_in_velocity(system, q0, v0, t0, inputs);
-    let (dead, forms) = (rows.coordinates(), HiddenConstraints::forms(system, q0));
-    let matrix = DMatrix::from_fn(dead.len(), forms.nrows(), |r, c| forms[(c, dead[r])]);
-    if !unbalanced.iter().all(|x| x.is_finite()) {
-        return Err(
-            "the Euler–Lagrange rows of the coordinates without kinetic energy are not finite \
-             at the initial state"
-                .to_string(),
-        );
-    }
-    let residual = if forms.nrows() == 0 {
-        largest(unbalanced.iter().copied())
-    } else {
-        let svd = matrix.clone().svd(true, true);
-        let cutoff = 1e-12 * svd.singular_values.amax();
-        let rhs = -&unbalanced;
-        let multipliers = svd.solve(&rhs, cutoff).map_err(|e| e.to_string())?;
-        largest((matrix * multipliers - &rhs).iter().copied())
-    };
-    if exceeds(residual, tolerance * size) {
-        let names: Vec<String> = dead.iter().map(|&i| name(i)).collect();
-        return Err(format!(
-            "the initial state violates a hidden constraint of the coordinates without kinetic \
-             energy ({}): their forces are not balanced by any constraint force (residual \
-             {residual:.3e}); e.g. charges on parallel capacitors must have equal voltages",
-            names.join(", ")
-        ));
     }
     Ok(())
 }

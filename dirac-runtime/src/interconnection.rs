@@ -107,6 +107,44 @@ impl Junction {
     pub fn name(&self) -> &str {
         &self.name
     }
+
+    /// The junction's terms as `(coordinate, coefficient)`, each coordinate's index found by
+    /// `index`: an `Err(InvalidInterconnection)` for no terms, a coordinate `index` does not
+    /// know (the message adds what `known` says of it), a zero or non-finite coefficient, and
+    /// a coordinate named twice.
+    pub(crate) fn resolve_terms(
+        &self,
+        index: impl Fn(&str) -> Option<usize>,
+        known: impl Fn(&str) -> String,
+    ) -> Result<Vec<(usize, f64)>, DiracError> {
+        let invalid = |why: String| Err(DiracError::InvalidInterconnection(why));
+        if self.terms.is_empty() {
+            return invalid(format!("junction {:?} has no terms", self.name));
+        }
+        let mut resolved: Vec<(usize, f64)> = Vec::with_capacity(self.terms.len());
+        for (coordinate, coefficient) in &self.terms {
+            let Some(i) = index(coordinate) else {
+                return invalid(format!(
+                    "junction {:?} names {coordinate:?}, which is not a coordinate of the \
+                     interconnection ({})",
+                    self.name,
+                    known(coordinate)
+                ));
+            };
+            if !coefficient.is_finite() || *coefficient == 0.0 {
+                return invalid(format!(
+                    "junction {:?} gives {coordinate} the coefficient {coefficient}: it must be \
+                     finite and nonzero",
+                    self.name
+                ));
+            }
+            if resolved.iter().any(|&(k, _)| k == i) {
+                return invalid(format!("junction {:?} names {coordinate} twice", self.name));
+            }
+            resolved.push((i, *coefficient));
+        }
+        Ok(resolved)
+    }
 }
 
 /// The model made of the component `A` (on `R^NA`) and the component `B` (on `R^NB`) joined by
@@ -219,43 +257,23 @@ impl<const N: usize, const C: usize> Junctions<N, C> {
             {
                 return invalid(format!("two junctions are named {:?}", junction.name));
             }
-            if junction.terms.is_empty() {
-                return invalid(format!("junction {:?} has no terms", junction.name));
-            }
-            for (coordinate, coefficient) in &junction.terms {
-                let Some(i) = coordinates.iter().position(|n| n == coordinate) else {
-                    let instance = coordinate.split('.').next().unwrap_or_default();
-                    let known = if instances.iter().any(|n| n == instance) {
-                        let prefix = format!("{instance}.");
-                        let theirs: Vec<&str> = coordinates
-                            .iter()
-                            .filter(|n| n.starts_with(&prefix))
-                            .map(String::as_str)
-                            .collect();
-                        format!("{instance} has {}", theirs.join(", "))
-                    } else {
-                        format!("the instances are {}", instances.join(", "))
-                    };
-                    return invalid(format!(
-                        "junction {:?} names {coordinate:?}, which is not a coordinate of the \
-                         interconnection ({known})",
-                        junction.name
-                    ));
-                };
-                if !coefficient.is_finite() || *coefficient == 0.0 {
-                    return invalid(format!(
-                        "junction {:?} gives {coordinate} the coefficient {coefficient}: it must \
-                         be finite and nonzero",
-                        junction.name
-                    ));
+            let known = |coordinate: &str| {
+                let instance = coordinate.split('.').next().unwrap_or_default();
+                if instances.iter().any(|n| n == instance) {
+                    let prefix = format!("{instance}.");
+                    let theirs: Vec<&str> = coordinates
+                        .iter()
+                        .filter(|n| n.starts_with(&prefix))
+                        .map(String::as_str)
+                        .collect();
+                    format!("{instance} has {}", theirs.join(", "))
+                } else {
+                    format!("the instances are {}", instances.join(", "))
                 }
-                if rows[j][i] != 0.0 {
-                    return invalid(format!(
-                        "junction {:?} names {coordinate} twice",
-                        junction.name
-                    ));
-                }
-                rows[j][i] = *coefficient;
+            };
+            let index = |coordinate: &str| coordinates.iter().position(|n| n == coordinate);
+            for (i, coefficient) in junction.resolve_terms(index, known)? {
+                rows[j][i] = coefficient;
             }
         }
         let names: [String; C] = std::array::from_fn(|j| junctions[j].name.clone());

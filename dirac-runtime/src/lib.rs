@@ -40,6 +40,7 @@ mod layout;
 pub mod legendre;
 mod lu;
 pub mod manifold;
+pub mod modular;
 pub mod newton;
 #[cfg(feature = "plot")]
 pub mod plot;
@@ -74,6 +75,7 @@ pub use input::Input;
 pub use interconnection::{Interconnected, Interconnection, Junction, Junctions, Ports};
 pub use lu::SingularPivot;
 pub use manifold::{Manifold, Vectors};
+pub use modular::{Modular, PortWork};
 pub use newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 pub use product::{Configuration, Product, Rates};
 pub use quadrature::{Quadrature, Rule};

@@ -166,6 +166,60 @@ pub enum NewtonFailure {
     },
 }
 
+impl NewtonFailure {
+    /// The error of a solve of `problem` (what is solved, for the message) that failed at step
+    /// `step` with `options`; a singular Jacobian names its unknowns by `name`.
+    pub(crate) fn into_error(
+        self,
+        problem: &'static str,
+        step: u64,
+        options: &NewtonOptions,
+        name: impl Fn(usize) -> String,
+    ) -> DiracError {
+        match self {
+            NewtonFailure::NoConvergence {
+                residual,
+                update,
+                iterations,
+            } => DiracError::NoConvergence {
+                problem,
+                step,
+                residual,
+                update,
+                iterations,
+                tolerance: options.residual_tolerance,
+                step_tolerance: options.step_tolerance,
+            },
+            NewtonFailure::Singular(pivot) => DiracError::SingularJacobian {
+                problem,
+                step,
+                unknowns: pivot
+                    .involved
+                    .iter()
+                    .map(|&column| name(column))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            },
+            NewtonFailure::NotContracting { contraction, .. } => DiracError::UntrustedStep {
+                problem,
+                step,
+                contraction,
+                max_contraction: options.max_contraction,
+            },
+            NewtonFailure::NonFinite => DiracError::NonFinite {
+                what: format!(
+                    "the residual of {problem} at step {step} (the iterate left the Lagrangian's \
+                     domain; try a smaller step)"
+                ),
+                value: f64::NAN,
+            },
+            NewtonFailure::Dimension { expected, got } => DiracError::Dimension(format!(
+                "{problem}: {got} unknowns where the solver has {expected}"
+            )),
+        }
+    }
+}
+
 /// Newton's method for `F(x) = 0` on `R^n`, reusing its buffers across solves.
 ///
 /// The caller's closure fills the residual at `x`, adds the Jacobian into the zeroed matrix

@@ -1537,47 +1537,14 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             Problem::Step => E::NAME,
             Problem::Velocity => E::VELOCITY,
         };
+        let options = self.newton.options();
+        if which == Problem::Step {
+            return failure.into_error(problem, self.steps, options, |column| {
+                self.equations.unknown_name(column)
+            });
+        }
         match failure {
-            NewtonFailure::NoConvergence {
-                residual,
-                update,
-                iterations,
-            } => DiracError::NoConvergence {
-                problem,
-                step: self.steps,
-                residual,
-                update,
-                iterations,
-                tolerance: self.newton.options().residual_tolerance,
-                step_tolerance: self.newton.options().step_tolerance,
-            },
-            NewtonFailure::Singular(pivot) => {
-                let unknowns: Vec<String> = pivot
-                    .involved
-                    .iter()
-                    .map(|&column| {
-                        if which == Problem::Velocity && column < N {
-                            format!("{} (velocity)", self.equations.coordinate_name(column))
-                        } else if which == Problem::Velocity {
-                            format!("the multiplier of velocity constraint {}", column - N)
-                        } else {
-                            self.equations.unknown_name(column)
-                        }
-                    })
-                    .collect();
-                DiracError::SingularJacobian {
-                    problem,
-                    step: self.steps,
-                    unknowns: unknowns.join(", "),
-                }
-            }
-            NewtonFailure::NotContracting { contraction, .. } => DiracError::UntrustedStep {
-                problem,
-                step: self.steps,
-                contraction,
-                max_contraction: self.newton.options().max_contraction,
-            },
-            NewtonFailure::NonFinite if which == Problem::Velocity => DiracError::NonFinite {
+            NewtonFailure::NonFinite => DiracError::NonFinite {
                 what: format!(
                     "the residual of {problem} after {} steps (the velocity iterate left the \
                      Lagrangian's domain; start_from_momentum_near takes a guess inside it)",
@@ -1585,17 +1552,13 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                 ),
                 value: f64::NAN,
             },
-            NewtonFailure::NonFinite => DiracError::NonFinite {
-                what: format!(
-                    "the residual of {problem} at step {} (the iterate left the Lagrangian's \
-                     domain; try a smaller step)",
-                    self.steps
-                ),
-                value: f64::NAN,
-            },
-            NewtonFailure::Dimension { expected, got } => DiracError::Dimension(format!(
-                "{problem}: {got} unknowns where the solver has {expected}"
-            )),
+            failure => failure.into_error(problem, self.steps, options, |column| {
+                if column < N {
+                    format!("{} (velocity)", self.equations.coordinate_name(column))
+                } else {
+                    format!("the multiplier of velocity constraint {}", column - N)
+                }
+            }),
         }
     }
 }

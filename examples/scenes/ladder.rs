@@ -79,6 +79,31 @@ pub fn chain(m: f64, k: f64) -> Result<Chain, DiracError> {
     )
 }
 
+/// The chain of `cells` masses `m` and springs `k` as a [`Modular`] interconnection stepped by
+/// `quadrature` with step `h`, joined as [`chain`] joins them: closed into a ring, or open, the
+/// first mass free and the last spring's end held by a wall (the junction `wall`,
+/// `cell[K−1].dend = 0`).
+pub fn modular_chain(
+    m: f64,
+    k: f64,
+    cells: usize,
+    ring: bool,
+    h: f64,
+) -> Result<Modular, DiracError> {
+    let mut chain = Modular::new(Quadrature::midpoint(), h)?;
+    for j in 0..cells {
+        chain.add(&format!("cell[{j}]"), Tethered { m, k })?;
+    }
+    for j in 0..cells {
+        let joint = Junction::new(format!("joint{j}")).flow(format!("cell[{j}].end"), 1.0);
+        chain.join(match (j + 1 < cells, ring) {
+            (true, _) | (false, true) => joint.flow(format!("cell[{}].x", (j + 1) % cells), -1.0),
+            (false, false) => Junction::new("wall").flow(format!("cell[{j}].end"), 1.0),
+        })?;
+    }
+    Ok(chain)
+}
+
 /// The lattice's angular frequency of wave number `kappa` when `omega0² = 1/(l c)` or `k/m`.
 pub fn lattice_frequency(omega0: f64, kappa: f64) -> f64 {
     2.0 * omega0 * (kappa / 2.0).sin().abs()

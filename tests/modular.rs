@@ -1,0 +1,281 @@
+//! The modular step: components assembled and factorised on their own, coupled through the
+//! junctions' Schur complement, step exactly the monolithic interconnection's equations; the
+//! ports keep Tellegen's theorem; what the modular step cannot do it refuses.
+
+#[path = "../examples/scenes/mod.rs"]
+mod scenes;
+
+use dirac::interconnection::{Interconnection, Junction};
+use dirac::nalgebra::DVector;
+use dirac::prelude::*;
+use scenes::components::{Capacitor, Inductor, MassSpring, Resistor};
+use scenes::ladder;
+
+fn lc_loop(h: f64) -> Modular {
+    let mut lc = Modular::new(Quadrature::midpoint(), h).unwrap();
+    lc.add("l", Inductor { l: 1.3 }).unwrap();
+    lc.add("c", Capacitor { c: 0.7 }).unwrap();
+    lc.join(Junction::new("series").flow("l.q", 1.0).flow("c.q", -1.0))
+        .unwrap();
+    lc
+}
+
+/// The LC loop from an inductor and a capacitor (the capacitor without kinetic energy, its
+/// velocity fixed by the junction) stepped by parts equals the same interconnection stepped
+/// monolithically over 1 000 steps: charges, momenta and the junction's multiplier to 1e-12;
+/// and the port work of the two parts cancels (Tellegen) to round-off at every step.
+#[test]
+fn the_lc_loop_by_parts_equals_the_monolithic_loop() {
+    let h = 0.05;
+    let mut parts = lc_loop(h);
+    let whole = Interconnection::new(
+        ("l", Inductor { l: 1.3 }),
+        ("c", Capacitor { c: 0.7 }),
+        [Junction::new("series").flow("l.q", 1.0).flow("c.q", -1.0)],
+    )
+    .unwrap();
+    let mut monolithic = Stepper::new(whole, Quadrature::midpoint(), h).unwrap();
+    let (q0, v0) = ([0.3, 0.3], [1.0, 1.0]);
+    parts.start_from_velocity(&q0, &v0).unwrap();
+    monolithic
+        .start_from_velocity(SVector::from(q0), SVector::from(v0))
+        .unwrap();
+    assert_eq!(parts.coordinate_names(), monolithic.coordinate_names());
+    let (mut worst, mut tellegen): (f64, f64) = (0.0, 0.0);
+    for _ in 0..1000 {
+        parts.step().unwrap();
+        monolithic.step().unwrap();
+        worst = worst
+            .max((parts.q() - DVector::from_column_slice(monolithic.q().as_slice())).amax())
+            .max((parts.p() - DVector::from_column_slice(monolithic.p().as_slice())).amax())
+            .max((parts.multipliers().unwrap()[0] - monolithic.multipliers()[0]).abs());
+        let ports = parts.ports().unwrap();
+        tellegen = tellegen.max(ports.net_work().abs() / ports.scale);
+        // The junction's effort is the capacitor's voltage on the step, up to sign.
+        assert_eq!(ports.efforts.len(), 1);
+    }
+    println!("LC loop: apart by {worst:e}, Tellegen {tellegen:e}");
+    assert!(worst < 1e-12, "apart by {worst:e}");
+    assert!(
+        tellegen < 1e-14,
+        "Tellegen off by {tellegen:e} of the terms"
+    );
+    assert!((parts.t() - 50.0).abs() < 1e-12 && parts.steps() == 1000);
+    // It oscillated (ω² = 1 / (1.3 · 0.7)): not a trivial agreement.
+    assert!(parts.q().amax() > 0.5);
+}
+
+/// The ring of 16 masses on springs (each a mass tethered to a massless end, the ends joined to
+/// the next mass) stepped by parts equals the `Repeated` ring stepped monolithically, a
+/// travelling wave over 400 steps, to 1e-12; and the wave turns by the discrete dispersion
+/// relation's phase step.
+#[test]
+fn the_ring_by_parts_equals_the_monolithic_ring() {
+    let (m, k, h, mode) = (1.5, 0.6, 0.1, 3);
+    let kappa = 2.0 * std::f64::consts::PI * mode as f64 / ladder::CELLS as f64;
+    let omega = ladder::lattice_frequency((k / m).sqrt(), kappa);
+    let (q0, v0) = ladder::chain_wave(mode, omega);
+    let mut monolithic =
+        Stepper::new(ladder::chain(m, k).unwrap(), Quadrature::midpoint(), h).unwrap();
+    monolithic.start_from_velocity(q0, v0).unwrap();
+    let mut parts = ladder::modular_chain(m, k, ladder::CELLS, true, h).unwrap();
+    parts
+        .start_from_velocity(q0.as_slice(), v0.as_slice())
+        .unwrap();
+    assert_eq!(parts.coordinate_names(), monolithic.coordinate_names());
+    let mut worst: f64 = 0.0;
+    for _ in 0..400 {
+        parts.step().unwrap();
+        monolithic.step().unwrap();
+        let apart = (parts.q() - DVector::from_column_slice(monolithic.q().as_slice())).amax();
+        let multipliers = DVector::from_column_slice(parts.multipliers().unwrap());
+        let theirs = DVector::from_column_slice(monolithic.multipliers());
+        worst = worst.max(apart).max((multipliers - theirs).amax());
+        assert!(parts.constraint_violation().unwrap() < 1e-14);
+    }
+    println!("ring: apart by {worst:e}");
+    assert!(worst < 1e-12, "apart by {worst:e}");
+    let q = SVector::<f64, { 2 * ladder::CELLS }>::from_column_slice(parts.q().as_slice());
+    let (phase, _) = ladder::phase(mode, &q);
+    let (start, _) = ladder::phase(mode, &q0);
+    let turned = 400.0 * ladder::discrete_phase_step(h, omega);
+    let expected = (start + turned).rem_euclid(2.0 * std::f64::consts::PI);
+    let found = phase.rem_euclid(2.0 * std::f64::consts::PI);
+    assert!(
+        (found - expected).abs() < 1e-9,
+        "{found} against {expected}"
+    );
+}
+
+/// Stepped in parallel (rayon) or one component after another, the open chain of 200 cells
+/// steps bit for bit alike (each component's equations are its own; the Schur complement is
+/// summed in one order).
+#[test]
+fn parallel_and_sequential_steps_agree_bit_for_bit() {
+    let cells = 200;
+    // Masses x_j = 0.01 sin j, each spring's end at the next mass.
+    let x = |j: usize| 0.01 * (j as f64).sin();
+    let q0: Vec<f64> = (0..cells).flat_map(|j| [x(j), x(j + 1)]).collect();
+    let v0 = vec![0.0; 2 * cells];
+    let mut runs = [true, false].map(|parallel| {
+        let mut chain = ladder::modular_chain(1.0, 1.0, cells, false, 0.05)
+            .unwrap()
+            .with_parallel(parallel);
+        chain.start_from_velocity(&q0, &v0).unwrap();
+        chain.run(50).unwrap();
+        chain
+    });
+    assert_eq!(runs[0].q(), runs[1].q());
+    assert_eq!(runs[0].p(), runs[1].p());
+    assert!(runs[0].q().amax() > 0.0);
+    runs[0].step().unwrap();
+    assert_ne!(runs[0].q(), runs[1].q());
+}
+
+/// The series RLC from three components, two of them (the resistor and the capacitor) without
+/// kinetic energy: the junctions fix their velocities. It equals the monolithic
+/// interconnection (the inductor and the resistor, then the capacitor) over 500 steps, and its
+/// charge decays as the closed form `e^{−rt/2l} cos(ω_d t)` to the midpoint rule's error.
+#[test]
+fn the_rlc_by_parts_equals_the_monolithic_rlc() {
+    let (l, r, c, h) = (1.0, 0.2, 1.0, 0.01);
+    let mut parts = Modular::new(Quadrature::midpoint(), h).unwrap();
+    parts.add("l", Inductor { l }).unwrap();
+    parts.add("r", Resistor { r }).unwrap();
+    parts.add("c", Capacitor { c }).unwrap();
+    parts
+        .join(Junction::new("lr").flow("l.q", 1.0).flow("r.q", -1.0))
+        .unwrap();
+    parts
+        .join(Junction::new("rc").flow("r.q", 1.0).flow("c.q", -1.0))
+        .unwrap();
+    let lr: Interconnection<_, _, 1, 1, 2, 1> = Interconnection::new(
+        ("l", Inductor { l }),
+        ("r", Resistor { r }),
+        [Junction::new("lr").flow("l.q", 1.0).flow("r.q", -1.0)],
+    )
+    .unwrap();
+    let whole = Interconnection::new(
+        ("lr", lr),
+        ("c", Capacitor { c }),
+        [Junction::new("rc").flow("lr.r.q", 1.0).flow("c.q", -1.0)],
+    )
+    .unwrap();
+    let mut monolithic = Stepper::new(whole, Quadrature::midpoint(), h).unwrap();
+    let q0 = [1.0, 1.0, 1.0];
+    parts.start_from_velocity(&q0, &[0.0; 3]).unwrap();
+    monolithic
+        .start_from_velocity(SVector::from(q0), SVector::zeros())
+        .unwrap();
+    let mut worst: f64 = 0.0;
+    for _ in 0..500 {
+        parts.step().unwrap();
+        monolithic.step().unwrap();
+        worst =
+            worst.max((parts.q() - DVector::from_column_slice(monolithic.q().as_slice())).amax());
+    }
+    println!("RLC: apart by {worst:e}");
+    assert!(worst < 1e-12, "apart by {worst:e}");
+    let t = parts.t();
+    let (decay, omega) = (
+        r / (2.0 * l),
+        (1.0 / (l * c) - (r / (2.0 * l)).powi(2)).sqrt(),
+    );
+    let exact = (-decay * t).exp() * ((omega * t).cos() + decay / omega * (omega * t).sin());
+    assert!(
+        (parts.q()[2] - exact).abs() < 1e-4,
+        "{} against {exact}",
+        parts.q()[2]
+    );
+}
+
+fn refused<T: std::fmt::Debug>(result: Result<T, DiracError>) -> DiracError {
+    result.expect_err("refused")
+}
+
+/// What the modular step cannot do it refuses with an error that says why, and a failed step
+/// or start changes nothing.
+#[test]
+fn what_the_modular_step_cannot_do_is_refused() {
+    // A Galerkin rule.
+    let error = refused(Modular::new(Quadrature::galerkin(2).unwrap(), 0.1));
+    assert!(matches!(&error, DiracError::Unsupported(why) if why.contains("degree 1")));
+    // Names.
+    let mut lc = lc_loop(0.1);
+    let error = refused(lc.add("l", Inductor { l: 1.0 }));
+    assert!(
+        matches!(&error, DiracError::InvalidInterconnection(why) if why.contains("two instances"))
+    );
+    let error = refused(lc.join(Junction::new("bad").flow("c.charge", 1.0)));
+    assert!(
+        matches!(&error, DiracError::InvalidInterconnection(why) if why.contains("\"c.charge\"") && why.contains("c has c.q")),
+        "{error}"
+    );
+    let error = refused(lc.join(Junction::new("series").flow("c.q", 1.0)));
+    assert!(
+        matches!(&error, DiracError::InvalidInterconnection(why) if why.contains("two junctions"))
+    );
+    // A start that violates the junction.
+    let error = refused(lc.start_from_velocity(&[0.0, 0.0], &[1.0, 0.5]));
+    assert!(
+        matches!(&error, DiracError::InconsistentInitialState(why) if why.contains("junction series")),
+        "{error}"
+    );
+    assert!(matches!(lc.step(), Err(DiracError::NotStarted)));
+    // Junctions that depend on each other: the first step's Schur complement is singular.
+    let mut twice = lc_loop(0.1);
+    twice
+        .join(Junction::new("again").flow("l.q", 2.0).flow("c.q", -2.0))
+        .unwrap();
+    let error = refused(twice.start_from_velocity(&[0.0, 0.0], &[1.0, 1.0]));
+    assert!(
+        matches!(&error, DiracError::SingularJacobian { unknowns, .. } if unknowns.contains("junction again")),
+        "{error}"
+    );
+    assert!(matches!(twice.step(), Err(DiracError::NotStarted)));
+    // Two capacitors in parallel: a hidden constraint across the components (equal voltages)
+    // that no junction's impulse enters.
+    let mut parallel = Modular::new(Quadrature::midpoint(), 0.1).unwrap();
+    parallel.add("a", Capacitor { c: 1.0 }).unwrap();
+    parallel.add("b", Capacitor { c: 2.0 }).unwrap();
+    parallel.add("l", Inductor { l: 1.0 }).unwrap();
+    parallel
+        .join(
+            Junction::new("kcl")
+                .flow("l.q", 1.0)
+                .flow("a.q", -1.0)
+                .flow("b.q", -1.0),
+        )
+        .unwrap();
+    let error = refused(parallel.start_from_velocity(&[1.0, 2.0, 3.0], &[0.5, 0.5, 1.0]));
+    assert!(
+        matches!(&error, DiracError::Unsupported(why) if why.contains("a.q, b.q") && why.contains("hidden constraints")),
+        "{error}"
+    );
+    // A step that fails leaves the state as it was.
+    let mut chain = ladder::modular_chain(1.0, 1.0, 4, false, 0.1)
+        .unwrap()
+        .with_newton_options(NewtonOptions {
+            max_iterations: 1,
+            ..Default::default()
+        })
+        .unwrap();
+    let q0 = [0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]; // the first spring stretched
+    chain.start_from_velocity(&q0, &[0.0; 8]).unwrap();
+    let error = refused(chain.step());
+    assert!(matches!(error, DiracError::NoConvergence { .. }), "{error}");
+    assert_eq!(chain.q().as_slice(), &q0);
+    assert_eq!(chain.steps(), 0);
+    assert!(matches!(
+        refused(chain.start_from_velocity(&q0, &[0.0; 3])),
+        DiracError::Dimension(_)
+    ));
+    // A component's own violation names it.
+    let mut springs = Modular::new(Quadrature::midpoint(), 0.1).unwrap();
+    springs.add("a", MassSpring { m: 1.0, k: 1.0 }).unwrap();
+    let error = refused(springs.start_from_velocity(&[f64::NAN], &[0.0]));
+    assert!(
+        matches!(&error, DiracError::NonFinite { what, .. } if what.contains("component a")),
+        "{error}"
+    );
+}
