@@ -437,8 +437,84 @@ fn interconnection(c: &mut Criterion) {
     group.finish();
 }
 
+/// The modular step against the monolithic one on the same interconnections (h = 0.01,
+/// midpoint), and how it grows along an open chain of `K` tethered masses, one component after
+/// another and in parallel.
+fn modular(c: &mut Criterion) {
+    use scenes::components::{Capacitor, Inductor};
+    use scenes::ladder;
+    let mut group = c.benchmark_group("modular_step");
+    let h = 0.01;
+    let series = || Junction::new("series").flow("l.q", 1.0).flow("c.q", -1.0);
+    let whole = Interconnection::new(
+        ("l", Inductor { l: 1.0 }),
+        ("c", Capacitor { c: 1.0 }),
+        [series()],
+    )
+    .expect("valid loop");
+    let mut monolithic = Stepper::new(whole, Quadrature::midpoint(), h).expect("valid scene");
+    monolithic
+        .start_from_velocity(vector![1.0, 1.0], SVector::zeros())
+        .expect("consistent start");
+    group.bench_function("lc_loop/monolithic", |b| {
+        b.iter(|| black_box(monolithic.step()).expect("step"))
+    });
+    let mut parts = Modular::new(Quadrature::midpoint(), h).expect("valid rule");
+    parts.add("l", Inductor { l: 1.0 }).expect("a name");
+    parts.add("c", Capacitor { c: 1.0 }).expect("a name");
+    parts.join(series()).expect("valid junction");
+    parts
+        .start_from_velocity(&[1.0, 1.0], &[0.0, 0.0])
+        .expect("consistent start");
+    group.bench_function("lc_loop/modular", |b| {
+        b.iter(|| black_box(parts.step()).expect("step"))
+    });
+    let (q0, v0) = ladder::chain_wave(3, 0.5);
+    let mut ring = Stepper::new(
+        ladder::chain(1.0, 1.0).expect("valid ring"),
+        Quadrature::midpoint(),
+        h,
+    )
+    .expect("valid scene");
+    ring.start_from_velocity(q0, v0).expect("consistent start");
+    group.bench_function("ring16/monolithic", |b| {
+        b.iter(|| black_box(ring.step()).expect("step"))
+    });
+    let mut parts = ladder::modular_chain(1.0, 1.0, ladder::CELLS, true, h).expect("valid ring");
+    parts
+        .start_from_velocity(q0.as_slice(), v0.as_slice())
+        .expect("consistent start");
+    group.bench_function("ring16/modular", |b| {
+        b.iter(|| black_box(parts.step()).expect("step"))
+    });
+    group.sample_size(20);
+    for cells in [10, 100, 1000, 10000] {
+        // A wave along the open chain: masses at 0.1 sin(πj/K), each spring's end at the next.
+        let x = |j: usize| 0.1 * (std::f64::consts::PI * j as f64 / cells as f64).sin();
+        let q0: Vec<f64> = (0..cells).flat_map(|j| [x(j), x(j + 1)]).collect();
+        for parallel in [false, true] {
+            let mut chain = ladder::modular_chain(1.0, 1.0, cells, false, h)
+                .expect("valid chain")
+                .with_parallel(parallel);
+            chain
+                .start_from_velocity(&q0, &vec![0.0; 2 * cells])
+                .expect("consistent start");
+            let name = if parallel {
+                "chain/parallel"
+            } else {
+                "chain/sequential"
+            };
+            group.bench_with_input(BenchmarkId::new(name, cells), &cells, |b, _| {
+                b.iter(|| black_box(chain.step()).expect("step"))
+            });
+        }
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
+    modular,
     interconnection,
     routes,
     lie_group,

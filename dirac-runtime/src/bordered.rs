@@ -32,10 +32,12 @@
 //! ```
 
 use nalgebra::DMatrix;
+use rayon::prelude::*;
 
 use crate::banded::Banded;
 use crate::jacobian::Jacobian;
 use crate::lu::{self, SingularPivot};
+use crate::newton::largest;
 
 /// A block-bordered Jacobian (see the [module](self) documentation).
 #[derive(Debug, Clone)]
@@ -47,6 +49,8 @@ pub struct Bordered {
     couplings: usize,
     size: usize,
     schur: Banded,
+    /// Blocks per parallel task (`usize::MAX`: one after another).
+    grain: usize,
     /// The coupling rows' absolute sums (scratch of the norm).
     coupling_sums: Vec<f64>,
 }
@@ -130,7 +134,15 @@ impl Bordered {
             size: offset + couplings,
             schur: Banded::new(couplings, spread, spread),
             coupling_sums: vec![0.0; couplings],
+            grain: usize::MAX,
         }
+    }
+
+    /// Factorises and solves the blocks across rayon's threads, `grain` blocks or more per
+    /// task (`usize::MAX`, the default: one after another). The result is the same bit for bit.
+    pub fn parallel(mut self, grain: usize) -> Self {
+        self.grain = grain.max(1);
+        self
     }
 
     /// The half-width of the Schur complement's band.
@@ -184,22 +196,36 @@ impl Jacobian for Bordered {
     fn norm(&mut self) -> f64 {
         let mut norm: f64 = 0.0;
         self.coupling_sums.fill(0.0);
-        for (j, block) in self.diagonal.iter().zip(&self.blocks) {
-            for i in 0..j.nrows() {
-                let sum: f64 = j.row(i).iter().map(|v| v.abs()).sum::<f64>()
-                    + block.e.row(i).iter().map(|v| v.abs()).sum::<f64>();
-                // NaN propagates: a row that is not finite makes the norm NaN.
-                norm = if sum.is_nan() {
-                    f64::NAN
+        for (j, block) in self.diagonal.iter().zip(&mut self.blocks) {
+            // Row sums of [J_c E_c], column by column (the storage's order), in `scales`.
+            let n = j.nrows();
+            let sums = &mut block.scales[..n];
+            sums.fill(0.0);
+            for column in j.as_slice().chunks_exact(n.max(1)) {
+                for i in 0..n {
+                    sums[i] += column[i].abs();
+                }
+            }
+            for column in block.e.as_slice().chunks_exact(n.max(1)) {
+                for i in 0..n {
+                    sums[i] += column[i].abs();
+                }
+            }
+            for &sum in sums.iter() {
+                // A NaN stays NaN.
+                norm = if sum > norm || sum.is_nan() || norm.is_nan() {
+                    if norm.is_nan() { norm } else { sum }
                 } else {
-                    norm.max(sum)
+                    norm
                 };
             }
             for (a, &coupling) in block.touching.iter().enumerate() {
-                self.coupling_sums[coupling] += block.g.row(a).iter().map(|v| v.abs()).sum::<f64>();
+                for i in 0..n {
+                    self.coupling_sums[coupling] += block.g[(a, i)].abs();
+                }
             }
         }
-        self.coupling_sums.iter().fold(norm, |n, &s| n.max(s))
+        largest(std::iter::once(norm).chain(self.coupling_sums.iter().copied()))
     }
 
     fn is_finite(&self) -> bool {
@@ -209,8 +235,7 @@ impl Jacobian for Bordered {
     }
 
     fn factorise(&mut self, tolerance: f64) -> Result<(), SingularPivot> {
-        self.schur.clear();
-        for (j, block) in self.diagonal.iter_mut().zip(&mut self.blocks) {
+        let factorise = |(j, block): (&mut DMatrix<f64>, &mut Block)| {
             lu::factorise(j, &mut block.pivots, &mut block.scales, tolerance).map_err(|p| {
                 SingularPivot {
                     column: block.offset + p.column,
@@ -222,10 +247,36 @@ impl Jacobian for Bordered {
             for column in block.y.as_mut_slice().chunks_exact_mut(n.max(1)) {
                 lu::solve(j, &block.pivots, column);
             }
-            let coupled = &block.g * &block.y;
+            Ok(())
+        };
+        // The first singular block (by column) whichever thread met it.
+        let first = |a: Result<(), SingularPivot>, b: Result<(), SingularPivot>| match (a, b) {
+            (Err(a), Err(b)) => Err(if a.column <= b.column { a } else { b }),
+            (Err(e), Ok(())) | (Ok(()), Err(e)) => Err(e),
+            (Ok(()), Ok(())) => Ok(()),
+        };
+        if self.grain < self.blocks.len() {
+            self.diagonal
+                .par_iter_mut()
+                .zip(self.blocks.par_iter_mut())
+                .with_min_len(self.grain)
+                .map(factorise)
+                .reduce(|| Ok(()), first)?;
+        } else {
+            let pairs = self.diagonal.iter_mut().zip(self.blocks.iter_mut());
+            pairs.map(factorise).try_for_each(|r| r)?;
+        }
+        // Σ_c G_c Y_c into the Schur complement, without a temporary.
+        self.schur.clear();
+        for block in &self.blocks {
+            let n = block.y.nrows();
             for (a, &row) in block.touching.iter().enumerate() {
                 for (b, &column) in block.touching.iter().enumerate() {
-                    self.schur.add(row, column, coupled[(a, b)]);
+                    let mut entry = 0.0;
+                    for i in 0..n {
+                        entry += block.g[(a, i)] * block.y[(i, b)];
+                    }
+                    self.schur.add(row, column, entry);
                 }
             }
         }
@@ -239,24 +290,23 @@ impl Jacobian for Bordered {
     fn solve(&self, b: &mut [f64]) {
         let first = self.first_coupling();
         let (own, coupling) = b.split_at_mut(first);
-        // s − Σ G_c z_c, negated below.
-        for (j, block) in self.diagonal.iter().zip(&self.blocks) {
-            let z = &mut own[block.offset..block.offset + j.nrows()];
-            lu::solve(j, &block.pivots, z);
+        let (diagonal, blocks, grain) = (&self.diagonal, &self.blocks, self.grain);
+        each_block(diagonal, blocks, own, grain, &|j, block, z| {
+            lu::solve(j, &block.pivots, z)
+        });
+        // s − Σ G_c z_c, negated.
+        for block in blocks {
+            let z = &own[block.offset..block.offset + block.y.nrows()];
             for (a, &c) in block.touching.iter().enumerate() {
-                coupling[c] -= block
-                    .g
-                    .row(a)
-                    .iter()
-                    .zip(z.iter())
-                    .map(|(g, z)| g * z)
-                    .sum::<f64>();
+                let g = block.g.row(a);
+                coupling[c] -= g.iter().zip(z).map(|(g, z)| g * z).sum::<f64>();
             }
         }
         coupling.iter_mut().for_each(|v| *v = -*v);
         self.schur.solve(coupling);
-        for (j, block) in self.diagonal.iter().zip(&self.blocks) {
-            let z = &mut own[block.offset..block.offset + j.nrows()];
+        // x_c = z_c − Y_c μ: a few operations a block, not worth a parallel pass.
+        for block in blocks {
+            let z = &mut own[block.offset..block.offset + block.y.nrows()];
             for (a, &c) in block.touching.iter().enumerate() {
                 for (i, zi) in z.iter_mut().enumerate() {
                     *zi -= block.y[(i, a)] * coupling[c];
@@ -264,6 +314,30 @@ impl Jacobian for Bordered {
             }
         }
     }
+}
+
+/// Applies `f` to each block with its rows of `b` (which begins at the first block's rows),
+/// halving the blocks across rayon's threads while more than `grain` remain.
+fn each_block<F>(diagonal: &[DMatrix<f64>], blocks: &[Block], b: &mut [f64], grain: usize, f: &F)
+where
+    F: Fn(&DMatrix<f64>, &Block, &mut [f64]) + Sync,
+{
+    let Some(start) = blocks.first().map(|block| block.offset) else {
+        return;
+    };
+    if blocks.len() <= grain {
+        for (j, block) in diagonal.iter().zip(blocks) {
+            let at = block.offset - start;
+            f(j, block, &mut b[at..at + j.nrows()]);
+        }
+        return;
+    }
+    let mid = blocks.len() / 2;
+    let (left, right) = b.split_at_mut(blocks[mid].offset - start);
+    rayon::join(
+        || each_block(&diagonal[..mid], &blocks[..mid], left, grain, f),
+        || each_block(&diagonal[mid..], &blocks[mid..], right, grain, f),
+    );
 }
 
 #[cfg(test)]

@@ -46,7 +46,7 @@
 //! # Ok::<(), dirac_runtime::DiracError>(())
 //! ```
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap, HashSet};
 
 use nalgebra::{DMatrix, DVector, SVector};
 use rayon::prelude::*;
@@ -58,7 +58,7 @@ use crate::derivatives::degenerate;
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
 use crate::euler_lagrange::EulerLagrange;
-use crate::hidden_constraint::{HiddenConstraints, null_space};
+use crate::hidden_constraint::HiddenConstraints;
 use crate::interconnection::Junction;
 use crate::jacobian::Jacobian;
 use crate::newton::{Newton, NewtonOptions, NewtonReport, exceeds, largest};
@@ -69,6 +69,9 @@ use crate::system::DiracSystem;
 
 /// Components, from this many on, are assembled and factorised in parallel by default.
 const PARALLEL_FROM: usize = 64;
+
+/// Components per parallel task.
+const GRAIN: usize = 32;
 
 /// The relative consistency an initial state must have (as a [`Stepper`](crate::Stepper)'s).
 const START_TOLERANCE: f64 = 1e-9;
@@ -84,7 +87,16 @@ pub struct Modular {
     junctions: Vec<Coupling>,
     /// `instance.coordinate` → (component, coordinate).
     lookup: HashMap<String, (usize, usize)>,
-    run: Option<Running>,
+    /// Instance name → component.
+    instances: HashMap<String, usize>,
+    /// The junctions' names.
+    junction_names: HashSet<String>,
+    /// The first component with one-forms: the others' must be held at its constraint point.
+    constrained: Option<usize>,
+    /// The number of coordinates of all components.
+    total: usize,
+    /// The run (boxed: a step takes it out and puts it back).
+    run: Option<Box<Running>>,
 }
 
 /// A named component and where it sits.
@@ -171,6 +183,10 @@ impl Modular {
             components: Vec::new(),
             junctions: Vec::new(),
             lookup: HashMap::new(),
+            instances: HashMap::new(),
+            junction_names: HashSet::new(),
+            constrained: None,
+            total: 0,
             run: None,
         })
     }
@@ -187,6 +203,7 @@ impl Modular {
     /// 64 components on).
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = Some(parallel);
+        self.run = None;
         self
     }
 
@@ -204,15 +221,14 @@ impl Modular {
                 "the instance name {name:?} must be non-empty and without '.'"
             ));
         }
-        if self.components.iter().any(|c| c.name == name) {
+        if self.instances.contains_key(name) {
             return invalid(format!("two instances are named {name:?}: name them apart"));
         }
         let discrete = DiscreteLagrangian::new(system, self.quadrature.clone(), self.h);
         let part: Box<dyn Part> = Box::new(Model::new(EulerLagrange::new(discrete)?));
-        if let Some(other) = self
-            .components
-            .iter()
-            .find(|c| c.part.one_forms() && part.one_forms() && c.part.point() != part.point())
+        if let Some(other) = self.constrained.map(|c| &self.components[c])
+            && part.one_forms()
+            && other.part.point() != part.point()
         {
             return invalid(format!(
                 "{} holds its one-forms at {:?} and {name} at {:?}: the components need one \
@@ -222,26 +238,37 @@ impl Modular {
                 part.point()
             ));
         }
+        let coordinates: Vec<String> = (0..M)
+            .map(|i| format!("{name}.{}", part.coordinate_name(i)))
+            .collect();
+        if let Some((i, coordinate)) = coordinates
+            .iter()
+            .enumerate()
+            .find(|(i, c)| coordinates[..*i].contains(c))
+        {
+            return invalid(format!(
+                "{name} has two coordinates named {coordinate:?} (the {i}th and an earlier \
+                 one): a junction could not tell them apart"
+            ));
+        }
         let index = self.components.len();
-        let first = self.coordinates();
-        for i in 0..M {
-            let coordinate = format!("{name}.{}", part.coordinate_name(i));
-            if self.lookup.insert(coordinate.clone(), (index, i)).is_some() {
-                return invalid(format!(
-                    "{name} has two coordinates named {coordinate:?}: a junction could not tell \
-                     them apart"
-                ));
-            }
+        for (i, coordinate) in coordinates.into_iter().enumerate() {
+            self.lookup.insert(coordinate, (index, i));
+        }
+        self.instances.insert(name.to_string(), index);
+        if part.one_forms() && self.constrained.is_none() {
+            self.constrained = Some(index);
         }
         self.components.push(Component {
             name: name.to_string(),
             part,
-            first,
+            first: self.total,
             offset: 0,
             couplings: Vec::new(),
             impulse: vec![0.0; M],
             scale: 0.0,
         });
+        self.total += M;
         self.run = None;
         Ok(())
     }
@@ -251,30 +278,30 @@ impl Modular {
     /// coordinate, a coordinate twice, a zero or non-finite coefficient, no terms, or a name
     /// taken. Junctions that depend on each other are refused at the start.
     pub fn join(&mut self, junction: Junction) -> Result<(), DiracError> {
-        if self.junctions.iter().any(|j| j.name == junction.name()) {
+        if self.junction_names.contains(junction.name()) {
             return Err(DiracError::InvalidInterconnection(format!(
                 "two junctions are named {:?}",
                 junction.name()
             )));
         }
-        let names: Vec<&str> = self.components.iter().map(|c| c.name.as_str()).collect();
+        // What there is, said only when a coordinate is unknown.
         let known = |coordinate: &str| {
             let instance = coordinate.split('.').next().unwrap_or_default();
-            match names.iter().position(|n| *n == instance) {
-                Some(c) => format!(
-                    "{instance} has {}",
-                    (0..self.components[c].part.coordinates())
-                        .map(|i| format!(
-                            "{instance}.{}",
-                            self.components[c].part.coordinate_name(i)
-                        ))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-                None => format!("the instances are {}", names.join(", ")),
+            match self.instances.get(instance) {
+                Some(&c) => {
+                    let part = &self.components[c].part;
+                    let theirs: Vec<String> = (0..part.coordinates())
+                        .map(|i| format!("{instance}.{}", part.coordinate_name(i)))
+                        .collect();
+                    format!("{instance} has {}", theirs.join(", "))
+                }
+                None => {
+                    let names: Vec<&str> =
+                        self.components.iter().map(|c| c.name.as_str()).collect();
+                    format!("the instances are {}", names.join(", "))
+                }
             }
         };
-        let coordinates: Vec<(usize, usize)> = self.lookup.values().copied().collect();
         let index = |coordinate: &str| {
             let &(c, i) = self.lookup.get(coordinate)?;
             Some(self.components[c].first + i)
@@ -283,13 +310,11 @@ impl Modular {
             .resolve_terms(index, known)?
             .into_iter()
             .map(|(global, a)| {
-                let &(c, i) = coordinates
-                    .iter()
-                    .find(|&&(c, i)| self.components[c].first + i == global)
-                    .expect("resolved");
-                (c, i, a)
+                let c = self.components.partition_point(|c| c.first <= global) - 1;
+                (c, global - self.components[c].first, a)
             })
             .collect();
+        self.junction_names.insert(junction.name().to_string());
         self.junctions.push(Coupling {
             name: junction.name().to_string(),
             terms,
@@ -300,7 +325,7 @@ impl Modular {
 
     /// The number of coordinates of all components.
     pub fn coordinates(&self) -> usize {
-        self.components.iter().map(|c| c.part.coordinates()).sum()
+        self.total
     }
 
     /// `instance.coordinate` for every coordinate, in the components' order.
@@ -324,6 +349,47 @@ impl Modular {
         self.h
     }
 
+    /// Sets the input named `instance.input` (e.g. a voltage source's `drive.u`) from the
+    /// next step on; `UnknownInput` lists the inputs there are, `NonFinite` refuses a value.
+    pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), DiracError> {
+        let found = name.split_once('.').and_then(|(instance, input)| {
+            let c = *self.instances.get(instance)?;
+            let part = &self.components[c].part;
+            let i = (0..part.inputs()).find(|&i| part.input_name(i) == input)?;
+            Some((c, i))
+        });
+        let Some((c, i)) = found else {
+            let inputs: Vec<String> = self
+                .components
+                .iter()
+                .flat_map(|c| {
+                    (0..c.part.inputs()).map(|i| format!("{}.{}", c.name, c.part.input_name(i)))
+                })
+                .collect();
+            return Err(DiracError::UnknownInput(format!(
+                "{name:?}; the inputs are {}",
+                if inputs.is_empty() {
+                    "none".to_string()
+                } else {
+                    inputs.join(", ")
+                }
+            )));
+        };
+        if !value.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: format!("input {name}"),
+                value,
+            });
+        }
+        if self.components[c].part.set_input(i, value)
+            && let Some(run) = self.run.as_mut()
+        {
+            // A step after a change of inputs is predicted from the last one alone.
+            run.predictor.restart();
+        }
+        Ok(())
+    }
+
     /// Starts a run at time 0 from the positions `q` and velocities `v` of every coordinate
     /// (in the order of [`coordinate_names`](Self::coordinate_names)). Each component's state
     /// is checked as a [`Stepper`](crate::Stepper) checks a model's, its degenerate rows
@@ -332,8 +398,9 @@ impl Modular {
     /// components, which the modular step does not project onto: step the interconnection
     /// monolithically), coordinates whose Lagrangian is linear in their velocity with a
     /// momentum that is not zero, and junctions that depend on each other or on the
-    /// components' own constraints (the first step's Schur complement is singular). On error
-    /// nothing changes.
+    /// components' own constraints (the first step's Schur complement is singular). A state or
+    /// a model refused by the checks changes nothing; one refused by the first step's trial
+    /// solve (singular) leaves the interconnection not started.
     pub fn start_from_velocity(&mut self, q: &[f64], v: &[f64]) -> Result<(), DiracError> {
         let n = self.coordinates();
         if q.len() != n || v.len() != n {
@@ -360,6 +427,8 @@ impl Modular {
         }
         self.check_junctions(v, tolerance)?;
         self.check_degenerate(q, v)?;
+        // From here a failure leaves no run (the components begin afresh).
+        self.run = None;
         for (component, state) in self.components.iter_mut().zip(started) {
             component.part.begin(state);
         }
@@ -377,7 +446,7 @@ impl Modular {
         }
         let jacobian = self.bordered();
         let unknowns = jacobian.size();
-        let mut run = Running {
+        let mut run = Box::new(Running {
             newton: Newton::with_jacobian(jacobian, self.options)?,
             unknowns: DVector::zeros(unknowns),
             predictor: Predictor::new(unknowns),
@@ -386,7 +455,7 @@ impl Modular {
             multipliers: vec![0.0; self.junctions.len()],
             violation: 0.0,
             report: None,
-        };
+        });
         // A model the step does not determine (dependent junctions, a component singular on
         // its own) is refused here, before the first step, naming the unknowns.
         let trial = self.solve(&mut run);
@@ -404,6 +473,12 @@ impl Modular {
         Ok(())
     }
 
+    /// Whether the components are stepped in parallel.
+    fn parallel(&self) -> bool {
+        self.parallel
+            .unwrap_or(self.components.len() >= PARALLEL_FROM)
+    }
+
     /// The block-bordered Jacobian of a step: a block per component, the junctions' rows and
     /// columns.
     fn bordered(&self) -> Bordered {
@@ -419,7 +494,8 @@ impl Modular {
         };
         let (rows, columns): (Vec<Vec<_>>, Vec<Vec<_>>) =
             self.components.iter().map(borders).unzip();
-        Bordered::new(&sizes, &rows, &columns)
+        let grain = if self.parallel() { GRAIN } else { usize::MAX };
+        Bordered::new(&sizes, &rows, &columns).parallel(grain)
     }
 
     /// `a_j · v = 0` for every junction, to the start's tolerance.
@@ -469,22 +545,20 @@ impl Modular {
         if dead.is_empty() {
             return Ok(());
         }
+        let column: HashMap<(usize, usize), usize> =
+            dead.iter().enumerate().map(|(k, &d)| (d, k)).collect();
         for junction in &self.junctions {
             let entries = junction
                 .terms
                 .iter()
-                .filter_map(|&(c, i, a)| Some((dead.iter().position(|&d| d == (c, i))?, a)));
+                .filter_map(|&(c, i, a)| Some((*column.get(&(c, i))?, a)));
             forms.push(entries.collect());
         }
-        let matrix = DMatrix::from_fn(forms.len(), dead.len(), |r, k| {
-            forms[r].iter().find(|e| e.0 == k).map_or(0.0, |e| e.1)
-        });
-        let null = null_space(&matrix);
-        if null.ncols() == 0 {
+        let Some(support) = null_vector(forms, dead.len()) else {
             return Ok(());
-        }
-        let names: Vec<String> = (0..dead.len())
-            .filter(|&k| null.row(k).iter().any(|w| w.abs() > 1e-8))
+        };
+        let names: Vec<String> = support
+            .into_iter()
             .map(|k| {
                 let (c, i) = dead[k];
                 let component = &self.components[c];
@@ -493,11 +567,10 @@ impl Modular {
             .collect();
         Err(DiracError::Unsupported(format!(
             "the modular step with hidden constraints across the components: the rows of {} \
-             (coordinates without kinetic energy) combine into {} constraint(s) that no \
-             junction's impulse enters (e.g. parallel capacitors); step the interconnection \
-             monolithically (Interconnection), which projects onto them",
-            names.join(", "),
-            null.ncols()
+             (coordinates without kinetic energy) combine into a constraint that no junction's \
+             impulse enters (e.g. parallel capacitors); step the interconnection monolithically \
+             (Interconnection), which projects onto it",
+            names.join(", ")
         )))
     }
 
@@ -506,20 +579,27 @@ impl Modular {
     fn solve(&mut self, run: &mut Running) -> Result<(NewtonReport, f64), DiracError> {
         let first = run.unknowns.len() - self.junctions.len();
         let previous = run.predictor.predict();
-        for component in &mut self.components {
+        let parallel = self.parallel();
+        let predict = |component: &mut Component| {
             let range = component.offset..component.offset + component.part.unknowns();
-            let before = previous.map(|p| &p.as_slice()[range.clone()]);
             component
                 .part
-                .predict(before, &mut run.unknowns.as_mut_slice()[range]);
+                .predict(previous.map(|p| &p.as_slice()[range]));
+        };
+        if parallel {
+            let components = self.components.par_iter_mut().with_min_len(GRAIN);
+            components.for_each(predict);
+        } else {
+            self.components.iter_mut().for_each(predict);
+        }
+        for component in &self.components {
+            let range = component.offset..component.offset + component.part.unknowns();
+            run.unknowns.as_mut_slice()[range].copy_from_slice(component.part.unknowns_of_step());
         }
         match previous {
             Some(p) => run.unknowns.as_mut_slice()[first..].copy_from_slice(&p.as_slice()[first..]),
             None => run.unknowns.as_mut_slice()[first..].fill(0.0),
         }
-        let parallel = self
-            .parallel
-            .unwrap_or(self.components.len() >= PARALLEL_FROM);
         let (components, junctions) = (&mut self.components, &self.junctions);
         let evaluate =
             |x: &DVector<f64>, r: &mut DVector<f64>, blocks: Option<&mut Vec<DMatrix<f64>>>| {
@@ -539,11 +619,11 @@ impl Modular {
                     (Some(blocks), true) => components
                         .par_iter_mut()
                         .zip(blocks.par_iter_mut())
-                        .with_min_len(16)
+                        .with_min_len(GRAIN)
                         .for_each(|(c, b)| assemble(c, Some(b))),
                     (None, true) => components
                         .par_iter_mut()
-                        .with_min_len(16)
+                        .with_min_len(GRAIN)
                         .for_each(|c| assemble(c, None)),
                     (Some(blocks), false) => components
                         .iter_mut()
@@ -579,21 +659,31 @@ impl Modular {
                 names,
             )
         })?;
-        let mut violation: f64 = 0.0;
-        for component in &mut self.components {
+        let x = run.unknowns.as_slice();
+        let advance = |component: &mut Component| {
             let range = component.offset..component.offset + component.part.unknowns();
-            match component
-                .part
-                .advance(&run.unknowns.as_slice()[range], run.steps)
-            {
-                Ok(v) => violation = largest([violation, v]),
-                Err(error) => {
-                    let name = component.name.clone();
-                    self.components.iter_mut().for_each(|c| c.part.discard());
-                    return Err(in_component(&name, error));
-                }
+            component.part.advance(&x[range], run.steps)
+        };
+        // Each component's violation, or the first component's error.
+        let advanced: Result<f64, (usize, DiracError)> = if parallel {
+            let components = self.components.par_iter_mut().with_min_len(GRAIN);
+            let each = components
+                .enumerate()
+                .map(|(c, component)| advance(component).map_err(|e| (c, e)));
+            each.reduce(|| Ok(0.0), worse)
+        } else {
+            let each = self.components.iter_mut().enumerate();
+            let mut each = each.map(|(c, component)| advance(component).map_err(|e| (c, e)));
+            each.try_fold(0.0, |v, r| worse(Ok(v), r))
+        };
+        let violation = match advanced {
+            Ok(violation) => violation,
+            Err((c, error)) => {
+                let name = self.components[c].name.clone();
+                self.components.iter_mut().for_each(|c| c.part.discard());
+                return Err(in_component(&name, error));
             }
-        }
+        };
         let junction_violation = self.junctions.iter().map(|junction| {
             let moved = junction.terms.iter().map(|&(c, i, a)| {
                 let component = &self.components[c];
@@ -660,7 +750,7 @@ impl Modular {
     }
 
     fn running(&self) -> Result<&Running, DiracError> {
-        self.run.as_ref().ok_or(DiracError::NotStarted)
+        self.run.as_deref().ok_or(DiracError::NotStarted)
     }
 
     /// The time of the current state (0 before a start).
@@ -736,6 +826,83 @@ impl Modular {
     }
 }
 
+/// A null vector of the matrix of sparse `rows` (`(column, value)` entries) over `columns`
+/// columns, where it has one: the columns it moves. Gaussian elimination with partial pivoting
+/// on the sparse rows (a pivot at or below `1e-10` of its row's largest entry counts as zero),
+/// then back-substitution from the first column that has no pivot. Rows of a chain's junctions
+/// touch neighbours only, so the elimination costs `O(columns)` there.
+fn null_vector(rows: Vec<Vec<(usize, f64)>>, columns: usize) -> Option<Vec<usize>> {
+    let scales: Vec<f64> = rows
+        .iter()
+        .map(|row| row.iter().fold(0.0, |m: f64, e| m.max(e.1.abs())))
+        .collect();
+    let mut rows: Vec<BTreeMap<usize, f64>> = rows
+        .into_iter()
+        .map(|row| row.into_iter().collect())
+        .collect();
+    let mut holding: Vec<Vec<usize>> = vec![Vec::new(); columns];
+    for (r, row) in rows.iter().enumerate() {
+        for &k in row.keys() {
+            holding[k].push(r);
+        }
+    }
+    let mut used = vec![false; rows.len()];
+    let mut pivots: Vec<usize> = Vec::with_capacity(columns);
+    for k in 0..columns {
+        let relative = |r: usize| rows[r].get(&k).map_or(0.0, |v| v.abs() / scales[r]);
+        let best = holding[k]
+            .iter()
+            .copied()
+            .filter(|&r| !used[r])
+            .max_by(|&a, &b| relative(a).total_cmp(&relative(b)));
+        let Some(p) = best.filter(|&p| relative(p) > 1e-10) else {
+            // Column k combines the columns before it: x_k = 1, and the pivot rows give the rest.
+            let mut x = vec![0.0; k + 1];
+            x[k] = 1.0;
+            for (j, &p) in pivots.iter().enumerate().rev() {
+                let sum: f64 = rows[p].range(j + 1..=k).map(|(&l, &v)| v * x[l]).sum();
+                x[j] = -sum / rows[p][&j];
+            }
+            let size = x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+            return Some((0..=k).filter(|&j| x[j].abs() > 1e-8 * size).collect());
+        };
+        used[p] = true;
+        pivots.push(p);
+        let pivot_row = rows[p].clone();
+        let pivot = pivot_row[&k];
+        for r in std::mem::take(&mut holding[k]) {
+            if used[r] {
+                continue;
+            }
+            let Some(value) = rows[r].remove(&k) else {
+                continue;
+            };
+            let factor = value / pivot;
+            for (&l, &v) in pivot_row.range(k + 1..) {
+                let entry = rows[r].entry(l).or_insert_with(|| {
+                    holding[l].push(r);
+                    0.0
+                });
+                *entry -= factor * v;
+            }
+        }
+    }
+    None
+}
+
+/// The larger of two violations (NaN wins), or the error of the first component of two that
+/// failed.
+fn worse(
+    a: Result<f64, (usize, DiracError)>,
+    b: Result<f64, (usize, DiracError)>,
+) -> Result<f64, (usize, DiracError)> {
+    match (a, b) {
+        (Ok(a), Ok(b)) => Ok(largest([a, b])),
+        (Err(a), Err(b)) => Err(if a.0 <= b.0 { a } else { b }),
+        (Err(e), _) | (_, Err(e)) => Err(e),
+    }
+}
+
 /// An error of component `name`, said to be its.
 fn in_component(name: &str, error: DiracError) -> DiracError {
     match error {
@@ -768,6 +935,10 @@ trait Part: Send + std::fmt::Debug {
     fn coordinate_name(&self, i: usize) -> String;
     fn one_forms(&self) -> bool;
     fn point(&self) -> ConstraintPoint;
+    fn inputs(&self) -> usize;
+    fn input_name(&self, i: usize) -> String;
+    /// Sets input `i` (finite); whether it changed.
+    fn set_input(&mut self, i: usize, value: f64) -> bool;
     /// The number of unknowns of a step (after [`begin`](Self::begin)).
     fn unknowns(&self) -> usize;
     fn unknown_name(&self, column: usize) -> String;
@@ -779,8 +950,12 @@ trait Part: Send + std::fmt::Debug {
     fn begin(&mut self, state: Started);
     /// Forgets the run (a start that failed after `begin`).
     fn stop(&mut self);
-    /// Prepares the step and writes its predictor.
-    fn predict(&mut self, previous: Option<&[f64]>, x: &mut [f64]);
+    /// Prepares the step and writes its predictor (read by
+    /// [`unknowns_of_step`](Self::unknowns_of_step)) from its part of the previous solutions'
+    /// extrapolation, where there is one.
+    fn predict(&mut self, previous: Option<&[f64]>);
+    /// The unknowns of the step last predicted or assembled.
+    fn unknowns_of_step(&self) -> &[f64];
     /// The residual at `x` with the junctions' impulse (into its own buffer), the Jacobian
     /// into `jacobian`; the size of the residual's terms.
     fn assemble(&mut self, impulse: &[f64], x: &[f64], jacobian: Option<&mut DMatrix<f64>>) -> f64;
@@ -860,6 +1035,20 @@ impl<S: DiracSystem<M> + Send, const M: usize> Part for Model<S, M> {
         self.equations.constraint_point()
     }
 
+    fn inputs(&self) -> usize {
+        S::INPUTS
+    }
+
+    fn input_name(&self, i: usize) -> String {
+        self.equations.input_name(i)
+    }
+
+    fn set_input(&mut self, i: usize, value: f64) -> bool {
+        let changed = self.equations.inputs()[i] != value;
+        self.equations.inputs_mut()[i] = value;
+        changed
+    }
+
     fn unknowns(&self) -> usize {
         self.equations.unknowns()
     }
@@ -904,14 +1093,17 @@ impl<S: DiracSystem<M> + Send, const M: usize> Part for Model<S, M> {
         (self.state, self.before, self.proposed) = (None, None, None);
     }
 
-    fn predict(&mut self, previous: Option<&[f64]>, x: &mut [f64]) {
+    fn predict(&mut self, previous: Option<&[f64]>) {
         let state = *self.state();
         let previous = previous.map(|p| {
             self.previous.copy_from_slice(p);
             &self.previous
         });
         self.equations.predict(&state, previous, &mut self.x);
-        x.copy_from_slice(self.x.as_slice());
+    }
+
+    fn unknowns_of_step(&self) -> &[f64] {
+        self.x.as_slice()
     }
 
     fn assemble(&mut self, impulse: &[f64], x: &[f64], jacobian: Option<&mut DMatrix<f64>>) -> f64 {
@@ -969,5 +1161,27 @@ impl<S: DiracSystem<M> + Send, const M: usize> Part for Model<S, M> {
         self.state
             .as_ref()
             .map_or(vec![0.0; M], |s| s.p.as_slice().to_vec())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn null_vectors_of_sparse_rows() {
+        // x₀ − x₁ = 0, x₁ − x₂ = 0 over three columns: (1, 1, 1).
+        let chain = vec![vec![(0, 1.0), (1, -1.0)], vec![(1, 1.0), (2, -1.0)]];
+        assert_eq!(null_vector(chain.clone(), 3), Some(vec![0, 1, 2]));
+        // With x₂ pinned, none.
+        let pinned = [chain, vec![vec![(2, 3.0)]]].concat();
+        assert_eq!(null_vector(pinned, 3), None);
+        // A column no row touches; and one that pivoting must find below a zero.
+        assert_eq!(null_vector(vec![vec![(0, 2.0)]], 2), Some(vec![1]));
+        let swap = vec![vec![(1, 1.0)], vec![(0, 1.0), (1, 5.0)]];
+        assert_eq!(null_vector(swap, 2), None);
+        // Dependent in a combination: x₀ + x₁ and 2x₀ + 2x₁ leave (1, −1).
+        let twice = vec![vec![(0, 1.0), (1, 1.0)], vec![(0, 2.0), (1, 2.0)]];
+        assert_eq!(null_vector(twice, 2), Some(vec![0, 1]));
     }
 }
