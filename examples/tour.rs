@@ -47,6 +47,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     reports.push(circuit::subcircuits_report()?);
     reports.push(scenes::port::components_report()?);
     reports.push(scenes::ladder::report()?);
+    reports.push(scenes::ladder::modular_report()?);
     // The newer model classes with the Gauss rules (the trapezoid is refused for a Lagrangian
     // linear in the velocities).
     type Newer = fn(Quadrature) -> Result<Report, DiracError>;
