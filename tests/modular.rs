@@ -107,6 +107,76 @@ fn the_ring_by_parts_equals_the_monolithic_ring() {
     );
 }
 
+/// Each component's velocity and energy read from a modular run: the velocities equal the
+/// monolithic stepper's `v()` to 1e-12 (the capacitor's, which only the junction fixes,
+/// included), and each component's energy changes over a step by exactly its port work
+/// (midpoint rule, quadratic Lagrangians): on the LC loop and on every cell of the ring of 16
+/// masses, to 1e-14 of the energies and work in play, at every step.
+#[test]
+fn each_components_energy_changes_by_its_port_work() {
+    let h = 0.05;
+    let mut parts = lc_loop(h);
+    let whole = Interconnection::new(
+        ("l", Inductor { l: 1.3 }),
+        ("c", Capacitor { c: 0.7 }),
+        [Junction::new("series").flow("l.q", 1.0).flow("c.q", -1.0)],
+    )
+    .unwrap();
+    let mut monolithic = Stepper::new(whole, Quadrature::midpoint(), h).unwrap();
+    parts.start_from_velocity(&[0.3, 0.3], &[1.0, 1.0]).unwrap();
+    monolithic
+        .start_from_velocity(SVector::from([0.3, 0.3]), SVector::from([1.0, 1.0]))
+        .unwrap();
+    let balance = |parts: &mut Modular, steps: usize| {
+        let (mut worst, mut largest_work): (f64, f64) = (0.0, 0.0);
+        let mut before = parts.energies().unwrap();
+        for _ in 0..steps {
+            parts.step().unwrap();
+            let now = parts.energies().unwrap();
+            let ports = parts.ports().unwrap();
+            let scale = before
+                .iter()
+                .chain(&now)
+                .fold(ports.scale, |m, e| m.max(e.abs()));
+            for c in 0..now.len() {
+                worst = worst.max((now[c] - before[c] - ports.work[c]).abs() / scale);
+                largest_work = largest_work.max(ports.work[c].abs());
+            }
+            before = now;
+        }
+        (worst, largest_work)
+    };
+    let mut apart: f64 = 0.0;
+    for _ in 0..200 {
+        parts.step().unwrap();
+        monolithic.step().unwrap();
+        let v = parts.velocities().unwrap();
+        apart =
+            apart.max((v - DVector::from_column_slice(monolithic.v().unwrap().as_slice())).amax());
+    }
+    println!("LC loop velocities apart by {apart:e}");
+    assert!(apart < 1e-12, "velocities apart by {apart:e}");
+    let (worst, work) = balance(&mut parts, 500);
+    println!("LC loop: energy balance {worst:e}, largest work {work:e}");
+    assert!(
+        worst < 1e-14 && work > 1e-3,
+        "balance off by {worst:e} (work {work:e})"
+    );
+
+    let (m, k, mode) = (1.5, 0.6, 3);
+    let kappa = 2.0 * std::f64::consts::PI * mode as f64 / ladder::CELLS as f64;
+    let (q0, v0) = ladder::chain_wave(mode, ladder::lattice_frequency((k / m).sqrt(), kappa));
+    let mut ring = ladder::modular_chain(m, k, ladder::CELLS, true, 0.1).unwrap();
+    ring.start_from_velocity(q0.as_slice(), v0.as_slice())
+        .unwrap();
+    let (worst, work) = balance(&mut ring, 300);
+    println!("ring: energy balance {worst:e}, largest work {work:e}");
+    assert!(
+        worst < 1e-14 && work > 1e-4,
+        "balance off by {worst:e} (work {work:e})"
+    );
+}
+
 /// Stepped in parallel (rayon) or one component after another, the open chain of 200 cells
 /// steps bit for bit alike (each component's equations are its own; the Schur complement is
 /// summed in one order).

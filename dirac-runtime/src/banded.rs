@@ -3,7 +3,9 @@
 //! neighbours in a chain or a ladder. `m` unknowns with `b` diagonals on each side cost
 //! `O(m b²)` to factorise and `O(m b)` to solve.
 
+use crate::jacobian::Jacobian;
 use crate::lu::SingularPivot;
+use crate::newton::largest;
 
 /// An `m × m` matrix with `lower` diagonals below the main one and `upper` above, stored row by
 /// row with room for the `lower` diagonals that pivoting adds above.
@@ -114,6 +116,9 @@ impl Banded {
                 b[i] -= self.data[self.index(i, k)] * b[k];
             }
         }
+        if m == 0 {
+            return;
+        }
         for k in (0..m).rev() {
             let end = (k + upper + lower).min(m - 1);
             let mut sum = b[k];
@@ -122,6 +127,51 @@ impl Banded {
             }
             b[k] = sum / self.data[self.index(k, k)];
         }
+    }
+}
+
+impl Jacobian for Banded {
+    type Matrix = Banded;
+
+    fn size(&self) -> usize {
+        self.m
+    }
+
+    fn matrix(&mut self) -> &mut Banded {
+        self
+    }
+
+    fn clear(&mut self) {
+        self.data.fill(0.0);
+    }
+
+    fn fits(&self, n: usize) -> bool {
+        n == self.m && self.data.len() == self.m * self.width() && self.pivots.len() == self.m
+    }
+
+    fn restore(&mut self, n: usize) {
+        *self = Self::new(n, self.lower, self.upper);
+    }
+
+    fn norm(&mut self) -> f64 {
+        let width = self.width();
+        let sums = self
+            .data
+            .chunks_exact(width.max(1))
+            .map(|row| row.iter().map(|v| v.abs()).sum());
+        largest(sums)
+    }
+
+    fn is_finite(&self) -> bool {
+        self.data.iter().all(|v| v.is_finite())
+    }
+
+    fn factorise(&mut self, tolerance: f64) -> Result<(), SingularPivot> {
+        Banded::factorise(self, tolerance)
+    }
+
+    fn solve(&self, b: &mut [f64]) {
+        Banded::solve(self, b);
     }
 }
 

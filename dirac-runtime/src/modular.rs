@@ -51,10 +51,11 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 use nalgebra::{DMatrix, DVector, SVector};
 use rayon::prelude::*;
 
+use crate::banded::Banded;
 use crate::bordered::Bordered;
 use crate::configuration_space::Euclidean;
 use crate::constraint_point::ConstraintPoint;
-use crate::derivatives::degenerate;
+use crate::derivatives::{Seed, degenerate, seeded};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
 use crate::euler_lagrange::EulerLagrange;
@@ -809,6 +810,61 @@ impl Modular {
         self.run.as_ref().and_then(|run| run.report)
     }
 
+    /// The velocity of every coordinate at the current state (in the order of
+    /// [`coordinate_names`](Self::coordinate_names)): the Legendre transform inverted with the
+    /// constraints, `∂L_c/∂v(q_c, v_c) = p_c + C_cᵀ ν_c + Σ_j ν_j a_j^c` for every component
+    /// `c` (its own one-forms and holonomic differentials `C_c`), `C_c v_c = 0` and the
+    /// junctions `Σ_c a_j^c · v_c = 0`, solved by Newton's method from the last step's
+    /// velocities. Its matrix is a band matrix with each junction's row beside the components
+    /// it joins (a chain costs `O(K)`), factorised with partial pivoting, so components without
+    /// kinetic energy, whose velocities only the junctions fix, need no block of their own.
+    pub fn velocities(&self) -> Result<DVector<f64>, DiracError> {
+        let run = self.running()?;
+        let layout = VelocityLayout::of(&self.components, &self.junctions);
+        let mut newton = Newton::with_jacobian(layout.band(), self.options)?;
+        let mut x = DVector::zeros(layout.size);
+        for (component, &at) in self.components.iter().zip(&layout.components) {
+            let guess = component.part.velocity_hint();
+            x.as_mut_slice()[at..at + guess.len()].copy_from_slice(&guess);
+        }
+        let (components, junctions) = (&self.components, &self.junctions);
+        let solved = newton.solve(&mut x, |x, r, band| {
+            layout.assemble(components, junctions, x.as_slice(), r.as_mut_slice(), band)
+        });
+        let names = |column: usize| layout.unknown_name(components, junctions, column);
+        solved.map_err(|failure| {
+            failure.into_error(
+                "the modular velocity solve",
+                run.steps,
+                &self.options,
+                names,
+            )
+        })?;
+        let mut v = DVector::zeros(self.total);
+        for (component, &at) in self.components.iter().zip(&layout.components) {
+            let n = component.part.coordinates();
+            v.as_mut_slice()[component.first..component.first + n]
+                .copy_from_slice(&x.as_slice()[at..at + n]);
+        }
+        Ok(v)
+    }
+
+    /// Each component's energy `E_c = ⟨∂L_c/∂v, v_c⟩ − L_c` at the current state, with the
+    /// [`velocities`](Self::velocities). With the midpoint rule, quadratic Lagrangians and the
+    /// constraint point `Midpoint`, `E_c(k+1) − E_c(k)` equals the component's port work over
+    /// the step ([`ports`](Self::ports)) to round-off.
+    pub fn energies(&self) -> Result<Vec<f64>, DiracError> {
+        let v = self.velocities()?;
+        Ok(self
+            .components
+            .iter()
+            .map(|c| {
+                let n = c.part.coordinates();
+                c.part.energy(&v.as_slice()[c.first..c.first + n])
+            })
+            .collect())
+    }
+
     /// The junctions' efforts and each component's port work over the last step (see
     /// [`PortWork`]); `NotStarted` before a start and zeros before the first step.
     pub fn ports(&self) -> Result<PortWork, DiracError> {
@@ -923,6 +979,161 @@ fn in_component(name: &str, error: DiracError) -> DiracError {
     }
 }
 
+/// Where the velocity solve's unknowns sit: each component's velocities then its own
+/// multipliers, and each junction's multiplier right after the last component it touches, so
+/// that along a chain the matrix is a band.
+struct VelocityLayout {
+    /// The first unknown of each component.
+    components: Vec<usize>,
+    /// The unknown (and row) of each junction.
+    junctions: Vec<usize>,
+    size: usize,
+    lower: usize,
+    upper: usize,
+}
+
+impl VelocityLayout {
+    fn of(components: &[Component], junctions: &[Coupling]) -> Self {
+        let mut last = vec![Vec::new(); components.len()];
+        for (j, junction) in junctions.iter().enumerate() {
+            let c = junction
+                .terms
+                .iter()
+                .map(|t| t.0)
+                .max()
+                .expect("a junction has terms");
+            last[c].push(j);
+        }
+        let (mut at, mut starts, mut places) = (0, Vec::new(), vec![0; junctions.len()]);
+        for (component, theirs) in components.iter().zip(&last) {
+            starts.push(at);
+            at += component.part.coordinates() + component.part.constraints();
+            for &j in theirs {
+                places[j] = at;
+                at += 1;
+            }
+        }
+        let mut layout = Self {
+            components: starts,
+            junctions: places,
+            size: at,
+            lower: 0,
+            upper: 0,
+        };
+        // The band: each component's own block, and each junction's row and column.
+        for component in components {
+            let width = component.part.coordinates() + component.part.constraints();
+            layout.lower = layout.lower.max(width.saturating_sub(1));
+            layout.upper = layout.upper.max(width.saturating_sub(1));
+        }
+        for (j, junction) in junctions.iter().enumerate() {
+            for &(c, i, _) in &junction.terms {
+                let spread = layout.junctions[j].abs_diff(layout.components[c] + i);
+                layout.lower = layout.lower.max(spread);
+                layout.upper = layout.upper.max(spread);
+            }
+        }
+        layout
+    }
+
+    fn band(&self) -> Banded {
+        Banded::new(self.size, self.lower, self.upper)
+    }
+
+    /// The residual at `x` into `r` and, when asked, the Jacobian into `band`; the size of the
+    /// residual's terms.
+    fn assemble(
+        &self,
+        components: &[Component],
+        junctions: &[Coupling],
+        x: &[f64],
+        r: &mut [f64],
+        mut band: Option<&mut Banded>,
+    ) -> f64 {
+        let mut scale: f64 = 0.0;
+        for (component, &at) in components.iter().zip(&self.components) {
+            let (n, m) = (component.part.coordinates(), component.part.constraints());
+            let rows = component.part.legendre(&x[at..at + n]);
+            let p = component.part.p();
+            for i in 0..n {
+                r[at + i] = rows.momentum[i] - p[i];
+                scale = scale.max(p[i].abs()).max(rows.momentum[i].abs());
+                for (a, nu) in x[at + n..at + n + m].iter().enumerate() {
+                    r[at + i] -= rows.forms[(a, i)] * nu;
+                }
+            }
+            for a in 0..m {
+                let terms = (0..n).map(|k| rows.forms[(a, k)] * x[at + k]);
+                let (row, size) = terms.fold((0.0, 0.0), |(r, s), t: f64| (r + t, s + t.abs()));
+                r[at + n + a] = row;
+                scale = scale.max(size);
+            }
+            if let Some(band) = band.as_deref_mut() {
+                for i in 0..n {
+                    for k in 0..n {
+                        band.add(at + i, at + k, rows.hessian[(i, k)]);
+                    }
+                    for a in 0..m {
+                        band.add(at + i, at + n + a, -rows.forms[(a, i)]);
+                        band.add(at + n + a, at + i, rows.forms[(a, i)]);
+                    }
+                }
+            }
+        }
+        for (junction, &row) in junctions.iter().zip(&self.junctions) {
+            let (mut value, mut size) = (0.0, 0.0);
+            for &(c, i, a) in &junction.terms {
+                let column = self.components[c] + i;
+                r[column] -= a * x[row];
+                value += a * x[column];
+                size += (a * x[column]).abs();
+                if let Some(band) = band.as_deref_mut() {
+                    band.add(column, row, -a);
+                    band.add(row, column, a);
+                }
+            }
+            r[row] = value;
+            scale = scale.max(size);
+        }
+        scale
+    }
+
+    /// The name of unknown `column`.
+    fn unknown_name(
+        &self,
+        components: &[Component],
+        junctions: &[Coupling],
+        column: usize,
+    ) -> String {
+        if let Some(j) = self.junctions.iter().position(|&at| at == column) {
+            return format!("the multiplier of junction {}", junctions[j].name);
+        }
+        let c = self.components.partition_point(|&at| at <= column) - 1;
+        let (component, i) = (&components[c], column - self.components[c]);
+        if i < component.part.coordinates() {
+            format!(
+                "{}.{} (velocity)",
+                component.name,
+                component.part.coordinate_name(i)
+            )
+        } else {
+            format!(
+                "{}: the multiplier of its constraint {}",
+                component.name,
+                i - component.part.coordinates()
+            )
+        }
+    }
+}
+
+/// A component's Legendre rows at its position: `∂L/∂v`, `∂²L/∂v²` and its own constraint
+/// forms (one-forms, then holonomic differentials; rows over its coordinates).
+struct Legendre {
+    momentum: Vec<f64>,
+    hessian: DMatrix<f64>,
+    forms: DMatrix<f64>,
+}
+
 /// What [`Part::degenerate`] finds at a start.
 struct Degenerate {
     /// The coordinates without kinetic energy.
@@ -977,6 +1188,14 @@ trait Part: Send + std::fmt::Debug {
     fn last_step(&self, i: usize) -> f64;
     fn q(&self) -> Vec<f64>;
     fn p(&self) -> Vec<f64>;
+    /// The number of its own constraints (one-forms and holonomic).
+    fn constraints(&self) -> usize;
+    /// The velocity of the last step at its end (the initial velocity before one).
+    fn velocity_hint(&self) -> Vec<f64>;
+    /// The Legendre rows at its position with velocity `v`.
+    fn legendre(&self, v: &[f64]) -> Legendre;
+    /// The energy at its position with velocity `v`.
+    fn energy(&self, v: &[f64]) -> f64;
 }
 
 /// A checked initial state, type-erased.
@@ -1166,6 +1385,30 @@ impl<S: DiracSystem<M> + Send, const M: usize> Part for Model<S, M> {
         self.state
             .as_ref()
             .map_or(vec![0.0; M], |s| s.p.as_slice().to_vec())
+    }
+
+    fn constraints(&self) -> usize {
+        S::ONE_FORMS + S::HOLONOMIC
+    }
+
+    fn velocity_hint(&self) -> Vec<f64> {
+        self.state().velocity.as_slice().to_vec()
+    }
+
+    fn legendre(&self, v: &[f64]) -> Legendre {
+        let (system, q) = (self.equations.discrete().system(), &self.state().q);
+        let v = SVector::from_column_slice(v);
+        let l = seeded(system, q, &v, Seed::VELOCITY, Seed::VELOCITY);
+        Legendre {
+            momentum: l.first.as_slice().to_vec(),
+            hessian: DMatrix::from_column_slice(M, M, l.mixed.as_slice()),
+            forms: HiddenConstraints::forms(system, q),
+        }
+    }
+
+    fn energy(&self, v: &[f64]) -> f64 {
+        let system = self.equations.discrete().system();
+        crate::legendre::energy(system, &self.state().q, &SVector::from_column_slice(v))
     }
 }
 
