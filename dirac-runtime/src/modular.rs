@@ -94,6 +94,8 @@ pub struct Modular {
     lookup: HashMap<String, (usize, usize)>,
     /// Instance name → component.
     instances: HashMap<String, usize>,
+    /// The names of included interconnections (their components are `name.instance`).
+    nested: HashSet<String>,
     /// The junctions' names.
     junction_names: HashSet<String>,
     /// The first component with one-forms: the others' must be held at its constraint point.
@@ -189,6 +191,7 @@ impl Modular {
             junctions: Vec::new(),
             lookup: HashMap::new(),
             instances: HashMap::new(),
+            nested: HashSet::new(),
             junction_names: HashSet::new(),
             constrained: None,
             total: 0,
@@ -227,7 +230,7 @@ impl Modular {
                 "the instance name {name:?} must be non-empty and without '.'"
             ));
         }
-        if self.instances.contains_key(name) {
+        if self.instances.contains_key(name) || self.nested.contains(name) {
             return invalid(format!("two instances are named {name:?}: name them apart"));
         }
         let discrete = DiscreteLagrangian::new(system, self.quadrature.clone(), self.h);
@@ -275,6 +278,106 @@ impl Modular {
             scale: 0.0,
         });
         self.total += M;
+        self.run = None;
+        Ok(())
+    }
+
+    /// Adds the interconnection `other` as the instance `name`, a component made of components
+    /// (a hierarchy): its components become `name.instance` (coordinates
+    /// `name.instance.coordinate`, inputs `name.instance.input`) and its junctions
+    /// `name.junction`, so junctions of this interconnection can reach into it. The
+    /// interconnection of interconnections is one interconnection: the steps are those of the
+    /// same components and junctions added here one by one. Fails on a name that is empty,
+    /// contains `.`, or is taken, on another quadrature or step, and on components holding their
+    /// one-forms at another constraint point. `other`'s run, if any, is not carried over.
+    ///
+    /// ```
+    /// use dirac_runtime::modular::Modular;
+    /// use dirac_runtime::{DiracSystem, Junction, Quadrature, Scalar};
+    /// use nalgebra::SVector;
+    /// struct Mass;
+    /// impl DiracSystem<1> for Mass {
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] * 0.5
+    ///     }
+    /// }
+    /// let mut pair = Modular::new(Quadrature::midpoint(), 0.1)?;
+    /// pair.add("a", Mass)?;
+    /// pair.add("b", Mass)?;
+    /// pair.join(Junction::new("glue").flow("a.q0", 1.0).flow("b.q0", -1.0))?;
+    /// let mut whole = Modular::new(Quadrature::midpoint(), 0.1)?;
+    /// whole.include("left", pair)?;
+    /// whole.add("c", Mass)?;
+    /// whole.join(Junction::new("tie").flow("left.b.q0", 1.0).flow("c.q0", -1.0))?;
+    /// assert_eq!(whole.coordinate_names(), ["left.a.q0", "left.b.q0", "c.q0"]);
+    /// assert_eq!(whole.junction_names(), ["left.glue", "tie"]);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn include(&mut self, name: &str, other: Modular) -> Result<(), DiracError> {
+        let invalid = |why: String| Err(DiracError::InvalidInterconnection(why));
+        if name.is_empty() || name.contains('.') {
+            return invalid(format!(
+                "the instance name {name:?} must be non-empty and without '.'"
+            ));
+        }
+        if other.quadrature != self.quadrature || other.h != self.h {
+            return invalid(format!(
+                "{name} steps with {} and h = {}, this interconnection with {} and h = {}",
+                other.quadrature.name(),
+                other.h,
+                self.quadrature.name(),
+                self.h
+            ));
+        }
+        if self.instances.contains_key(name) || self.nested.contains(name) {
+            return invalid(format!("two instances are named {name:?}: name them apart"));
+        }
+        let prefix = format!("{name}.");
+        if let Some(j) = other
+            .junctions
+            .iter()
+            .find(|j| self.junction_names.contains(&format!("{prefix}{}", j.name)))
+        {
+            return invalid(format!("two junctions are named {prefix}{}", j.name));
+        }
+        if let (Some(mine), Some(theirs)) = (self.constrained, other.constrained) {
+            let (mine, theirs) = (&self.components[mine], &other.components[theirs]);
+            if mine.part.point() != theirs.part.point() {
+                return invalid(format!(
+                    "{} holds its one-forms at {:?} and {prefix}{} at {:?}: the components need \
+                     one constraint point",
+                    mine.name,
+                    mine.part.point(),
+                    theirs.name,
+                    theirs.part.point()
+                ));
+            }
+        }
+        let base = self.components.len();
+        self.nested.insert(name.to_string());
+        if self.constrained.is_none() {
+            self.constrained = other.constrained.map(|c| base + c);
+        }
+        for mut component in other.components {
+            component.name = format!("{prefix}{}", component.name);
+            component.first = self.total;
+            for i in 0..component.part.coordinates() {
+                let coordinate =
+                    format!("{}.{}", component.name, component.part.coordinate_name(i));
+                self.lookup.insert(coordinate, (self.components.len(), i));
+            }
+            self.instances
+                .insert(component.name.clone(), self.components.len());
+            self.total += component.part.coordinates();
+            component.part.stop();
+            self.components.push(component);
+        }
+        for mut junction in other.junctions {
+            junction.name = format!("{prefix}{}", junction.name);
+            junction.terms.iter_mut().for_each(|t| t.0 += base);
+            self.junction_names.insert(junction.name.clone());
+            self.junctions.push(junction);
+        }
         self.run = None;
         Ok(())
     }
@@ -358,7 +461,7 @@ impl Modular {
     /// Sets the input named `instance.input` (e.g. a voltage source's `drive.u`) from the
     /// next step on; `UnknownInput` lists the inputs there are, `NonFinite` refuses a value.
     pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), DiracError> {
-        let found = name.split_once('.').and_then(|(instance, input)| {
+        let found = name.rsplit_once('.').and_then(|(instance, input)| {
             let c = *self.instances.get(instance)?;
             let part = &self.components[c].part;
             let i = (0..part.inputs()).find(|&i| part.input_name(i) == input)?;
