@@ -267,6 +267,122 @@ fn included_interconnections_equal_the_flat_and_the_monolithic_ones() {
     assert!(nested.q().amax() > 0.3);
 }
 
+/// A knife edge in the plane with its one-form held at the step's end (`σ = 1`).
+struct KnifeEdge;
+impl DiracSystem<3> for KnifeEdge {
+    const ONE_FORMS: usize = 1;
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+        (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * 0.5 - q[1] * 0.3
+    }
+    fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, _a: usize) -> SVector<D, 3> {
+        SVector::from([q[2].sin(), -q[2].cos(), D::from(0.0)])
+    }
+    fn constraint_point(&self) -> ConstraintPoint {
+        ConstraintPoint::End
+    }
+    fn coordinate_name(&self, i: usize) -> String {
+        ["x", "y", "theta"][i].into()
+    }
+}
+
+/// A component with its own one-forms held at the step's end, joined to one without: every
+/// junction's impulse takes the constrained component's share (`σ = 1` here, not the other
+/// component's ½), as in the monolithic interconnection, which the steps equal to 1e-12 over
+/// 400 steps; its own multiplier sits beside the junction's in the velocity solve.
+#[test]
+fn the_junctions_take_the_constrained_components_constraint_point() {
+    let h = 0.02;
+    let tie = || {
+        Junction::new("tie")
+            .flow("knife.x", 1.0)
+            .flow("mass.x", -1.0)
+    };
+    let whole = Interconnection::new(
+        ("knife", KnifeEdge),
+        ("mass", MassSpring { m: 2.0, k: 0.5 }),
+        [tie()],
+    )
+    .unwrap();
+    let mut monolithic = Stepper::new(whole, Quadrature::midpoint(), h).unwrap();
+    let mut parts = Modular::new(Quadrature::midpoint(), h).unwrap();
+    parts.add("knife", KnifeEdge).unwrap();
+    parts.add("mass", MassSpring { m: 2.0, k: 0.5 }).unwrap();
+    parts.join(tie()).unwrap();
+    // Heading 0.3, moving along it; the mass moves with the blade's x.
+    let (theta, speed) = (0.3_f64, 1.0);
+    let q0 = [0.0, 0.0, theta, 0.0];
+    let v0 = [
+        speed * theta.cos(),
+        speed * theta.sin(),
+        0.7,
+        speed * theta.cos(),
+    ];
+    parts.start_from_velocity(&q0, &v0).unwrap();
+    monolithic
+        .start_from_velocity(SVector::from(q0), SVector::from(v0))
+        .unwrap();
+    let mut worst: f64 = 0.0;
+    for _ in 0..400 {
+        parts.step().unwrap();
+        monolithic.step().unwrap();
+        worst = worst
+            .max((parts.q() - DVector::from_column_slice(monolithic.q().as_slice())).amax())
+            .max((parts.p() - DVector::from_column_slice(monolithic.p().as_slice())).amax())
+            .max((parts.multipliers().unwrap()[0] - monolithic.multipliers()[1]).abs());
+    }
+    let v = parts.velocities().unwrap();
+    let apart = (v - DVector::from_column_slice(monolithic.v().unwrap().as_slice())).amax();
+    println!("knife edge and mass: apart by {worst:e}, velocities {apart:e}");
+    assert!(
+        worst < 1e-12 && apart < 1e-12,
+        "apart by {worst:e}, velocities {apart:e}"
+    );
+    assert!(
+        parts.multipliers().unwrap()[0].abs() > 1e-6,
+        "the junction carried no impulse"
+    );
+}
+
+/// Junctions joined in any order give the same steps: the multipliers are numbered along the
+/// components inside (a chain of 30 tethered masses joined backwards, bit for bit).
+#[test]
+fn the_order_of_joining_does_not_change_the_steps() {
+    let cells = 30;
+    let x = |j: usize| 0.05 * (j as f64 * 0.7).sin();
+    let q0: Vec<f64> = (0..cells).flat_map(|j| [x(j), x(j + 1)]).collect();
+    let forward = ladder::modular_chain(1.0, 1.0, cells, false, 0.05).unwrap();
+    let mut backward = Modular::new(Quadrature::midpoint(), 0.05).unwrap();
+    for j in 0..cells {
+        backward
+            .add(
+                &format!("cell[{j}]"),
+                scenes::components::Tethered { m: 1.0, k: 1.0 },
+            )
+            .unwrap();
+    }
+    for j in (0..cells).rev() {
+        let end = Junction::new(format!("joint{j}")).flow(format!("cell[{j}].end"), 1.0);
+        backward
+            .join(if j + 1 < cells {
+                end.flow(format!("cell[{}].x", j + 1), -1.0)
+            } else {
+                Junction::new("wall").flow(format!("cell[{j}].end"), 1.0)
+            })
+            .unwrap();
+    }
+    let mut runs = [forward, backward];
+    for chain in &mut runs {
+        chain
+            .start_from_velocity(&q0, &vec![0.0; 2 * cells])
+            .unwrap();
+        chain.run(100).unwrap();
+    }
+    assert_eq!(runs[0].q(), runs[1].q());
+    let mut reversed = runs[1].multipliers().unwrap().to_vec();
+    reversed.reverse();
+    assert_eq!(runs[0].multipliers().unwrap(), &reversed[..]);
+}
+
 /// Stepped in parallel (rayon) or one component after another, the open chain of 200 cells
 /// steps bit for bit alike (each component's equations are its own; the Schur complement is
 /// summed in one order).

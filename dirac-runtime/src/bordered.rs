@@ -1,45 +1,48 @@
-//! A block-bordered Jacobian, solved by its diagonal blocks and a Schur complement.
-//!
-//! ```text
-//!     ⎡ J_1            E_1 ⎤        J_c   a block's own unknowns (filled per evaluation)
-//! J = ⎢      ⋱          ⋮  ⎥        E_c   how the couplings μ enter block c's rows
-//!     ⎢          J_K   E_K ⎥        G_c   how block c's unknowns enter the coupling rows
-//!     ⎣ G_1  …   G_K    0  ⎦        (E_c and G_c constant, on the couplings touching c)
-//! ```
-//!
-//! `J (x, μ) = (r, s)` is solved by `z_c = J_c⁻¹ r_c`, `Y_c = J_c⁻¹ E_c`, the Schur complement
-//! `S = Σ_c G_c Y_c`, `S μ = Σ_c G_c z_c − s`, and `x_c = z_c − Y_c μ`. Each block is factorised
-//! on its own, so `K` blocks of size `n` cost `O(K n³)`; `S` is a band matrix whose width is the
-//! largest spread of the couplings one block touches (numbered along a chain, a few), so it
-//! costs `O(m b²)` for `m` couplings and half-width `b`. Factorising `S` with partial pivoting
-//! needs every `J_c` regular on its own: a block singular alone (a coordinate that only the
-//! couplings determine) is refused, naming its column.
-//!
-//! ```
-//! use dirac_runtime::jacobian::{Bordered, Jacobian};
-//! // Two 1 × 1 blocks coupled by one row x₀ − x₁ (E = Gᵀ).
-//! let mut j = Bordered::new(&[1, 1], &[vec![(0, 0, 1.0)], vec![(0, 0, -1.0)]], &[
-//!     vec![(0, 0, 1.0)],
-//!     vec![(0, 0, -1.0)],
-//! ]);
-//! j.matrix()[0][(0, 0)] = 2.0;
-//! j.matrix()[1][(0, 0)] = 4.0;
-//! j.factorise(1e-13).unwrap();
-//! // [[2, 0, 1], [0, 4, −1], [1, −1, 0]] (x₀, x₁, μ) = (3, 3, 0)
-//! let mut b = [3.0, 3.0, 0.0];
-//! j.solve(&mut b);
-//! assert!((b[0] - 1.0).abs() < 1e-15 && (b[1] - 1.0).abs() < 1e-15 && (b[2] - 1.0).abs() < 1e-15);
-//! ```
+//! A block-bordered Jacobian, solved by its diagonal blocks and a Schur complement (see
+//! [`Bordered`]).
 
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 use crate::banded::Banded;
+use crate::error::DiracError;
 use crate::jacobian::Jacobian;
 use crate::lu::{self, SingularPivot};
 use crate::newton::largest;
 
-/// A block-bordered Jacobian (see the [module](self) documentation).
+/// A block-bordered Jacobian, solved by its diagonal blocks and a Schur complement.
+///
+/// ```text
+///     ⎡ J_1            E_1 ⎤        J_c   a block's own unknowns (filled per evaluation)
+/// J = ⎢      ⋱          ⋮  ⎥        E_c   how the couplings μ enter block c's rows
+///     ⎢          J_K   E_K ⎥        G_c   how block c's unknowns enter the coupling rows
+///     ⎣ G_1  …   G_K    0  ⎦        (E_c and G_c constant, on the couplings touching c)
+/// ```
+///
+/// `J (x, μ) = (r, s)` is solved by `z_c = J_c⁻¹ r_c`, `Y_c = J_c⁻¹ E_c`, the Schur complement
+/// `S = Σ_c G_c Y_c`, `S μ = Σ_c G_c z_c − s`, and `x_c = z_c − Y_c μ`. Each block is factorised
+/// on its own, so `K` blocks of size `n` cost `O(K n³)`; `S` is a band matrix whose width is the
+/// largest spread of the couplings one block touches (numbered along a chain, a few), so it
+/// costs `O(m b²)` for `m` couplings and half-width `b`. Factorising `S` with partial pivoting
+/// needs every `J_c` regular on its own: a block singular alone (a coordinate that only the
+/// couplings determine) is refused, naming its column.
+///
+/// ```
+/// use dirac_runtime::jacobian::{Bordered, Jacobian};
+/// // Two 1 × 1 blocks coupled by one row x₀ − x₁ (E = Gᵀ).
+/// let mut j = Bordered::new(&[1, 1], &[vec![(0, 0, 1.0)], vec![(0, 0, -1.0)]], &[
+///     vec![(0, 0, 1.0)],
+///     vec![(0, 0, -1.0)],
+/// ])?;
+/// j.matrix()[0][(0, 0)] = 2.0;
+/// j.matrix()[1][(0, 0)] = 4.0;
+/// j.factorise(1e-13).unwrap();
+/// // [[2, 0, 1], [0, 4, −1], [1, −1, 0]] (x₀, x₁, μ) = (3, 3, 0)
+/// let mut b = [3.0, 3.0, 0.0];
+/// j.solve(&mut b);
+/// assert!((b[0] - 1.0).abs() < 1e-15 && (b[1] - 1.0).abs() < 1e-15 && (b[2] - 1.0).abs() < 1e-15);
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Bordered {
     /// The diagonal blocks `J_c`, filled by the residual's closure.
@@ -76,12 +79,28 @@ impl Bordered {
     /// Blocks of `sizes` unknowns; `rows[c]` lists the entries `(row of block c, coupling,
     /// value)` of `E_c` and `columns[c]` the entries `(coupling, column of block c, value)` of
     /// `G_c`. The couplings are the unknowns after the blocks' (as many as the largest coupling
-    /// named, plus one).
+    /// named, plus one). `Err(Dimension)` where the lists are not one per block, an entry lies
+    /// outside its block, or a coupling touches no block (its Schur row would be zero).
     pub fn new(
         sizes: &[usize],
         rows: &[Vec<(usize, usize, f64)>],
         columns: &[Vec<(usize, usize, f64)>],
-    ) -> Self {
+    ) -> Result<Self, DiracError> {
+        let invalid = |why: String| Err(DiracError::Dimension(why));
+        if rows.len() != sizes.len() || columns.len() != sizes.len() {
+            return invalid(format!(
+                "{} blocks with {} lists of E entries and {} of G entries",
+                sizes.len(),
+                rows.len(),
+                columns.len()
+            ));
+        }
+        for (c, &n) in sizes.iter().enumerate() {
+            let outside = |i: usize| i >= n;
+            if rows[c].iter().any(|e| outside(e.0)) || columns[c].iter().any(|g| outside(g.1)) {
+                return invalid(format!("an entry of block {c} outside its {n} unknowns"));
+            }
+        }
         let couplings = rows
             .iter()
             .flatten()
@@ -127,7 +146,15 @@ impl Bordered {
                 block
             })
             .collect();
-        Self {
+        let mut touched = vec![false; couplings];
+        blocks
+            .iter()
+            .flat_map(|b| &b.touching)
+            .for_each(|&j| touched[j] = true);
+        if let Some(j) = touched.iter().position(|t| !t) {
+            return invalid(format!("coupling {j} touches no block"));
+        }
+        Ok(Self {
             diagonal: sizes.iter().map(|&n| DMatrix::zeros(n, n)).collect(),
             blocks,
             couplings,
@@ -135,7 +162,7 @@ impl Bordered {
             schur: Banded::new(couplings, spread, spread),
             coupling_sums: vec![0.0; couplings],
             grain: usize::MAX,
-        }
+        })
     }
 
     /// Factorises and solves the blocks across rayon's threads, `grain` blocks or more per
@@ -357,7 +384,7 @@ mod tests {
             rows[i + 1].push((0, i, -0.5));
             columns[i + 1].push((i, 0, -1.0));
         }
-        let mut bordered = Bordered::new(&vec![n; k], &rows, &columns);
+        let mut bordered = Bordered::new(&vec![n; k], &rows, &columns).unwrap();
         let size = bordered.size();
         let mut dense = Dense::new(size);
         for (c, j) in bordered.matrix().iter_mut().enumerate() {

@@ -97,7 +97,7 @@ pub struct EulerLagrange<S, const N: usize, C> {
     scratch: DMatrix<f64>,
     /// The impulse of the junctions on a component of a modular interconnection (see
     /// [`set_coupling`](Self::set_coupling)), `None` for a model stepped on its own.
-    coupling: Option<SVector<f64, N>>,
+    coupling: Option<(SVector<f64, N>, f64)>,
 }
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
@@ -230,7 +230,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// A coordinate among `coordinates` (without kinetic energy) whose momentum `ϑ_d = ∂L/∂v_d`
     /// depends on the position, probed at `(q, v)` and at a point moved off `q` by uneven
     /// amounts (a dependence can vanish at one point).
-    fn turning(
+    pub(crate) fn turning(
         system: &S,
         q: &SVector<f64, N>,
         v: &SVector<f64, N>,
@@ -297,9 +297,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
 
     /// The junctions' impulse `ι = Σ_j μ_j a_j` on this component over the next step (a covector
     /// of its coordinates): its share `σ ι` enters the rows of `p_k`'s equation and the rest the
-    /// momentum `p_{k+1}`, as a constant constraint one-form's impulse would.
-    pub(crate) fn set_coupling(&mut self, impulse: &SVector<f64, N>) {
-        self.coupling = Some(*impulse);
+    /// momentum `p_{k+1}`, as a constant constraint one-form's impulse would. `σ` is the
+    /// interconnection's (one for all its junctions), not necessarily this component's.
+    pub(crate) fn set_coupling(&mut self, impulse: &SVector<f64, N>, share: f64) {
+        self.coupling = Some((*impulse, share));
     }
 
     /// The checks of a start that do not depend on the model's degenerate coordinates: finite,
@@ -842,8 +843,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             covectors += impulses;
             scale = scale.max(size);
         }
-        if let Some(impulse) = self.coupling {
-            let share = self.point.share();
+        if let Some((impulse, share)) = self.coupling {
             for i in 0..N {
                 residual[i] += share * impulse[i];
             }

@@ -1,5 +1,5 @@
 //! The Jacobian of a Newton solve: the matrix the residual's closure fills, its factorisation and
-//! its solves. [`Dense`] is one LU of the whole matrix; [`Bordered`](crate::jacobian::Bordered)
+//! its solves. [`Dense`] is one LU of the whole matrix; [`Bordered`]
 //! factors diagonal blocks on their own and couples them through a Schur complement (the
 //! modular step of an interconnection, see [`modular`](crate::modular)).
 

@@ -129,6 +129,8 @@ struct Coupling {
     name: String,
     /// `(component, coordinate, coefficient)`.
     terms: Vec<(usize, usize, f64)>,
+    /// Where its multiplier sits among the junctions' unknowns of a step (set at a start).
+    rank: usize,
 }
 
 /// A run: the solver sized for its unknowns and what the steps carry.
@@ -154,8 +156,9 @@ pub struct PortWork {
     pub efforts: Vec<f64>,
     /// The work done on each component through the junctions.
     pub work: Vec<f64>,
-    /// The size of the terms summed into the work (`Σ |e_j a_j^c Δq^c|`): Tellegen's
-    /// `Σ_c W_c = 0` holds to round-off of this.
+    /// The size of the terms summed into the work, `Σ_j Σ_c |e_j a_j^c · Δq^c|` (termwise):
+    /// Tellegen's `Σ_c W_c = 0` holds to round-off of this (the junctions are linear rows, which
+    /// Newton's updates hold to round-off).
     pub scale: f64,
 }
 
@@ -203,7 +206,7 @@ impl Modular {
     pub fn with_newton_options(mut self, options: NewtonOptions) -> Result<Self, DiracError> {
         options.validate()?;
         self.options = options;
-        self.run = None;
+        self.end_run();
         Ok(self)
     }
 
@@ -212,7 +215,7 @@ impl Modular {
     /// on a 2-core machine). The steps are the same bit for bit.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = Some(parallel);
-        self.run = None;
+        self.end_run();
         self
     }
 
@@ -278,7 +281,7 @@ impl Modular {
             scale: 0.0,
         });
         self.total += M;
-        self.run = None;
+        self.end_run();
         Ok(())
     }
 
@@ -378,7 +381,7 @@ impl Modular {
             self.junction_names.insert(junction.name.clone());
             self.junctions.push(junction);
         }
-        self.run = None;
+        self.end_run();
         Ok(())
     }
 
@@ -425,10 +428,11 @@ impl Modular {
             .collect();
         self.junction_names.insert(junction.name().to_string());
         self.junctions.push(Coupling {
+            rank: self.junctions.len(),
             name: junction.name().to_string(),
             terms,
         });
-        self.run = None;
+        self.end_run();
         Ok(())
     }
 
@@ -548,12 +552,24 @@ impl Modular {
             offset += component.part.unknowns();
             component.couplings.clear();
         }
-        for (j, junction) in self.junctions.iter().enumerate() {
+        // The junctions' multipliers in the order of the components they join (the first, then
+        // the last), whatever order they were joined in: the Schur complement's band is then as
+        // narrow as the interconnection's shape allows.
+        let span = |j: &Coupling| {
+            let components = j.terms.iter().map(|t| t.0);
+            (components.clone().min(), components.max())
+        };
+        let mut order: Vec<usize> = (0..self.junctions.len()).collect();
+        order.sort_by_key(|&j| span(&self.junctions[j]));
+        for (rank, &j) in order.iter().enumerate() {
+            self.junctions[j].rank = rank;
+        }
+        for junction in &self.junctions {
             for &(c, i, a) in &junction.terms {
-                self.components[c].couplings.push((j, i, a));
+                self.components[c].couplings.push((junction.rank, i, a));
             }
         }
-        let jacobian = self.bordered();
+        let jacobian = self.bordered()?;
         let unknowns = jacobian.size();
         let mut run = Box::new(Running {
             newton: Newton::with_jacobian(jacobian, self.options)?,
@@ -572,14 +588,18 @@ impl Modular {
             component.part.discard();
         }
         if let Err(error @ DiracError::SingularJacobian { .. }) = trial {
-            for component in &mut self.components {
-                component.part.stop();
-            }
+            self.end_run();
             return Err(error);
         }
-        run.newton = Newton::with_jacobian(self.bordered(), self.options)?;
+        run.newton = Newton::with_jacobian(self.bordered()?, self.options)?;
         self.run = Some(run);
         Ok(())
+    }
+
+    /// Ends the run (a change of the model): the components forget their states.
+    fn end_run(&mut self) {
+        self.run = None;
+        self.components.iter_mut().for_each(|c| c.part.stop());
     }
 
     /// Whether the components are stepped in parallel.
@@ -588,12 +608,21 @@ impl Modular {
             .unwrap_or(self.components.len() >= PARALLEL_FROM)
     }
 
+    /// Where the junctions' impulses are held: the constrained components' constraint point
+    /// (they agree), or the midpoint; one share `σ` for every junction, as in the monolithic
+    /// interconnection.
+    fn junction_point(&self) -> ConstraintPoint {
+        self.constrained.map_or(ConstraintPoint::Midpoint, |c| {
+            self.components[c].part.point()
+        })
+    }
+
     /// The block-bordered Jacobian of a step: a block per component, the junctions' rows and
     /// columns.
-    fn bordered(&self) -> Bordered {
+    fn bordered(&self) -> Result<Bordered, DiracError> {
+        let share = self.junction_point().share();
         let sizes: Vec<usize> = self.components.iter().map(|c| c.part.unknowns()).collect();
         let borders = |component: &Component| {
-            let share = component.part.point().share();
             let rows = component
                 .couplings
                 .iter()
@@ -604,7 +633,7 @@ impl Modular {
         let (rows, columns): (Vec<Vec<_>>, Vec<Vec<_>>) =
             self.components.iter().map(borders).unzip();
         let grain = if self.parallel() { GRAIN } else { usize::MAX };
-        Bordered::new(&sizes, &rows, &columns).parallel(grain)
+        Ok(Bordered::new(&sizes, &rows, &columns)?.parallel(grain))
     }
 
     /// `a_j · v = 0` for every junction, to the start's tolerance.
@@ -635,7 +664,10 @@ impl Modular {
         for (c, component) in self.components.iter().enumerate() {
             let range = component.first..component.first + component.part.coordinates();
             let found = component.part.degenerate(&q[range.clone()], &v[range]);
-            if let Some(&(i, momentum)) = found.momenta.iter().find(|(_, p)| *p != 0.0) {
+            let turning = found.turning.map(|i| (i, f64::NAN));
+            if let Some((i, momentum)) =
+                turning.or(found.momenta.iter().copied().find(|(_, p)| *p != 0.0))
+            {
                 return Err(DiracError::Unsupported(format!(
                     "the modular step on {}.{}, whose Lagrangian is linear in its velocity with \
                      the momentum {momentum} (first-order rows are collocated only in a \
@@ -709,6 +741,7 @@ impl Modular {
             Some(p) => run.unknowns.as_mut_slice()[first..].copy_from_slice(&p.as_slice()[first..]),
             None => run.unknowns.as_mut_slice()[first..].fill(0.0),
         }
+        let share = self.junction_point().share();
         let (components, junctions) = (&mut self.components, &self.junctions);
         let evaluate =
             |x: &DVector<f64>, r: &mut DVector<f64>, blocks: Option<&mut Vec<DMatrix<f64>>>| {
@@ -720,9 +753,10 @@ impl Modular {
                         component.impulse[i] += a * mu[j];
                     }
                     let range = component.offset..component.offset + component.part.unknowns();
-                    component.scale = component
-                        .part
-                        .assemble(&component.impulse, &x[range], block);
+                    component.scale =
+                        component
+                            .part
+                            .assemble(&component.impulse, share, &x[range], block);
                 };
                 match (blocks, parallel) {
                     (Some(blocks), true) => components
@@ -747,13 +781,13 @@ impl Modular {
                         .copy_from_slice(residual);
                     scale = scale.max(component.scale);
                 }
-                for (j, junction) in junctions.iter().enumerate() {
+                for junction in junctions {
                     let terms = junction.terms.iter().map(|&(c, i, a)| {
                         // The step's end point is a component's first unknowns (degree 1).
                         a * x[components[c].offset + i]
                     });
                     let (row, size) = terms.fold((0.0, 0.0), |(r, s), t: f64| (r + t, s + t.abs()));
-                    r[first + j] = row;
+                    r[first + junction.rank] = row;
                     scale = scale.max(size);
                 }
                 scale
@@ -808,11 +842,8 @@ impl Modular {
 
     /// The name of unknown `column` of a step (`first`: the junctions' first).
     fn unknown_name(&self, column: usize, first: usize) -> String {
-        if column >= first {
-            return format!(
-                "the multiplier of junction {}",
-                self.junctions[column - first].name
-            );
+        if let Some(junction) = self.junctions.iter().find(|j| first + j.rank == column) {
+            return format!("the multiplier of junction {}", junction.name);
         }
         let component = self
             .components
@@ -843,8 +874,9 @@ impl Modular {
             component.part.accept(t);
         }
         let first = run.unknowns.len() - self.junctions.len();
-        run.multipliers
-            .copy_from_slice(&run.unknowns.as_slice()[first..]);
+        for (multiplier, junction) in run.multipliers.iter_mut().zip(&self.junctions) {
+            *multiplier = run.unknowns[first + junction.rank];
+        }
         run.predictor.record(&run.unknowns);
         run.steps += 1;
         run.violation = violation;
@@ -979,7 +1011,7 @@ impl Modular {
             for &(c, i, a) in &junction.terms {
                 let term = effort * a * self.components[c].part.last_step(i);
                 work[c] += term;
-                scale = scale.max(term.abs());
+                scale += term.abs();
             }
         }
         Ok(PortWork {
@@ -996,6 +1028,12 @@ impl Modular {
 /// then back-substitution from the first column that has no pivot. Rows of a chain's junctions
 /// touch neighbours only, so the elimination costs `O(columns)` there.
 fn null_vector(rows: Vec<Vec<(usize, f64)>>, columns: usize) -> Option<Vec<usize>> {
+    // Exact zeros are no entries; a row without entries constrains nothing.
+    let rows: Vec<Vec<(usize, f64)>> = rows
+        .into_iter()
+        .map(|row| row.into_iter().filter(|e| e.1 != 0.0).collect::<Vec<_>>())
+        .filter(|row| !row.is_empty())
+        .collect();
     let scales: Vec<f64> = rows
         .iter()
         .map(|row| row.iter().fold(0.0, |m: f64, e| m.max(e.1.abs())))
@@ -1013,7 +1051,11 @@ fn null_vector(rows: Vec<Vec<(usize, f64)>>, columns: usize) -> Option<Vec<usize
     let mut used = vec![false; rows.len()];
     let mut pivots: Vec<usize> = Vec::with_capacity(columns);
     for k in 0..columns {
-        let relative = |r: usize| rows[r].get(&k).map_or(0.0, |v| v.abs() / scales[r]);
+        // A NaN (a form that is not finite) never makes a pivot.
+        let relative = |r: usize| {
+            let found = rows[r].get(&k).map_or(0.0, |v| v.abs() / scales[r]);
+            if found.is_nan() { 0.0 } else { found }
+        };
         let best = holding[k]
             .iter()
             .copied()
@@ -1243,6 +1285,8 @@ struct Degenerate {
     coordinates: Vec<usize>,
     /// Their momenta `∂L/∂v` (must be zero).
     momenta: Vec<(usize, f64)>,
+    /// One of them whose momentum depends on the position, if any.
+    turning: Option<usize>,
     /// The component's one-forms and holonomic differentials (rows over its coordinates).
     forms: DMatrix<f64>,
 }
@@ -1277,7 +1321,13 @@ trait Part: Send + std::fmt::Debug {
     fn unknowns_of_step(&self) -> &[f64];
     /// The residual at `x` with the junctions' impulse (into its own buffer), the Jacobian
     /// into `jacobian`; the size of the residual's terms.
-    fn assemble(&mut self, impulse: &[f64], x: &[f64], jacobian: Option<&mut DMatrix<f64>>) -> f64;
+    fn assemble(
+        &mut self,
+        impulse: &[f64],
+        share: f64,
+        x: &[f64],
+        jacobian: Option<&mut DMatrix<f64>>,
+    ) -> f64;
     fn residual(&self) -> &[f64];
     /// Proposes the state after the step solved by `x`; its constraint violation.
     fn advance(&mut self, x: &[f64], step: u64) -> Result<f64, DiracError>;
@@ -1397,7 +1447,9 @@ impl<S: DiracSystem<M> + Send, const M: usize> Part for Model<S, M> {
         let system = self.equations.discrete().system();
         let coordinates = degenerate(system, &q, &v);
         let p = crate::legendre::momentum(system, &q, &v);
+        let turning = EulerLagrange::<S, M, Euclidean>::turning(system, &q, &v, &coordinates);
         Degenerate {
+            turning,
             momenta: coordinates.iter().map(|&i| (i, p[i])).collect(),
             coordinates,
             forms: HiddenConstraints::forms(system, &q),
@@ -1433,10 +1485,16 @@ impl<S: DiracSystem<M> + Send, const M: usize> Part for Model<S, M> {
         self.x.as_slice()
     }
 
-    fn assemble(&mut self, impulse: &[f64], x: &[f64], jacobian: Option<&mut DMatrix<f64>>) -> f64 {
+    fn assemble(
+        &mut self,
+        impulse: &[f64],
+        share: f64,
+        x: &[f64],
+        jacobian: Option<&mut DMatrix<f64>>,
+    ) -> f64 {
         let state = *self.state();
         self.equations
-            .set_coupling(&SVector::from_column_slice(impulse));
+            .set_coupling(&SVector::from_column_slice(impulse), share);
         self.x.copy_from_slice(x);
         self.equations
             .assemble(&state, &self.x, &mut self.residual, jacobian)
@@ -1531,6 +1589,10 @@ mod tests {
         assert_eq!(null_vector(vec![vec![(0, 2.0)]], 2), Some(vec![1]));
         let swap = vec![vec![(1, 1.0)], vec![(0, 1.0), (1, 5.0)]];
         assert_eq!(null_vector(swap, 2), None);
+        // A row of zeros (a form that misses these columns) and a NaN pivot are no pivots.
+        let zeros = vec![vec![(0, 0.0), (1, 0.0)], vec![(0, 1.0)], vec![(1, 1.0)]];
+        assert_eq!(null_vector(zeros, 2), None);
+        assert_eq!(null_vector(vec![vec![(0, f64::NAN)]], 1), Some(vec![0]));
         // Dependent in a combination: x₀ + x₁ and 2x₀ + 2x₁ leave (1, −1).
         let twice = vec![vec![(0, 1.0), (1, 1.0)], vec![(0, 2.0), (1, 2.0)]];
         assert_eq!(null_vector(twice, 2), Some(vec![0, 1]));
