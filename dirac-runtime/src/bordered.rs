@@ -221,38 +221,35 @@ impl Jacobian for Bordered {
     }
 
     fn norm(&mut self) -> f64 {
+        // The largest row sum, NaN where a sum is (a NaN entry), as `row_sum_norm`.
+        let mut sums: Vec<f64> = std::mem::take(&mut self.coupling_sums);
+        sums.iter_mut().for_each(|s| *s = 0.0);
         let mut norm: f64 = 0.0;
-        self.coupling_sums.fill(0.0);
-        for (j, block) in self.diagonal.iter().zip(&mut self.blocks) {
-            // Row sums of [J_c E_c], column by column (the storage's order), in `scales`.
+        for (j, block) in self.diagonal.iter().zip(&self.blocks) {
             let n = j.nrows();
-            let sums = &mut block.scales[..n];
-            sums.fill(0.0);
-            for column in j.as_slice().chunks_exact(n.max(1)) {
-                for i in 0..n {
-                    sums[i] += column[i].abs();
+            let (a, e, g) = (j.as_slice(), block.e.as_slice(), block.g.as_slice());
+            let t = block.touching.len();
+            for i in 0..n {
+                let mut sum = 0.0;
+                for k in 0..n {
+                    sum += a[i + k * n].abs();
                 }
-            }
-            for column in block.e.as_slice().chunks_exact(n.max(1)) {
-                for i in 0..n {
-                    sums[i] += column[i].abs();
+                for c in 0..t {
+                    sum += e[i + c * n].abs();
                 }
+                norm = largest([norm, sum]);
             }
-            for &sum in sums.iter() {
-                // A NaN stays NaN.
-                norm = if sum > norm || sum.is_nan() || norm.is_nan() {
-                    if norm.is_nan() { norm } else { sum }
-                } else {
-                    norm
-                };
-            }
-            for (a, &coupling) in block.touching.iter().enumerate() {
-                for i in 0..n {
-                    self.coupling_sums[coupling] += block.g[(a, i)].abs();
+            for (c, &coupling) in block.touching.iter().enumerate() {
+                for k in 0..n {
+                    sums[coupling] += g[c + k * t].abs();
                 }
             }
         }
-        largest(std::iter::once(norm).chain(self.coupling_sums.iter().copied()))
+        for &sum in &sums {
+            norm = largest([norm, sum]);
+        }
+        self.coupling_sums = sums;
+        norm
     }
 
     fn is_finite(&self) -> bool {
