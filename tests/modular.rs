@@ -575,6 +575,14 @@ fn the_driven_motor_and_arm_by_parts_equal_the_monolithic_model() {
     );
 }
 
+/// A coordinate without energy or force: only junctions fix it.
+struct Wire;
+impl DiracSystem<1> for Wire {
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, _v: &SVector<D, 1>) -> D {
+        q[0] * 0.0
+    }
+}
+
 fn refused<T: std::fmt::Debug>(result: Result<T, DiracError>) -> DiracError {
     result.expect_err("refused")
 }
@@ -636,6 +644,22 @@ fn what_the_modular_step_cannot_do_is_refused() {
     let error = refused(parallel.start_from_velocity(&[1.0, 2.0, 3.0], &[0.5, 0.5, 1.0]));
     assert!(
         matches!(&error, DiracError::Unsupported(why) if why.contains("a.q, b.q") && why.contains("hidden constraints")),
+        "{error}"
+    );
+    // A component whose own step equations are singular (a wire: no energy, no force), though
+    // the junctions fix its current: the Schur complement needs each block regular.
+    let mut wired = lc_loop(0.1);
+    wired.add("wire", Wire).unwrap();
+    wired
+        .join(
+            Junction::new("through")
+                .flow("wire.q0", 1.0)
+                .flow("l.q", -1.0),
+        )
+        .unwrap();
+    let error = refused(wired.start_from_velocity(&[0.0, 0.0, 0.0], &[1.0, 1.0, 1.0]));
+    assert!(
+        matches!(&error, DiracError::Unsupported(why) if why.contains("wire: q0") && why.contains("monolithically")),
         "{error}"
     );
     // A step that fails leaves the state as it was.

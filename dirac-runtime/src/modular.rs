@@ -62,7 +62,7 @@ use crate::euler_lagrange::EulerLagrange;
 use crate::hidden_constraint::HiddenConstraints;
 use crate::interconnection::Junction;
 use crate::jacobian::Jacobian;
-use crate::newton::{Newton, NewtonOptions, NewtonReport, exceeds, largest};
+use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport, exceeds, largest};
 use crate::predictor::Predictor;
 use crate::quadrature::Quadrature;
 use crate::step_equations::{State, StepEquations};
@@ -587,7 +587,9 @@ impl Modular {
         for component in &mut self.components {
             component.part.discard();
         }
-        if let Err(error @ DiracError::SingularJacobian { .. }) = trial {
+        if let Err(error @ (DiracError::SingularJacobian { .. } | DiracError::Unsupported(_))) =
+            trial
+        {
             self.end_run();
             return Err(error);
         }
@@ -794,13 +796,26 @@ impl Modular {
             };
         let report = run.newton.solve(&mut run.unknowns, evaluate);
         let names = |column: usize| self.unknown_name(column, first);
-        let report = report.map_err(|failure| {
-            failure.into_error(
+        let report = report.map_err(|failure| match failure {
+            // A component's block singular on its own: the junctions may determine what its
+            // equations do not (a wire without energy), but the Schur complement needs it regular.
+            NewtonFailure::Singular(pivot) if pivot.column < first => {
+                let unknowns: Vec<String> = pivot.involved.iter().map(|&c| names(c)).collect();
+                DiracError::Unsupported(format!(
+                    "the modular step at step {}: a component's own step equations are singular \
+                     (the unknowns {} are not determined by its equations alone); each component \
+                     must determine its own step, given the junctions' impulses: step the \
+                     interconnection monolithically",
+                    run.steps,
+                    unknowns.join(", ")
+                ))
+            }
+            failure => failure.into_error(
                 "the modular discrete Euler–Lagrange equations",
                 run.steps,
                 &self.options,
                 names,
-            )
+            ),
         })?;
         let x = run.unknowns.as_slice();
         let advance = |component: &mut Component| {
