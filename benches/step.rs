@@ -437,6 +437,19 @@ fn interconnection(c: &mut Criterion) {
     group.finish();
 }
 
+/// Three angles coupled by cosines, with a position-dependent inertia, written by hand without
+/// closed forms: a component whose step takes hyper-dual Hessians.
+struct Angles;
+
+impl DiracSystem<3> for Angles {
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+        let kinetic = (0..3).fold(D::from(0.0), |sum, i| {
+            sum + v[i] * v[i] * (q[i].cos() * 0.1 + 1.0) * 0.5
+        });
+        kinetic + (q[0] - q[1]).cos() + (q[1] - q[2]).cos() + q[0].cos()
+    }
+}
+
 /// The modular step against the monolithic one on the same interconnections (h = 0.01,
 /// midpoint), and how it grows along an open chain of `K` tethered masses, one component after
 /// another and in parallel.
@@ -488,6 +501,35 @@ fn modular(c: &mut Criterion) {
         b.iter(|| black_box(parts.step()).expect("step"))
     });
     group.sample_size(20);
+    // Heavier components: three coupled angles each, differentiated by dual numbers (no closed
+    // forms), 1 000 of them in a chain, the last angle's rate of one the first's of the next.
+    let mut heavy = Modular::new(Quadrature::midpoint(), h).expect("valid rule");
+    let cells = 1000;
+    for j in 0..cells {
+        heavy.add(&format!("cell[{j}]"), Angles).expect("a name");
+    }
+    for j in 0..cells - 1 {
+        let joint = Junction::new(format!("joint{j}"))
+            .flow(format!("cell[{j}].q2"), 1.0)
+            .flow(format!("cell[{}].q0", j + 1), -1.0);
+        heavy.join(joint).expect("valid junction");
+    }
+    let q0: Vec<f64> = (0..3 * cells).map(|i| 0.1 * (i as f64 * 0.37).sin()).collect();
+    for parallel in [false, true] {
+        let mut chain = std::mem::replace(
+            &mut heavy,
+            Modular::new(Quadrature::midpoint(), h).expect("valid rule"),
+        )
+        .with_parallel(parallel);
+        chain
+            .start_from_velocity(&q0, &vec![0.0; 3 * cells])
+            .expect("consistent start");
+        let name = if parallel { "angles/parallel" } else { "angles/sequential" };
+        group.bench_with_input(BenchmarkId::new(name, cells), &cells, |b, _| {
+            b.iter(|| black_box(chain.step()).expect("step"))
+        });
+        heavy = chain;
+    }
     for cells in [10, 100, 1000, 10000] {
         // A wave along the open chain: masses at 0.1 sin(πj/K), each spring's end at the next.
         let x = |j: usize| 0.1 * (std::f64::consts::PI * j as f64 / cells as f64).sin();

@@ -69,10 +69,10 @@ use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
 
 /// Components, from this many on, are assembled and factorised in parallel by default. A
-/// parallel pass costs tens of microseconds here (threads waking), and a tethered mass's share
-/// of a step a fraction of one: on this 2-core machine the chain of 1 000 cells steps in 398 µs
-/// one after another and 700 µs in parallel, that of 10 000 cells in 7.8 ms and 6.2 ms
-/// (`cargo bench --bench step -- modular_step`).
+/// parallel pass costs tens of microseconds here (threads waking after the sequential parts),
+/// and a tethered mass's share of a step a fraction of one: on this 2-core machine the chain of
+/// 1 000 cells steps in 393–398 µs one after another and 700–824 µs in parallel, that of 10 000
+/// in 7.8–9.9 ms and 6.2–10.2 ms (two runs of `cargo bench --bench step -- modular_step`).
 const PARALLEL_FROM: usize = 5000;
 
 /// Components per parallel task.
