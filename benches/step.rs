@@ -514,7 +514,9 @@ fn modular(c: &mut Criterion) {
             .flow(format!("cell[{}].q0", j + 1), -1.0);
         heavy.join(joint).expect("valid junction");
     }
-    let q0: Vec<f64> = (0..3 * cells).map(|i| 0.1 * (i as f64 * 0.37).sin()).collect();
+    let q0: Vec<f64> = (0..3 * cells)
+        .map(|i| 0.1 * (i as f64 * 0.37).sin())
+        .collect();
     for parallel in [false, true] {
         let mut chain = std::mem::replace(
             &mut heavy,
@@ -524,7 +526,11 @@ fn modular(c: &mut Criterion) {
         chain
             .start_from_velocity(&q0, &vec![0.0; 3 * cells])
             .expect("consistent start");
-        let name = if parallel { "angles/parallel" } else { "angles/sequential" };
+        let name = if parallel {
+            "angles/parallel"
+        } else {
+            "angles/sequential"
+        };
         group.bench_with_input(BenchmarkId::new(name, cells), &cells, |b, _| {
             b.iter(|| black_box(chain.step()).expect("step"))
         });

@@ -11,6 +11,43 @@ use dirac::prelude::*;
 use scenes::components::{Capacitor, Inductor, MassSpring, Resistor};
 use scenes::{ladder, motor};
 
+/// Steps `parts` and `whole` side by side `steps` times, running `check` on the parts after each
+/// step: the largest difference of their positions, momenta and junction multipliers (those
+/// of the monolithic model from its multiplier `first_junction` on: after its components' own
+/// one-forms, before the holonomic constraints').
+fn lockstep<S: DiracSystem<N>, const N: usize>(
+    parts: &mut Modular,
+    whole: &mut Stepper<S, N>,
+    steps: usize,
+    first_junction: usize,
+    check: impl Fn(&Modular),
+) -> f64 {
+    let mut worst: f64 = 0.0;
+    for _ in 0..steps {
+        parts.step().unwrap();
+        whole.step().unwrap();
+        check(parts);
+        let theirs = &whole.multipliers()[first_junction..];
+        let multipliers = parts.multipliers().unwrap().iter().zip(theirs);
+        worst = multipliers.fold(worst, |w, (a, b)| w.max((a - b).abs()));
+        worst = worst
+            .max((parts.q() - DVector::from_column_slice(whole.q().as_slice())).amax())
+            .max((parts.p() - DVector::from_column_slice(whole.p().as_slice())).amax());
+    }
+    worst
+}
+
+/// The LC loop of [`lc_loop`] as one interconnection, stepped monolithically.
+fn lc_monolithic(h: f64) -> Stepper<Interconnection<Inductor, Capacitor, 1, 1, 2, 1>, 2> {
+    let whole = Interconnection::new(
+        ("l", Inductor { l: 1.3 }),
+        ("c", Capacitor { c: 0.7 }),
+        [Junction::new("series").flow("l.q", 1.0).flow("c.q", -1.0)],
+    )
+    .unwrap();
+    Stepper::new(whole, Quadrature::midpoint(), h).unwrap()
+}
+
 fn lc_loop(h: f64) -> Modular {
     let mut lc = Modular::new(Quadrature::midpoint(), h).unwrap();
     lc.add("l", Inductor { l: 1.3 }).unwrap();
@@ -27,14 +64,7 @@ fn lc_loop(h: f64) -> Modular {
 #[test]
 fn the_lc_loop_by_parts_equals_the_monolithic_loop() {
     let h = 0.05;
-    let mut parts = lc_loop(h);
-    let whole = Interconnection::new(
-        ("l", Inductor { l: 1.3 }),
-        ("c", Capacitor { c: 0.7 }),
-        [Junction::new("series").flow("l.q", 1.0).flow("c.q", -1.0)],
-    )
-    .unwrap();
-    let mut monolithic = Stepper::new(whole, Quadrature::midpoint(), h).unwrap();
+    let (mut parts, mut monolithic) = (lc_loop(h), lc_monolithic(h));
     let (q0, v0) = ([0.3, 0.3], [1.0, 1.0]);
     parts.start_from_velocity(&q0, &v0).unwrap();
     monolithic
@@ -83,16 +113,9 @@ fn the_ring_by_parts_equals_the_monolithic_ring() {
         .start_from_velocity(q0.as_slice(), v0.as_slice())
         .unwrap();
     assert_eq!(parts.coordinate_names(), monolithic.coordinate_names());
-    let mut worst: f64 = 0.0;
-    for _ in 0..400 {
-        parts.step().unwrap();
-        monolithic.step().unwrap();
-        let apart = (parts.q() - DVector::from_column_slice(monolithic.q().as_slice())).amax();
-        let multipliers = DVector::from_column_slice(parts.multipliers().unwrap());
-        let theirs = DVector::from_column_slice(monolithic.multipliers());
-        worst = worst.max(apart).max((multipliers - theirs).amax());
-        assert!(parts.constraint_violation().unwrap() < 1e-14);
-    }
+    let worst = lockstep(&mut parts, &mut monolithic, 400, 0, |parts| {
+        assert!(parts.constraint_violation().unwrap() < 1e-14)
+    });
     println!("ring: apart by {worst:e}");
     assert!(worst < 1e-12, "apart by {worst:e}");
     let q = SVector::<f64, { 2 * ladder::CELLS }>::from_column_slice(parts.q().as_slice());
@@ -115,14 +138,7 @@ fn the_ring_by_parts_equals_the_monolithic_ring() {
 #[test]
 fn each_components_energy_changes_by_its_port_work() {
     let h = 0.05;
-    let mut parts = lc_loop(h);
-    let whole = Interconnection::new(
-        ("l", Inductor { l: 1.3 }),
-        ("c", Capacitor { c: 0.7 }),
-        [Junction::new("series").flow("l.q", 1.0).flow("c.q", -1.0)],
-    )
-    .unwrap();
-    let mut monolithic = Stepper::new(whole, Quadrature::midpoint(), h).unwrap();
+    let (mut parts, mut monolithic) = (lc_loop(h), lc_monolithic(h));
     parts.start_from_velocity(&[0.3, 0.3], &[1.0, 1.0]).unwrap();
     monolithic
         .start_from_velocity(SVector::from([0.3, 0.3]), SVector::from([1.0, 1.0]))
@@ -321,15 +337,7 @@ fn the_junctions_take_the_constrained_components_constraint_point() {
     monolithic
         .start_from_velocity(SVector::from(q0), SVector::from(v0))
         .unwrap();
-    let mut worst: f64 = 0.0;
-    for _ in 0..400 {
-        parts.step().unwrap();
-        monolithic.step().unwrap();
-        worst = worst
-            .max((parts.q() - DVector::from_column_slice(monolithic.q().as_slice())).amax())
-            .max((parts.p() - DVector::from_column_slice(monolithic.p().as_slice())).amax())
-            .max((parts.multipliers().unwrap()[0] - monolithic.multipliers()[1]).abs());
-    }
+    let worst = lockstep(&mut parts, &mut monolithic, 400, 1, |_| ());
     let v = parts.velocities().unwrap();
     let apart = (v - DVector::from_column_slice(monolithic.v().unwrap().as_slice())).amax();
     println!("knife edge and mass: apart by {worst:e}, velocities {apart:e}");
@@ -383,15 +391,10 @@ fn a_component_with_its_own_holonomic_constraint_joins_by_parts() {
     monolithic
         .start_from_velocity(SVector::from(q0), SVector::from(v0))
         .unwrap();
-    let mut worst: f64 = 0.0;
-    for _ in 0..300 {
-        parts.step().unwrap();
-        monolithic.step().unwrap();
-        worst = worst
-            .max((parts.q() - DVector::from_column_slice(monolithic.q().as_slice())).amax())
-            .max((parts.p() - DVector::from_column_slice(monolithic.p().as_slice())).amax());
-        assert!(parts.constraint_violation().unwrap() < 1e-12);
-    }
+    // The monolithic model's multipliers: the junction (a one-form), then the bob's λ.
+    let worst = lockstep(&mut parts, &mut monolithic, 300, 0, |parts| {
+        assert!(parts.constraint_violation().unwrap() < 1e-12)
+    });
     let v = parts.velocities().unwrap();
     let apart = (v - DVector::from_column_slice(monolithic.v().unwrap().as_slice())).amax();
     println!("bob and cart: apart by {worst:e}, velocities {apart:e}");
@@ -504,13 +507,7 @@ fn the_rlc_by_parts_equals_the_monolithic_rlc() {
     monolithic
         .start_from_velocity(SVector::from(q0), SVector::zeros())
         .unwrap();
-    let mut worst: f64 = 0.0;
-    for _ in 0..500 {
-        parts.step().unwrap();
-        monolithic.step().unwrap();
-        worst =
-            worst.max((parts.q() - DVector::from_column_slice(monolithic.q().as_slice())).amax());
-    }
+    let worst = lockstep(&mut parts, &mut monolithic, 500, 0, |_| ());
     println!("RLC: apart by {worst:e}");
     assert!(worst < 1e-12, "apart by {worst:e}");
     let t = parts.t();
@@ -559,14 +556,7 @@ fn the_driven_motor_and_arm_by_parts_equal_the_monolithic_model() {
         DiracError::NonFinite { .. }
     ));
     parts.set_input("motor.u", motor::U).unwrap();
-    let mut worst: f64 = 0.0;
-    for _ in 0..1000 {
-        parts.step().unwrap();
-        monolithic.step().unwrap();
-        worst = worst
-            .max((parts.q() - DVector::from_column_slice(monolithic.q().as_slice())).amax())
-            .max((parts.p() - DVector::from_column_slice(monolithic.p().as_slice())).amax());
-    }
+    let worst = lockstep(&mut parts, &mut monolithic, 1000, 0, |_| ());
     println!("motor and arm: apart by {worst:e}");
     assert!(worst < 1e-12, "apart by {worst:e}");
     assert!(
