@@ -3,6 +3,7 @@
 //! neighbours in a chain or a ladder. `m` unknowns with `b` diagonals on each side cost
 //! `O(m b²)` to factorise and `O(m b)` to solve.
 
+use crate::error::DiracError;
 use crate::jacobian::Jacobian;
 use crate::lu::SingularPivot;
 use crate::newton::largest;
@@ -32,6 +33,27 @@ impl Banded {
             pivots: vec![0; m],
             scales: vec![0.0; m],
         }
+    }
+
+    /// [`new`](Self::new), refused with `Unsupported` where its storage would pass 2²⁶ numbers
+    /// (512 MB): a band as wide as the matrix (a junction between distant components, a ring's
+    /// closing junction), for which `what` (the solve it is for) would not fit.
+    pub fn within_memory(
+        m: usize,
+        lower: usize,
+        upper: usize,
+        what: &str,
+    ) -> Result<Self, DiracError> {
+        let entries = (2 * lower + upper + 1).checked_mul(m);
+        if entries.is_none_or(|n| n > 1 << 26) {
+            return Err(DiracError::Unsupported(format!(
+                "{what} as a band of {m} rows and half-widths {lower}, {upper} (more than 2^26 \
+                 numbers): a junction joins components far apart in their order (a ring's \
+                 closing junction); order the components so that joined ones are near, or step \
+                 the interconnection monolithically"
+            )));
+        }
+        Ok(Self::new(m, lower, upper))
     }
 
     fn width(&self) -> usize {
@@ -80,7 +102,7 @@ impl Banded {
             if best <= tolerance * self.scales[p] || !best.is_finite() {
                 return Err(SingularPivot {
                     column: k,
-                    involved: vec![k],
+                    involved: self.null_vector_support(k),
                 });
             }
             let end = (k + upper + lower).min(m - 1);
@@ -105,6 +127,22 @@ impl Banded {
             }
         }
         Ok(())
+    }
+
+    /// After elimination stopped at column `k`, column `k` is a combination of columns `0..k`:
+    /// `x = (−U₀₀⁻¹ u, 1, 0, …)` solves `A x = 0` there. The indices where `x` is not small.
+    fn null_vector_support(&self, k: usize) -> Vec<usize> {
+        let mut x = vec![0.0; k + 1];
+        x[k] = 1.0;
+        for i in (0..k).rev() {
+            let end = (i + self.upper + self.lower).min(k);
+            let s: f64 = (i + 1..=end)
+                .map(|j| self.data[self.index(i, j)] * x[j])
+                .sum();
+            x[i] = -s / self.data[self.index(i, i)];
+        }
+        let largest = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        (0..=k).filter(|&i| x[i].abs() > 1e-8 * largest).collect()
     }
 
     /// Solves `A x = b` in place of `b` with the factors.
@@ -227,6 +265,7 @@ mod tests {
         ] {
             band.add(i, j, v);
         }
-        assert_eq!(band.factorise(1e-13).unwrap_err().column, 1);
+        let singular = band.factorise(1e-13).unwrap_err();
+        assert_eq!((singular.column, singular.involved), (1, vec![0, 1]));
     }
 }

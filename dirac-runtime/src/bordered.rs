@@ -80,7 +80,9 @@ impl Bordered {
     /// value)` of `E_c` and `columns[c]` the entries `(coupling, column of block c, value)` of
     /// `G_c`. The couplings are the unknowns after the blocks' (as many as the largest coupling
     /// named, plus one). `Err(Dimension)` where the lists are not one per block, an entry lies
-    /// outside its block, or a coupling touches no block (its Schur row would be zero).
+    /// outside its block, or a coupling has no entry in any `E` or in any `G` (its Schur column
+    /// or row would be zero); `Unsupported` where the Schur complement's band would not fit in
+    /// memory (a coupling of blocks far apart in their order).
     pub fn new(
         sizes: &[usize],
         rows: &[Vec<(usize, usize, f64)>],
@@ -146,20 +148,28 @@ impl Bordered {
                 block
             })
             .collect();
-        let mut touched = vec![false; couplings];
-        blocks
-            .iter()
-            .flat_map(|b| &b.touching)
-            .for_each(|&j| touched[j] = true);
-        if let Some(j) = touched.iter().position(|t| !t) {
-            return invalid(format!("coupling {j} touches no block"));
+        // Every coupling needs entries in some E (its column) and some G (its row).
+        let (mut in_e, mut in_g) = (vec![false; couplings], vec![false; couplings]);
+        rows.iter().flatten().for_each(|e| in_e[e.1] = true);
+        columns.iter().flatten().for_each(|g| in_g[g.0] = true);
+        if let Some(j) = (0..couplings).find(|&j| !(in_e[j] && in_g[j])) {
+            return invalid(format!(
+                "coupling {j} has no entry in any block's {}: its Schur row or column would be \
+                 zero",
+                if in_e[j] { "G" } else { "E" }
+            ));
         }
         Ok(Self {
             diagonal: sizes.iter().map(|&n| DMatrix::zeros(n, n)).collect(),
             blocks,
             couplings,
             size: offset + couplings,
-            schur: Banded::new(couplings, spread, spread),
+            schur: Banded::within_memory(
+                couplings,
+                spread,
+                spread,
+                "the junctions' Schur complement",
+            )?,
             coupling_sums: vec![0.0; couplings],
             grain: usize::MAX,
         })
@@ -307,7 +317,7 @@ impl Jacobian for Bordered {
         let first = self.first_coupling();
         self.schur.factorise(tolerance).map_err(|p| SingularPivot {
             column: first + p.column,
-            involved: vec![first + p.column],
+            involved: p.involved.iter().map(|j| first + j).collect(),
         })
     }
 
@@ -419,6 +429,19 @@ mod tests {
             dense.solve(y.as_mut_slice());
             assert!((&x - &y).amax() < 1e-13 * y.amax(), "k {k}, n {n}");
         }
+    }
+
+    #[test]
+    fn malformed_borders_are_refused() {
+        let one = vec![(0, 0, 1.0)];
+        let twice = [one.clone(), one.clone()];
+        assert!(Bordered::new(&[1, 1], std::slice::from_ref(&one), &twice).is_err());
+        // A row index outside its block; a coupling without a G entry.
+        assert!(Bordered::new(&[1], &[vec![(1, 0, 1.0)]], std::slice::from_ref(&one)).is_err());
+        assert!(Bordered::new(&[1], std::slice::from_ref(&one), &[Vec::new()]).is_err());
+        assert!(
+            Bordered::new(&[1], std::slice::from_ref(&one), std::slice::from_ref(&one)).is_ok()
+        );
     }
 
     #[test]

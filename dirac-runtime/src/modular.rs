@@ -15,8 +15,8 @@
 //! and `p_{k+1}^c` gains `(1 − σ) Σ_j μ_j a_j^c`: exactly the monolithic equations. Newton's
 //! method solves them with a [`Bordered`] Jacobian: each `∂R_c/∂x_c` is factorised on its own
 //! and the junctions' Schur complement, a band matrix along a chain, couples them, so a chain
-//! of `K` components costs `O(K)` per step. The components are assembled and factorised in
-//! parallel (rayon) when there are many ([`Modular::with_parallel`]).
+//! of `K` components costs `O(K)` per step. The components can be assembled and factorised in
+//! parallel (rayon, [`Modular::with_parallel`]).
 //!
 //! ```
 //! use dirac_runtime::modular::Modular;
@@ -68,12 +68,12 @@ use crate::quadrature::Quadrature;
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
 
-/// Components, from this many on, are assembled and factorised in parallel by default. A
-/// parallel pass costs tens of microseconds here (threads waking after the sequential parts),
-/// and a tethered mass's share of a step a fraction of one: on this 2-core machine the chain of
-/// 1 000 cells steps in 393–398 µs one after another and 700–824 µs in parallel, that of 10 000
-/// in 7.8–9.9 ms and 6.2–10.2 ms (two runs of `cargo bench --bench step -- modular_step`).
-const PARALLEL_FROM: usize = 5000;
+/// Components are stepped one after another unless asked: a parallel pass costs tens of
+/// microseconds here (threads waking after the sequential parts), and on this 2-core machine the
+/// chain of 1 000 tethered cells steps in 393–398 µs one after another and 700–824 µs in
+/// parallel, that of 10 000 in 7.8–9.9 ms and 6.2–10.2 ms, and 1 000 heavier cells (three
+/// angles by dual numbers) in 1.11 ms and 1.19 ms (two runs of
+/// `cargo bench --bench step -- modular_step`): the evidence for a default is mixed.
 
 /// Components per parallel task.
 const GRAIN: usize = 32;
@@ -210,9 +210,11 @@ impl Modular {
         Ok(self)
     }
 
-    /// Whether the components are assembled and factorised in parallel (by default, from
-    /// 5 000 components on: below, the threads' hand-offs cost more than the components' work
-    /// on a 2-core machine). The steps are the same bit for bit.
+    /// Whether the components are assembled, factorised, solved and advanced in parallel
+    /// (rayon); by default not. The steps are the same bit for bit. On a 2-core machine it paid
+    /// 1.26× once on 10 000 tethered masses and nothing in another run, and cost more below
+    /// thousands of components (see the README's cost table): each step makes about seven
+    /// parallel passes, and a pass costs tens of microseconds.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = Some(parallel);
         self.end_run();
@@ -377,6 +379,7 @@ impl Modular {
         }
         for mut junction in other.junctions {
             junction.name = format!("{prefix}{}", junction.name);
+            junction.rank = self.junctions.len();
             junction.terms.iter_mut().for_each(|t| t.0 += base);
             self.junction_names.insert(junction.name.clone());
             self.junctions.push(junction);
@@ -398,7 +401,12 @@ impl Modular {
         }
         // What there is, said only when a coordinate is unknown.
         let known = |coordinate: &str| {
-            let instance = coordinate.split('.').next().unwrap_or_default();
+            // The longest instance the name begins with (an included one's are dotted).
+            let instance = coordinate
+                .rmatch_indices('.')
+                .map(|(k, _)| &coordinate[..k])
+                .find(|prefix| self.instances.contains_key(*prefix))
+                .unwrap_or_else(|| coordinate.split('.').next().unwrap_or_default());
             match self.instances.get(instance) {
                 Some(&c) => {
                     let part = &self.components[c].part;
@@ -465,10 +473,12 @@ impl Modular {
     /// Sets the input named `instance.input` (e.g. a voltage source's `drive.u`) from the
     /// next step on; `UnknownInput` lists the inputs there are, `NonFinite` refuses a value.
     pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), DiracError> {
-        let found = name.rsplit_once('.').and_then(|(instance, input)| {
-            let c = *self.instances.get(instance)?;
+        // The instance is a prefix up to some dot: a component's own input names may carry
+        // dots too (an `Interconnection` component's `source.u`).
+        let found = name.match_indices('.').find_map(|(k, _)| {
+            let c = *self.instances.get(&name[..k])?;
             let part = &self.components[c].part;
-            let i = (0..part.inputs()).find(|&i| part.input_name(i) == input)?;
+            let i = (0..part.inputs()).find(|&i| part.input_name(i) == name[k + 1..])?;
             Some((c, i))
         });
         let Some((c, i)) = found else {
@@ -553,11 +563,12 @@ impl Modular {
             component.couplings.clear();
         }
         // The junctions' multipliers in the order of the components they join (the first, then
-        // the last), whatever order they were joined in: the Schur complement's band is then as
-        // narrow as the interconnection's shape allows.
+        // the last, then the name), whatever order they were joined in: along a chain or a
+        // ladder the Schur complement is then a narrow band (a junction between distant
+        // components still widens it to their distance).
         let span = |j: &Coupling| {
             let components = j.terms.iter().map(|t| t.0);
-            (components.clone().min(), components.max())
+            (components.clone().min(), components.max(), j.name.clone())
         };
         let mut order: Vec<usize> = (0..self.junctions.len()).collect();
         order.sort_by_key(|&j| span(&self.junctions[j]));
@@ -569,7 +580,13 @@ impl Modular {
                 self.components[c].couplings.push((junction.rank, i, a));
             }
         }
-        let jacobian = self.bordered()?;
+        let jacobian = match self.bordered() {
+            Ok(jacobian) => jacobian,
+            Err(error) => {
+                self.end_run();
+                return Err(error);
+            }
+        };
         let unknowns = jacobian.size();
         let mut run = Box::new(Running {
             newton: Newton::with_jacobian(jacobian, self.options)?,
@@ -583,7 +600,7 @@ impl Modular {
         });
         // A model the step does not determine (dependent junctions, a component singular on
         // its own) is refused here, before the first step, naming the unknowns.
-        let trial = self.solve(&mut run);
+        let trial = self.solve(&mut run, true);
         for component in &mut self.components {
             component.part.discard();
         }
@@ -606,8 +623,7 @@ impl Modular {
 
     /// Whether the components are stepped in parallel.
     fn parallel(&self) -> bool {
-        self.parallel
-            .unwrap_or(self.components.len() >= PARALLEL_FROM)
+        self.parallel.unwrap_or(false)
     }
 
     /// Where the junctions' impulses are held: the constrained components' constraint point
@@ -666,10 +682,16 @@ impl Modular {
         for (c, component) in self.components.iter().enumerate() {
             let range = component.first..component.first + component.part.coordinates();
             let found = component.part.degenerate(&q[range.clone()], &v[range]);
-            let turning = found.turning.map(|i| (i, f64::NAN));
-            if let Some((i, momentum)) =
-                turning.or(found.momenta.iter().copied().find(|(_, p)| *p != 0.0))
-            {
+            if let Some(i) = found.turning {
+                return Err(DiracError::Unsupported(format!(
+                    "the modular step on {}.{}, whose Lagrangian is linear in its velocity with \
+                     a momentum ∂L/∂v that depends on the position (first-order rows are \
+                     collocated only in a model stepped on its own)",
+                    component.name,
+                    component.part.coordinate_name(i)
+                )));
+            }
+            if let Some(&(i, momentum)) = found.momenta.iter().find(|(_, p)| *p != 0.0) {
                 return Err(DiracError::Unsupported(format!(
                     "the modular step on {}.{}, whose Lagrangian is linear in its velocity with \
                      the momentum {momentum} (first-order rows are collocated only in a \
@@ -719,7 +741,9 @@ impl Modular {
 
     /// Solves the next step from the components' states into `run`'s unknowns and lets each
     /// component propose its next state (the states themselves do not change).
-    fn solve(&mut self, run: &mut Running) -> Result<(NewtonReport, f64), DiracError> {
+    /// `trial`: the start's trial step, where a component singular on its own is refused as
+    /// `Unsupported` (a later step reports a singular block as `SingularJacobian`).
+    fn solve(&mut self, run: &mut Running, trial: bool) -> Result<(NewtonReport, f64), DiracError> {
         let first = run.unknowns.len() - self.junctions.len();
         let previous = run.predictor.predict();
         let parallel = self.parallel();
@@ -799,14 +823,13 @@ impl Modular {
         let report = report.map_err(|failure| match failure {
             // A component's block singular on its own: the junctions may determine what its
             // equations do not (a wire without energy), but the Schur complement needs it regular.
-            NewtonFailure::Singular(pivot) if pivot.column < first => {
+            NewtonFailure::Singular(pivot) if trial && pivot.column < first => {
                 let unknowns: Vec<String> = pivot.involved.iter().map(|&c| names(c)).collect();
                 DiracError::Unsupported(format!(
-                    "the modular step at step {}: a component's own step equations are singular \
-                     (the unknowns {} are not determined by its equations alone); each component \
-                     must determine its own step, given the junctions' impulses: step the \
-                     interconnection monolithically",
-                    run.steps,
+                    "the modular step: a component's own step equations are singular at the \
+                     start (the unknowns {} are not determined by its equations alone); each \
+                     component must determine its own step, given the junctions' impulses: step \
+                     the interconnection monolithically",
                     unknowns.join(", ")
                 ))
             }
@@ -876,7 +899,7 @@ impl Modular {
     /// Advances one step. On error nothing changes.
     pub fn step(&mut self) -> Result<(), DiracError> {
         let mut run = self.run.take().ok_or(DiracError::NotStarted)?;
-        let solved = self.solve(&mut run);
+        let solved = self.solve(&mut run, false);
         let (report, violation) = match solved {
             Ok(solved) => solved,
             Err(error) => {
@@ -971,7 +994,7 @@ impl Modular {
     pub fn velocities(&self) -> Result<DVector<f64>, DiracError> {
         let run = self.running()?;
         let layout = VelocityLayout::of(&self.components, &self.junctions);
-        let mut newton = Newton::with_jacobian(layout.band(), self.options)?;
+        let mut newton = Newton::with_jacobian(layout.band()?, self.options)?;
         let mut x = DVector::zeros(layout.size);
         for (component, &at) in self.components.iter().zip(&layout.components) {
             let guess = component.part.velocity_hint();
@@ -1164,6 +1187,9 @@ impl VelocityLayout {
                 .expect("a junction has terms");
             last[c].push(j);
         }
+        // Beside each component, its junctions in the order of their multipliers.
+        last.iter_mut()
+            .for_each(|theirs| theirs.sort_by_key(|&j| junctions[j].rank));
         let (mut at, mut starts, mut places) = (0, Vec::new(), vec![0; junctions.len()]);
         for (component, theirs) in components.iter().zip(&last) {
             starts.push(at);
@@ -1196,8 +1222,8 @@ impl VelocityLayout {
         layout
     }
 
-    fn band(&self) -> Banded {
-        Banded::new(self.size, self.lower, self.upper)
+    fn band(&self) -> Result<Banded, DiracError> {
+        Banded::within_memory(self.size, self.lower, self.upper, "the velocity solve")
     }
 
     /// The residual at `x` into `r` and, when asked, the Jacobian into `band`; the size of the
