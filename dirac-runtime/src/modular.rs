@@ -68,13 +68,6 @@ use crate::quadrature::Quadrature;
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
 
-/// Components are stepped one after another unless asked: a parallel pass costs tens of
-/// microseconds here (threads waking after the sequential parts), and on this 2-core machine the
-/// chain of 1 000 tethered cells steps in 393–398 µs one after another and 700–824 µs in
-/// parallel, that of 10 000 in 7.8–9.9 ms and 6.2–10.2 ms, and 1 000 heavier cells (three
-/// angles by dual numbers) in 1.11 ms and 1.19 ms (two runs of
-/// `cargo bench --bench step -- modular_step`): the evidence for a default is mixed.
-
 /// Components per parallel task.
 const GRAIN: usize = 32;
 
