@@ -132,7 +132,6 @@ struct Running {
     newton: Newton<Bordered>,
     unknowns: DVector<f64>,
     predictor: Predictor,
-    start: f64,
     steps: u64,
     /// The junctions' multipliers (impulses) of the last step.
     multipliers: Vec<f64>,
@@ -585,7 +584,6 @@ impl Modular {
             newton: Newton::with_jacobian(jacobian, self.options)?,
             unknowns: DVector::zeros(unknowns),
             predictor: Predictor::new(unknowns),
-            start: 0.0,
             steps: 0,
             multipliers: vec![0.0; self.junctions.len()],
             violation: 0.0,
@@ -654,7 +652,7 @@ impl Modular {
                 .terms
                 .iter()
                 .map(|&(c, i, a)| a * v[self.components[c].first + i]);
-            let (rate, size) = terms.fold((0.0, 0.0), |(r, s), t: f64| (r + t, s + t.abs()));
+            let (rate, size) = sum_and_size(terms);
             if exceeds(rate.abs(), tolerance * size) {
                 return Err(DiracError::InconsistentInitialState(format!(
                     "the initial velocity violates junction {}: a·v = {rate:.3e}",
@@ -805,7 +803,7 @@ impl Modular {
                         // The step's end point is a component's first unknowns (degree 1).
                         a * x[components[c].offset + i]
                     });
-                    let (row, size) = terms.fold((0.0, 0.0), |(r, s), t: f64| (r + t, s + t.abs()));
+                    let (row, size) = sum_and_size(terms);
                     r[first + junction.rank] = row;
                     scale = scale.max(size);
                 }
@@ -900,7 +898,7 @@ impl Modular {
                 return Err(error);
             }
         };
-        let t = run.start + (run.steps + 1) as f64 * self.h;
+        let t = (run.steps + 1) as f64 * self.h;
         for component in &mut self.components {
             component.part.accept(t);
         }
@@ -929,7 +927,7 @@ impl Modular {
     pub fn t(&self) -> f64 {
         self.run
             .as_ref()
-            .map_or(0.0, |run| run.start + run.steps as f64 * self.h)
+            .map_or(0.0, |run| run.steps as f64 * self.h)
     }
 
     /// The steps taken since the start.
@@ -1127,6 +1125,11 @@ fn null_vector(rows: Vec<Vec<(usize, f64)>>, columns: usize) -> Option<Vec<usize
     None
 }
 
+/// `Σ t` over `terms` and the size of what it sums, `Σ |t|` (a residual row and its scale).
+fn sum_and_size(terms: impl Iterator<Item = f64>) -> (f64, f64) {
+    terms.fold((0.0, 0.0), |(sum, size), t| (sum + t, size + t.abs()))
+}
+
 /// The larger of two violations (NaN wins), or the error of the first component of two that
 /// failed.
 fn worse(
@@ -1243,7 +1246,7 @@ impl VelocityLayout {
             }
             for a in 0..m {
                 let terms = (0..n).map(|k| rows.forms[(a, k)] * x[at + k]);
-                let (row, size) = terms.fold((0.0, 0.0), |(r, s), t: f64| (r + t, s + t.abs()));
+                let (row, size) = sum_and_size(terms);
                 r[at + n + a] = row;
                 scale = scale.max(size);
             }
