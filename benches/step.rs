@@ -482,6 +482,34 @@ fn modular(c: &mut Criterion) {
     group.bench_function("lc_loop/modular", |b| {
         b.iter(|| black_box(parts.step()).expect("step"))
     });
+    // The seed's LC circuit from its two subcircuits (unequal capacitors): monolithically, and
+    // by parts with its hidden constraint across the components held at every step's end.
+    let seed = scenes::circuit::LcCircuit {
+        l: 1.0,
+        c1: 1.0,
+        c2: 1.0,
+        c3: 2.0,
+    };
+    let (q0, v0) = ([0.0, 1.0, 0.2, 0.4], [0.5, 0.5, 0.5 / 3.0, 1.0 / 3.0]);
+    let mut whole = Stepper::new(
+        scenes::circuit::lc_from_subcircuits(&seed).expect("valid circuit"),
+        Quadrature::midpoint(),
+        h,
+    )
+    .expect("valid scene");
+    whole
+        .start_from_velocity(SVector::from(q0), SVector::from(v0))
+        .expect("consistent start");
+    group.bench_function("seed_lc/monolithic", |b| {
+        b.iter(|| black_box(whole.step()).expect("step"))
+    });
+    let mut parts = scenes::circuit::lc_by_parts(&seed, h).expect("valid circuit");
+    parts
+        .start_from_velocity(&q0, &v0)
+        .expect("consistent start");
+    group.bench_function("seed_lc/modular", |b| {
+        b.iter(|| black_box(parts.step()).expect("step"))
+    });
     let (q0, v0) = ladder::chain_wave(3, 0.5);
     let mut ring = Stepper::new(
         ladder::chain(1.0, 1.0).expect("valid ring"),

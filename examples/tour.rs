@@ -45,6 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     reports.push(circuit::driven_report()?);
     reports.push(circuit::subcircuits_report()?);
+    reports.push(circuit::by_parts_report()?);
     reports.push(scenes::port::components_report()?);
     reports.push(scenes::ladder::report()?);
     reports.push(scenes::ladder::modular_report()?);

@@ -359,7 +359,7 @@ impl HiddenConstraints {
     }
 
     /// Moves `q` along the free directions until `c(q) = 0` to round-off: Newton's method with
-    /// the minimal-norm update. `v`, `t` and the inputs are those of the node.
+    /// the minimal-norm update ([`hold`]). `v`, `t` and the inputs are those of the node.
     pub fn project<S: DiracSystem<N>, const N: usize>(
         &self,
         system: &S,
@@ -371,40 +371,15 @@ impl HiddenConstraints {
         if self.count == 0 {
             return Ok(());
         }
-        let mut last = f64::INFINITY;
-        let settled = |residual: f64, scale: f64, last: f64| {
-            if !residual.is_finite() {
-                return Err("a hidden constraint is not finite at the step's end".to_string());
-            }
-            Ok(residual <= ROUND_OFF * scale || residual >= 0.5 * last)
-        };
-        for _ in 0..MAX_ITERATIONS {
-            // Where G is fixed, c alone first: a step that holds c to round-off (a circuit's,
-            // whose hidden constraints are linear) is accepted without the differential.
-            if let Some((residual, scale)) = self.fixed_residual(system, q, v, t, inputs)
-                && settled(residual, scale, last)?
-            {
-                return self.accept(residual, scale);
-            }
-            let e = self.evaluate(system, q, v, t, inputs)?;
-            let residual = largest(e.value.iter().copied());
-            if settled(residual, e.scale, last)? {
-                return self.accept(residual, e.scale);
-            }
-            last = residual;
-            let reduced = &e.differential * &e.free;
-            // nalgebra's SVD does not return on a matrix with an entry that is not finite.
-            if !reduced.iter().all(|x| x.is_finite()) {
-                return Err("the hidden constraints' differential is not finite".into());
-            }
-            let svd = reduced.svd(true, true);
-            let cutoff = 1e-12 * svd.singular_values.amax();
-            let alpha = svd.solve(&(-&e.value), cutoff).map_err(|m| m.to_string())?;
-            let step = &e.free * alpha;
-            *q += SVector::<f64, N>::from_fn(|i, _| step[i]);
-        }
-        let e = self.evaluate(system, q, v, t, inputs)?;
-        self.accept(largest(e.value.iter().copied()), e.scale)
+        hold(&mut Node {
+            hidden: self,
+            system,
+            q,
+            v,
+            t,
+            inputs,
+            free: DMatrix::zeros(0, 0),
+        })
     }
 
     /// `max_k |c_k(q)|` and the size of the terms summed into `c`, as [`evaluate`](Self::evaluate)
@@ -433,22 +408,158 @@ impl HiddenConstraints {
         }));
         Some((residual, scale))
     }
+}
 
-    fn accept(&self, residual: f64, scale: f64) -> Result<(), String> {
-        if residual <= TOLERANCE * scale.max(f64::MIN_POSITIVE) {
-            Ok(())
-        } else {
-            Err(format!(
-                "the hidden constraints could not be held at the step's end (residual \
-                 {residual:.3e}, terms of size {scale:.3e})"
-            ))
+/// The Euler–Lagrange rows of the coordinates `dead` without their multipliers, `R_D(q, v, t)`
+/// (see the [module](self) documentation), and the size of their terms; with `jacobians`, also
+/// their Jacobians in `q` (without the third derivatives of `L`) and in `v` (rows over `dead`,
+/// columns over all coordinates; else empty).
+pub(crate) fn degenerate_rows<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    dead: &[usize],
+    (q, v, t): (&SVector<f64, N>, &SVector<f64, N>, f64),
+    inputs: &[f64],
+    jacobians: bool,
+) -> Rows {
+    let these = HiddenConstraints {
+        dead: dead.to_vec(),
+        ..HiddenConstraints::none()
+    };
+    if jacobians {
+        let (value, by_v, by_q, scale) = these.rows(system, q, v, t, inputs);
+        Rows {
+            value,
+            by_q,
+            by_v,
+            scale,
         }
+    } else {
+        let (all, scale) = these.rows_at(system, q, v, t, inputs);
+        Rows {
+            value: DVector::from_iterator(dead.len(), all.iter().take(dead.len()).copied()),
+            by_q: DMatrix::zeros(0, 0),
+            by_v: DMatrix::zeros(0, 0),
+            scale,
+        }
+    }
+}
+
+/// What [`degenerate_rows`] finds.
+#[derive(Debug, Clone)]
+pub(crate) struct Rows {
+    pub value: DVector<f64>,
+    pub by_q: DMatrix<f64>,
+    pub by_v: DMatrix<f64>,
+    pub scale: f64,
+}
+
+/// Hidden constraints `c(q) = 0` held by moving `q` along free directions `Z`: what [`hold`]
+/// reads and moves. A model's own ([`HiddenConstraints::project`]) and an interconnection's
+/// across its components (the modular step) are held alike.
+pub(crate) trait Projection {
+    /// `max_k |c_k(q)|` and the size of the terms summed into `c`, where that costs less than
+    /// a [`linearise`](Self::linearise) (else `None`).
+    fn residual(&mut self) -> Result<Option<(f64, f64)>, String> {
+        Ok(None)
+    }
+    /// `c(q)`, its differential along the free directions `dc(q) Z` (rows: constraints,
+    /// columns: directions) and the size of the terms summed into `c`.
+    fn linearise(&mut self) -> Result<(DVector<f64>, DMatrix<f64>, f64), String>;
+    /// Moves `q` by `Z α`.
+    fn shift(&mut self, alpha: &DVector<f64>);
+}
+
+/// Newton's method on `c(q + Z α) = 0` with the minimal-norm update (singular values below
+/// `1e-12` of the largest count as zero). It stops on a residual at round-off of its terms or
+/// one that no longer halves, and accepts a residual within [`TOLERANCE`] of its terms; `Err`
+/// says why not (a residual that is not finite, or too large).
+pub(crate) fn hold(projection: &mut impl Projection) -> Result<(), String> {
+    let mut last = f64::INFINITY;
+    let settled = |residual: f64, scale: f64, last: f64| {
+        if !residual.is_finite() {
+            return Err("a hidden constraint is not finite at the step's end".to_string());
+        }
+        Ok(residual <= ROUND_OFF * scale || residual >= 0.5 * last)
+    };
+    for _ in 0..MAX_ITERATIONS {
+        // c alone first where that is cheaper: a step that holds c to round-off (a circuit's,
+        // whose hidden constraints are linear) is accepted without the differential.
+        if let Some((residual, scale)) = projection.residual()?
+            && settled(residual, scale, last)?
+        {
+            return accept(residual, scale);
+        }
+        let (value, reduced, scale) = projection.linearise()?;
+        let residual = largest(value.iter().copied());
+        if settled(residual, scale, last)? {
+            return accept(residual, scale);
+        }
+        last = residual;
+        // nalgebra's SVD does not return on a matrix with an entry that is not finite.
+        if !reduced.iter().all(|x| x.is_finite()) {
+            return Err("the hidden constraints' differential is not finite".into());
+        }
+        let svd = reduced.svd(true, true);
+        let cutoff = 1e-12 * svd.singular_values.amax();
+        let alpha = svd.solve(&(-&value), cutoff).map_err(|m| m.to_string())?;
+        projection.shift(&alpha);
+    }
+    let (value, _, scale) = projection.linearise()?;
+    accept(largest(value.iter().copied()), scale)
+}
+
+/// A residual within [`TOLERANCE`] of its terms, or why not.
+fn accept(residual: f64, scale: f64) -> Result<(), String> {
+    if residual <= TOLERANCE * scale.max(f64::MIN_POSITIVE) {
+        Ok(())
+    } else {
+        Err(format!(
+            "the hidden constraints could not be held at the step's end (residual \
+             {residual:.3e}, terms of size {scale:.3e})"
+        ))
+    }
+}
+
+/// A model's hidden constraints at a step's end node, held by [`hold`].
+struct Node<'a, S: DiracSystem<N>, const N: usize> {
+    hidden: &'a HiddenConstraints,
+    system: &'a S,
+    q: &'a mut SVector<f64, N>,
+    v: &'a SVector<f64, N>,
+    t: f64,
+    inputs: &'a [f64],
+    /// The free directions of the last linearisation.
+    free: DMatrix<f64>,
+}
+
+impl<S: DiracSystem<N>, const N: usize> Projection for Node<'_, S, N> {
+    fn residual(&mut self) -> Result<Option<(f64, f64)>, String> {
+        Ok(self
+            .hidden
+            .fixed_residual(self.system, self.q, self.v, self.t, self.inputs))
+    }
+
+    fn linearise(&mut self) -> Result<(DVector<f64>, DMatrix<f64>, f64), String> {
+        let e = self
+            .hidden
+            .evaluate(self.system, self.q, self.v, self.t, self.inputs)?;
+        let reduced = &e.differential * &e.free;
+        self.free = e.free;
+        Ok((e.value, reduced, e.scale))
+    }
+
+    fn shift(&mut self, alpha: &DVector<f64>) {
+        let step = &self.free * alpha;
+        *self.q += SVector::<f64, N>::from_fn(|i, _| step[i]);
     }
 }
 
 /// Whether the constraint forms are constant at `q` (no holonomic constraint, one-forms with
 /// zero derivative).
-fn constant_forms<S: DiracSystem<N>, const N: usize>(system: &S, q: &SVector<f64, N>) -> bool {
+pub(crate) fn constant_forms<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+) -> bool {
     S::HOLONOMIC == 0
         && (0..S::ONE_FORMS).all(|a| {
             constraint::one_form(system, q, a)

@@ -16,7 +16,9 @@
 //! method solves them with a [`Bordered`] Jacobian: each `∂R_c/∂x_c` is factorised on its own
 //! and the junctions' Schur complement, a band matrix along a chain, couples them, so a chain
 //! of `K` components costs `O(K)` per step. The components can be assembled and factorised in
-//! parallel (rayon, [`Modular::with_parallel`]).
+//! parallel (rayon, [`Modular::with_parallel`]). Hidden constraints across the components
+//! (parallel capacitors in different components) are held at every step's end as a model holds
+//! its own (see `hidden`).
 //!
 //! ```
 //! use dirac_runtime::modular::Modular;
@@ -46,7 +48,9 @@
 //! # Ok::<(), dirac_runtime::DiracError>(())
 //! ```
 
-use std::collections::{BTreeMap, HashMap, HashSet};
+mod hidden;
+
+use std::collections::{HashMap, HashSet};
 
 use nalgebra::{DMatrix, DVector, SVector};
 use rayon::prelude::*;
@@ -59,7 +63,7 @@ use crate::derivatives::{Seed, degenerate, seeded};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
 use crate::euler_lagrange::EulerLagrange;
-use crate::hidden_constraint::HiddenConstraints;
+use crate::hidden_constraint::{HiddenConstraints, Rows, constant_forms, degenerate_rows};
 use crate::interconnection::Junction;
 use crate::jacobian::Jacobian;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport, exceeds, largest};
@@ -67,6 +71,7 @@ use crate::predictor::Predictor;
 use crate::quadrature::Quadrature;
 use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
+use hidden::Hidden;
 
 /// Components per parallel task.
 const GRAIN: usize = 32;
@@ -137,6 +142,8 @@ struct Running {
     multipliers: Vec<f64>,
     violation: f64,
     report: Option<NewtonReport>,
+    /// The hidden constraints across the components, held at every step's end.
+    hidden: Option<Hidden>,
 }
 
 /// The flows and work through the junctions over the last step of a [`Modular`]
@@ -508,14 +515,18 @@ impl Modular {
     /// Starts a run at time 0 from the positions `q` and velocities `v` of every coordinate
     /// (in the order of [`coordinate_names`](Self::coordinate_names)). Each component's state
     /// is checked as a [`Stepper`](crate::Stepper) checks a model's, its degenerate rows
-    /// excepted; the junctions must hold, `a_j · v = 0`. Refused: coordinates without kinetic
-    /// energy whose rows the constraints do not determine (hidden constraints across the
-    /// components, which the modular step does not project onto: step the interconnection
-    /// monolithically), coordinates whose Lagrangian is linear in their velocity with a
-    /// momentum that is not zero, and junctions that depend on each other or on the
-    /// components' own constraints (the first step's Schur complement is singular). A state or
-    /// a model refused by the checks changes nothing; one refused by the first step's trial
-    /// solve (singular) leaves the interconnection not started.
+    /// excepted; the junctions must hold, `a_j · v = 0`. Coordinates without kinetic energy
+    /// whose rows no impulse reaches combine into hidden constraints across the components
+    /// (parallel capacitors: equal voltages), held at every step's end; the state must satisfy
+    /// them and their velocity form. Refused: such combinations that contain velocities (a
+    /// resistor beside a capacitor) or depend on time, where a component with coordinates
+    /// without kinetic energy has constraint forms that are not constant, or more than 256 of
+    /// them (step the interconnection monolithically);
+    /// coordinates whose Lagrangian is linear in their velocity with a momentum that is not
+    /// zero; and junctions that depend on each other or on the components' own constraints
+    /// (the first step's Schur complement is singular). A state or a model refused by the
+    /// checks changes nothing; one refused by the first step's trial solve (singular) leaves
+    /// the interconnection not started.
     pub fn start_from_velocity(&mut self, q: &[f64], v: &[f64]) -> Result<(), DiracError> {
         let n = self.coordinates();
         if q.len() != n || v.len() != n {
@@ -541,7 +552,7 @@ impl Modular {
             started.push(state);
         }
         self.check_junctions(v, tolerance)?;
-        self.check_degenerate(q, v)?;
+        let hidden = Hidden::find(&self.components, &self.junctions, (q, v), tolerance)?;
         // From here a failure leaves no run (the components begin afresh).
         self.run = None;
         for (component, state) in self.components.iter_mut().zip(started) {
@@ -588,6 +599,7 @@ impl Modular {
             multipliers: vec![0.0; self.junctions.len()],
             violation: 0.0,
             report: None,
+            hidden,
         });
         // A model the step does not determine (dependent junctions, a component singular on
         // its own) is refused here, before the first step, naming the unknowns.
@@ -661,73 +673,6 @@ impl Modular {
             }
         }
         Ok(())
-    }
-
-    /// Refuses coordinates without kinetic energy whose Euler–Lagrange rows the constraints'
-    /// impulses do not determine: where the forms restricted to those coordinates, `A_D`, have
-    /// a null vector `w`, the combination `Σ_d w_d R_d` of their rows is a hidden constraint
-    /// (no impulse enters it), which the modular step does not project onto.
-    fn check_degenerate(&self, q: &[f64], v: &[f64]) -> Result<(), DiracError> {
-        let mut dead: Vec<(usize, usize)> = Vec::new();
-        let mut forms: Vec<Vec<(usize, f64)>> = Vec::new();
-        for (c, component) in self.components.iter().enumerate() {
-            let range = component.first..component.first + component.part.coordinates();
-            let found = component.part.degenerate(&q[range.clone()], &v[range]);
-            if let Some(i) = found.turning {
-                return Err(DiracError::Unsupported(format!(
-                    "the modular step on {}.{}, whose Lagrangian is linear in its velocity with \
-                     a momentum ∂L/∂v that depends on the position (first-order rows are \
-                     collocated only in a model stepped on its own)",
-                    component.name,
-                    component.part.coordinate_name(i)
-                )));
-            }
-            if let Some(&(i, momentum)) = found.momenta.iter().find(|(_, p)| *p != 0.0) {
-                return Err(DiracError::Unsupported(format!(
-                    "the modular step on {}.{}, whose Lagrangian is linear in its velocity with \
-                     the momentum {momentum} (first-order rows are collocated only in a \
-                     model stepped on its own)",
-                    component.name,
-                    component.part.coordinate_name(i)
-                )));
-            }
-            let base = dead.len();
-            dead.extend(found.coordinates.iter().map(|&i| (c, i)));
-            for row in found.forms.row_iter() {
-                let entries = found.coordinates.iter().enumerate();
-                forms.push(entries.map(|(k, &i)| (base + k, row[i])).collect());
-            }
-        }
-        if dead.is_empty() {
-            return Ok(());
-        }
-        let column: HashMap<(usize, usize), usize> =
-            dead.iter().enumerate().map(|(k, &d)| (d, k)).collect();
-        for junction in &self.junctions {
-            let entries = junction
-                .terms
-                .iter()
-                .filter_map(|&(c, i, a)| Some((*column.get(&(c, i))?, a)));
-            forms.push(entries.collect());
-        }
-        let Some(support) = null_vector(forms, dead.len()) else {
-            return Ok(());
-        };
-        let names: Vec<String> = support
-            .into_iter()
-            .map(|k| {
-                let (c, i) = dead[k];
-                let component = &self.components[c];
-                format!("{}.{}", component.name, component.part.coordinate_name(i))
-            })
-            .collect();
-        Err(DiracError::Unsupported(format!(
-            "the modular step with hidden constraints across the components: the rows of {} \
-             (coordinates without kinetic energy) combine into a constraint that no junction's \
-             impulse enters (e.g. parallel capacitors); step the interconnection monolithically \
-             (Interconnection), which projects onto it",
-            names.join(", ")
-        )))
     }
 
     /// Solves the next step from the components' states into `run`'s unknowns and lets each
@@ -856,6 +801,13 @@ impl Modular {
                 return Err(in_component(&name, error));
             }
         };
+        if let Some(hidden) = &run.hidden {
+            let t = (run.steps + 1) as f64 * self.h;
+            if let Err(error) = hidden.project(&mut self.components, t, run.steps) {
+                self.components.iter_mut().for_each(|c| c.part.discard());
+                return Err(error);
+            }
+        }
         let junction_violation = self.junctions.iter().map(|junction| {
             let moved = junction.terms.iter().map(|&(c, i, a)| {
                 let component = &self.components[c];
@@ -977,21 +929,32 @@ impl Modular {
     /// The velocity of every coordinate at the current state (in the order of
     /// [`coordinate_names`](Self::coordinate_names)): the Legendre transform inverted with the
     /// constraints, `∂L_c/∂v(q_c, v_c) = p_c + C_cᵀ ν_c + Σ_j ν_j a_j^c` for every component
-    /// `c` (its own one-forms and holonomic differentials `C_c`), `C_c v_c = 0` and the
-    /// junctions `Σ_c a_j^c · v_c = 0`, solved by Newton's method from the last step's
+    /// `c` (its own one-forms and holonomic differentials `C_c`), `C_c v_c = 0`, the
+    /// junctions `Σ_c a_j^c · v_c = 0` and the velocity forms `dc(q) v = 0` of hidden
+    /// constraints across the components (each with a multiplier, as a junction's, and each
+    /// spanning every component it combines), solved by Newton's method from the last step's
     /// velocities. Its matrix is a band matrix with each junction's row beside the components
     /// it joins (a chain costs `O(K)`), factorised with partial pivoting, so components without
     /// kinetic energy, whose velocities only the junctions fix, need no block of their own.
     pub fn velocities(&self) -> Result<DVector<f64>, DiracError> {
         let run = self.running()?;
-        let layout = VelocityLayout::of(&self.components, &self.junctions);
+        // The hidden constraints' velocity forms join the junctions' rows.
+        let rows = match &run.hidden {
+            Some(hidden) => {
+                let mut rows = self.junctions.clone();
+                rows.extend(hidden.velocity_rows(&self.components, self.junctions.len())?);
+                std::borrow::Cow::Owned(rows)
+            }
+            None => std::borrow::Cow::Borrowed(&self.junctions),
+        };
+        let layout = VelocityLayout::of(&self.components, &rows, self.junctions.len());
         let mut newton = Newton::with_jacobian(layout.band()?, self.options)?;
         let mut x = DVector::zeros(layout.size);
         for (component, &at) in self.components.iter().zip(&layout.components) {
             let guess = component.part.velocity_hint();
             x.as_mut_slice()[at..at + guess.len()].copy_from_slice(&guess);
         }
-        let (components, junctions) = (&self.components, &self.junctions);
+        let (components, junctions) = (&self.components, &rows[..]);
         let solved = newton.solve(&mut x, |x, r, band| {
             layout.assemble(components, junctions, x.as_slice(), r.as_mut_slice(), band)
         });
@@ -1051,80 +1014,6 @@ impl Modular {
     }
 }
 
-/// A null vector of the matrix of sparse `rows` (`(column, value)` entries) over `columns`
-/// columns, where it has one: the columns it moves. Gaussian elimination with partial pivoting
-/// on the sparse rows (a pivot at or below `1e-10` of its row's largest entry counts as zero),
-/// then back-substitution from the first column that has no pivot. Rows of a chain's junctions
-/// touch neighbours only, so the elimination costs `O(columns)` there.
-fn null_vector(rows: Vec<Vec<(usize, f64)>>, columns: usize) -> Option<Vec<usize>> {
-    // Exact zeros are no entries; a row without entries constrains nothing.
-    let rows: Vec<Vec<(usize, f64)>> = rows
-        .into_iter()
-        .map(|row| row.into_iter().filter(|e| e.1 != 0.0).collect::<Vec<_>>())
-        .filter(|row| !row.is_empty())
-        .collect();
-    let scales: Vec<f64> = rows
-        .iter()
-        .map(|row| row.iter().fold(0.0, |m: f64, e| m.max(e.1.abs())))
-        .collect();
-    let mut rows: Vec<BTreeMap<usize, f64>> = rows
-        .into_iter()
-        .map(|row| row.into_iter().collect())
-        .collect();
-    let mut holding: Vec<Vec<usize>> = vec![Vec::new(); columns];
-    for (r, row) in rows.iter().enumerate() {
-        for &k in row.keys() {
-            holding[k].push(r);
-        }
-    }
-    let mut used = vec![false; rows.len()];
-    let mut pivots: Vec<usize> = Vec::with_capacity(columns);
-    for k in 0..columns {
-        // A NaN (a form that is not finite) never makes a pivot.
-        let relative = |r: usize| {
-            let found = rows[r].get(&k).map_or(0.0, |v| v.abs() / scales[r]);
-            if found.is_nan() { 0.0 } else { found }
-        };
-        let best = holding[k]
-            .iter()
-            .copied()
-            .filter(|&r| !used[r])
-            .max_by(|&a, &b| relative(a).total_cmp(&relative(b)));
-        let Some(p) = best.filter(|&p| relative(p) > 1e-10) else {
-            // Column k combines the columns before it: x_k = 1, and the pivot rows give the rest.
-            let mut x = vec![0.0; k + 1];
-            x[k] = 1.0;
-            for (j, &p) in pivots.iter().enumerate().rev() {
-                let sum: f64 = rows[p].range(j + 1..=k).map(|(&l, &v)| v * x[l]).sum();
-                x[j] = -sum / rows[p][&j];
-            }
-            let size = x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
-            return Some((0..=k).filter(|&j| x[j].abs() > 1e-8 * size).collect());
-        };
-        used[p] = true;
-        pivots.push(p);
-        let pivot_row = rows[p].clone();
-        let pivot = pivot_row[&k];
-        for r in std::mem::take(&mut holding[k]) {
-            if used[r] {
-                continue;
-            }
-            let Some(value) = rows[r].remove(&k) else {
-                continue;
-            };
-            let factor = value / pivot;
-            for (&l, &v) in pivot_row.range(k + 1..) {
-                let entry = rows[r].entry(l).or_insert_with(|| {
-                    holding[l].push(r);
-                    0.0
-                });
-                *entry -= factor * v;
-            }
-        }
-    }
-    None
-}
-
 /// `Σ t` over `terms` and the size of what it sums, `Σ |t|` (a residual row and its scale).
 fn sum_and_size(terms: impl Iterator<Item = f64>) -> (f64, f64) {
     terms.fold((0.0, 0.0), |(sum, size), t| (sum + t, size + t.abs()))
@@ -1166,13 +1055,16 @@ struct VelocityLayout {
     components: Vec<usize>,
     /// The unknown (and row) of each junction.
     junctions: Vec<usize>,
+    /// The number of junctions proper (rows after them are hidden constraints').
+    joined: usize,
     size: usize,
     lower: usize,
     upper: usize,
 }
 
 impl VelocityLayout {
-    fn of(components: &[Component], junctions: &[Coupling]) -> Self {
+    /// The layout of `junctions`, of which the first `joined` are junctions proper.
+    fn of(components: &[Component], junctions: &[Coupling], joined: usize) -> Self {
         let mut last = vec![Vec::new(); components.len()];
         for (j, junction) in junctions.iter().enumerate() {
             let c = junction
@@ -1198,6 +1090,7 @@ impl VelocityLayout {
         let mut layout = Self {
             components: starts,
             junctions: places,
+            joined,
             size: at,
             lower: 0,
             upper: 0,
@@ -1288,7 +1181,13 @@ impl VelocityLayout {
         column: usize,
     ) -> String {
         if let Some(j) = self.junctions.iter().position(|&at| at == column) {
-            return format!("the multiplier of junction {}", junctions[j].name);
+            // The rows after the junctions are hidden constraints' (`Hidden::velocity_rows`).
+            let name = &junctions[j].name;
+            return if j < self.joined {
+                format!("the multiplier of junction {name}")
+            } else {
+                format!("the multiplier of {name}")
+            };
         }
         let c = self.components.partition_point(|&at| at <= column) - 1;
         let (component, i) = (&components[c], column - self.components[c]);
@@ -1386,6 +1285,24 @@ trait Part: Send + std::fmt::Debug {
     fn legendre(&self, v: &[f64]) -> Legendre;
     /// The energy at its position with velocity `v`.
     fn energy(&self, v: &[f64]) -> f64;
+    /// The rows of its coordinates `dead` without their multipliers at `(q, v, t)`, with its
+    /// inputs (see [`degenerate_rows`]).
+    fn degenerate_rows(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        dead: &[usize],
+        jacobians: bool,
+    ) -> Rows;
+    /// Whether its constraint forms are constant at `q`.
+    fn constant_forms(&self, q: &[f64]) -> bool;
+    /// The proposed state's position and velocity (after [`advance`](Self::advance)).
+    fn proposed(&self) -> Option<(&[f64], &[f64])>;
+    /// Moves coordinate `i` of the proposed position by `delta`.
+    fn shift_proposed(&mut self, i: usize, delta: f64);
+    /// The Lagrangian finite at the proposed state (after it was moved).
+    fn check_proposed(&self, step: u64) -> Result<(), DiracError>;
 }
 
 /// A checked initial state, type-erased.
@@ -1608,30 +1525,49 @@ impl<S: DiracSystem<M> + Send, const M: usize> Part for Model<S, M> {
         let system = self.equations.discrete().system();
         crate::legendre::energy(system, &self.state().q, &SVector::from_column_slice(v))
     }
-}
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+    fn degenerate_rows(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        dead: &[usize],
+        jacobians: bool,
+    ) -> Rows {
+        let (q, v) = (SVector::from_column_slice(q), SVector::from_column_slice(v));
+        let system = self.equations.discrete().system();
+        degenerate_rows(
+            system,
+            dead,
+            (&q, &v, t),
+            self.equations.inputs(),
+            jacobians,
+        )
+    }
 
-    #[test]
-    fn null_vectors_of_sparse_rows() {
-        // x₀ − x₁ = 0, x₁ − x₂ = 0 over three columns: (1, 1, 1).
-        let chain = vec![vec![(0, 1.0), (1, -1.0)], vec![(1, 1.0), (2, -1.0)]];
-        assert_eq!(null_vector(chain.clone(), 3), Some(vec![0, 1, 2]));
-        // With x₂ pinned, none.
-        let pinned = [chain, vec![vec![(2, 3.0)]]].concat();
-        assert_eq!(null_vector(pinned, 3), None);
-        // A column no row touches; and one that pivoting must find below a zero.
-        assert_eq!(null_vector(vec![vec![(0, 2.0)]], 2), Some(vec![1]));
-        let swap = vec![vec![(1, 1.0)], vec![(0, 1.0), (1, 5.0)]];
-        assert_eq!(null_vector(swap, 2), None);
-        // A row of zeros (a form that misses these columns) and a NaN pivot are no pivots.
-        let zeros = vec![vec![(0, 0.0), (1, 0.0)], vec![(0, 1.0)], vec![(1, 1.0)]];
-        assert_eq!(null_vector(zeros, 2), None);
-        assert_eq!(null_vector(vec![vec![(0, f64::NAN)]], 1), Some(vec![0]));
-        // Dependent in a combination: x₀ + x₁ and 2x₀ + 2x₁ leave (1, −1).
-        let twice = vec![vec![(0, 1.0), (1, 1.0)], vec![(0, 2.0), (1, 2.0)]];
-        assert_eq!(null_vector(twice, 2), Some(vec![0, 1]));
+    fn constant_forms(&self, q: &[f64]) -> bool {
+        let system = self.equations.discrete().system();
+        constant_forms(system, &SVector::from_column_slice(q))
+    }
+
+    fn proposed(&self) -> Option<(&[f64], &[f64])> {
+        let next = self.proposed.as_ref()?;
+        Some((next.q.as_slice(), next.velocity.as_slice()))
+    }
+
+    fn shift_proposed(&mut self, i: usize, delta: f64) {
+        if let Some(next) = self.proposed.as_mut() {
+            next.q[i] += delta;
+        }
+    }
+
+    fn check_proposed(&self, step: u64) -> Result<(), DiracError> {
+        match &self.proposed {
+            Some(next) => self
+                .equations
+                .discrete()
+                .check_end(&next.q, &next.velocity, step),
+            None => Ok(()),
+        }
     }
 }

@@ -202,6 +202,30 @@ pub fn lc_from_subcircuits(c: &LcCircuit) -> Result<LcFromSubcircuits, DiracErro
     )
 }
 
+/// The circuit `c` by parts ([`Modular`]): the loop (`l`, `c2` in series) and the pair (`c1`,
+/// `c3`), each a `Modular` of its own, included as `loop` and `pair` and joined by KCL; the
+/// coordinates as [`lc_from_subcircuits`]'s. C1 ∥ C3 is a hidden constraint across the
+/// components, `q_c1/c1 = q_c3/c3`, held at every step's end.
+pub fn lc_by_parts(c: &LcCircuit, h: f64) -> Result<Modular, DiracError> {
+    let mut series = Modular::new(Quadrature::midpoint(), h)?;
+    series.add("l", Inductor { l: c.l })?;
+    series.add("c2", Capacitor { c: c.c2 })?;
+    series.join(Junction::new("series").flow("l.q", 1.0).flow("c2.q", -1.0))?;
+    let mut pair = Modular::new(Quadrature::midpoint(), h)?;
+    pair.add("c1", Capacitor { c: c.c1 })?;
+    pair.add("c3", Capacitor { c: c.c3 })?;
+    let mut circuit = Modular::new(Quadrature::midpoint(), h)?;
+    circuit.include("loop", series)?;
+    circuit.include("pair", pair)?;
+    circuit.join(
+        Junction::new("kcl")
+            .flow("loop.c2.q", 1.0)
+            .flow("pair.c1.q", -1.0)
+            .flow("pair.c3.q", -1.0),
+    )?;
+    Ok(circuit)
+}
+
 /// The LC circuit's loop, written with the attribute.
 #[dirac_system(subsystems(l, c2), junctions(series = l.dq - c2.dq))]
 #[derive(Debug, Clone, Copy)]
@@ -278,4 +302,41 @@ pub fn subcircuits_report() -> Result<Report, DiracError> {
     // The monolithic circuit's (q_l, q_c1, q_c2, q_c3) are the parts' 0, 2, 1, 3.
     let gap = super::ports::gap_to_whole(joined.clone(), LC, start, [0, 2, 1, 3])?;
     super::ports::report("LC (2 parts)", &joined, start, gap)
+}
+
+/// The tour's row: the seed's LC circuit by parts ([`lc_by_parts`], unequal capacitors) against
+/// the monolithic circuit from the same subcircuits to T = 10: how far apart they end, the
+/// hidden constraint `q_c1/c1 − q_c3/c3` across the components at every step's end, and
+/// Tellegen's theorem on the parts' port work.
+pub fn by_parts_report() -> Result<Report, DiracError> {
+    let c = LcCircuit { c3: 2.0, ..LC };
+    let (h, steps) = (0.01, 1000);
+    let (q0, v0) = ([0.0, 1.0, 0.2, 0.4], [0.5, 0.5, 0.5 / 3.0, 1.0 / 3.0]);
+    let start = std::time::Instant::now();
+    let mut parts = lc_by_parts(&c, h)?;
+    parts.start_from_velocity(&q0, &v0)?;
+    let mut whole = Stepper::new(lc_from_subcircuits(&c)?, Quadrature::midpoint(), h)?;
+    whole.start_from_velocity(SVector::from(q0), SVector::from(v0))?;
+    let (mut apart, mut hidden, mut tellegen): (f64, f64, f64) = (0.0, 0.0, 0.0);
+    for _ in 0..steps {
+        parts.step()?;
+        whole.step()?;
+        let q = parts.q();
+        let gap = (0..4).map(|i| (q[i] - whole.q()[i]).abs());
+        apart = gap.fold(apart, f64::max);
+        hidden = hidden.max((q[2] / c.c1 - q[3] / c.c3).abs());
+        let ports = parts.ports()?;
+        tellegen = tellegen.max(ports.net_work().abs() / ports.scale.max(f64::MIN_POSITIVE));
+    }
+    Ok(Report {
+        scene: "LC (C1 ∥ C3 unequal), by parts",
+        quadrature: "midpoint".into(),
+        h,
+        steps,
+        max_energy_error: None,
+        wall: start.elapsed(),
+        check: format!(
+            "= monolithic to {apart:.0e}; C1 ∥ C3 across parts held to {hidden:.0e}; Tellegen {tellegen:.0e}"
+        ),
+    })
 }
