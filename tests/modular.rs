@@ -8,7 +8,7 @@ mod scenes;
 use dirac::interconnection::{Interconnection, Junction};
 use dirac::nalgebra::DVector;
 use dirac::prelude::*;
-use scenes::components::{Capacitor, Inductor, MassSpring, Resistor, Source};
+use scenes::components::{Capacitor, Damper, Inductor, Mass, MassSpring, Resistor, Source, Spring};
 use scenes::{circuit, ladder, motor};
 
 /// Steps `parts` and `whole` side by side `steps` times, running `check` on the parts after each
@@ -858,6 +858,56 @@ fn two_hidden_constraints_across_components_of_several_coordinates() {
     let theirs = whole.v().unwrap();
     let gap = (0..5).fold(0.0_f64, |m, i| m.max((v[i] - theirs[i]).abs()));
     assert!(gap < 1e-12, "velocities {v} against {theirs}");
+}
+
+/// A mass, a spring and a damper, each a component, the spring and the damper both between the
+/// ground and the mass (`ds = dx`, `dd = dx`): by parts, the damped oscillator
+/// `m ẍ + c ẋ + k x = 0`, against its closed form at T = 5 at second order (h = 0.02, 0.01).
+#[test]
+fn a_mass_spring_and_damper_from_three_components_oscillate_as_one() {
+    let (m, k, c) = (2.0, 3.0, 0.4);
+    let omega = (k / m).sqrt();
+    let zeta = c / (2.0 * (k * m).sqrt());
+    let damped = omega * (1.0 - zeta * zeta).sqrt();
+    let exact = |t: f64| {
+        (-zeta * omega * t).exp()
+            * ((damped * t).cos() + zeta * omega / damped * (damped * t).sin())
+    };
+    let error = |h: f64| {
+        let mut parts = Modular::new(Quadrature::midpoint(), h).unwrap();
+        parts.add("mass", Mass { m }).unwrap();
+        parts.add("spring", Spring { k }).unwrap();
+        parts.add("damper", Damper { c }).unwrap();
+        parts
+            .join(
+                Junction::new("spring")
+                    .flow("spring.x", 1.0)
+                    .flow("mass.x", -1.0),
+            )
+            .unwrap();
+        parts
+            .join(
+                Junction::new("damper")
+                    .flow("damper.x", 1.0)
+                    .flow("mass.x", -1.0),
+            )
+            .unwrap();
+        parts
+            .start_from_velocity(&[1.0, 1.0, 1.0], &[0.0; 3])
+            .unwrap();
+        parts.run((5.0 / h).round() as u64).unwrap();
+        let q = parts.q();
+        assert!(
+            (q[0] - q[1]).abs() < 1e-12,
+            "the spring's elongation is the mass's: {q}"
+        );
+        (q[0] - exact(parts.t())).abs()
+    };
+    let (coarse, fine) = (error(0.02), error(0.01));
+    let order = (coarse / fine).log2();
+    println!("mass, spring, damper: errors {coarse:e}, {fine:e}, order {order}");
+    assert!(fine < 1e-4, "{fine:e}");
+    assert!((order - 2.0).abs() < 0.05, "order {order}");
 }
 
 /// The DC motor driving a pendulum arm through the shaft junction, with a voltage input set by

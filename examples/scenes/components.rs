@@ -32,6 +32,28 @@ pub struct Resistor {
 #[derive(Debug, Clone, Copy)]
 pub struct Source;
 
+/// A mass: L = ½ m ẋ² (its momentum is m ẋ).
+#[dirac_system(coordinates(x), lagrangian = 0.5 * m * dot(x).powi(2))]
+#[derive(Debug, Clone, Copy)]
+pub struct Mass {
+    pub m: f64,
+}
+
+/// A spring, its coordinate its elongation: L = −½ k x² (no kinetic energy, as a capacitor of
+/// capacitance 1/k).
+#[dirac_system(coordinates(x), lagrangian = -0.5 * k * x.powi(2))]
+#[derive(Debug, Clone, Copy)]
+pub struct Spring {
+    pub k: f64,
+}
+
+/// A damper, its coordinate its elongation: no energy, the force −c ẋ dx (as a resistor).
+#[dirac_system(coordinates(x), lagrangian = 0.0 * x, forces(-c * dot(x) * dx))]
+#[derive(Debug, Clone, Copy)]
+pub struct Damper {
+    pub c: f64,
+}
+
 /// A mass on a spring to the ground: L = ½ m ẋ² − ½ k x².
 #[dirac_system(coordinates(x), lagrangian = 0.5 * m * dot(x).powi(2) - 0.5 * k * x.powi(2))]
 #[derive(Debug, Clone, Copy)]
