@@ -484,13 +484,8 @@ fn modular(c: &mut Criterion) {
     });
     // The seed's LC circuit from its two subcircuits (unequal capacitors): monolithically, and
     // by parts with its hidden constraint across the components held at every step's end.
-    let seed = scenes::circuit::LcCircuit {
-        l: 1.0,
-        c1: 1.0,
-        c2: 1.0,
-        c3: 2.0,
-    };
-    let (q0, v0) = ([0.0, 1.0, 0.2, 0.4], [0.5, 0.5, 0.5 / 3.0, 1.0 / 3.0]);
+    let seed = scenes::circuit::UNEQUAL;
+    let (q0, v0) = scenes::circuit::UNEQUAL_START;
     let mut whole = Stepper::new(
         scenes::circuit::lc_from_subcircuits(&seed).expect("valid circuit"),
         Quadrature::midpoint(),

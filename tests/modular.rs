@@ -638,16 +638,8 @@ fn the_rlc_by_parts_equals_the_monolithic_rlc() {
 /// energy is conserved to round-off; Tellegen's theorem holds to 1e-11 of the work's terms.
 #[test]
 fn the_seed_lc_circuit_by_parts_holds_its_hidden_constraint_and_equals_the_whole() {
-    let c = circuit::LcCircuit {
-        l: 1.0,
-        c1: 1.0,
-        c2: 1.0,
-        c3: 2.0,
-    };
-    let h = 0.01;
-    // (l, c2, c1, c3): equal voltages on C1 and C3, a current 0.5 split 1 : 2 between them.
-    let q0 = [0.0, 1.0, 0.2, 0.4];
-    let v0 = [0.5, 0.5, 0.5 / 3.0, 1.0 / 3.0];
+    let (c, h) = (circuit::UNEQUAL, 0.01);
+    let (q0, v0) = circuit::UNEQUAL_START;
     let mut parts = circuit::lc_by_parts(&c, h).unwrap();
     assert_eq!(
         parts.coordinate_names(),
@@ -707,15 +699,8 @@ fn the_seed_lc_circuit_by_parts_holds_its_hidden_constraint_and_equals_the_whole
 /// levels (one model) to 1e-12 over 1 000 steps.
 #[test]
 fn a_hidden_constraint_inside_one_component_is_held_by_the_interconnection() {
-    let c = circuit::LcCircuit {
-        l: 1.0,
-        c1: 1.0,
-        c2: 1.0,
-        c3: 2.0,
-    };
-    let h = 0.01;
-    let q0 = [0.0, 1.0, 0.2, 0.4];
-    let v0 = [0.5, 0.5, 0.5 / 3.0, 1.0 / 3.0];
+    let (c, h) = (circuit::UNEQUAL, 0.01);
+    let (q0, v0) = circuit::UNEQUAL_START;
     let whole_model = circuit::LcByAttribute::of(&c);
     let mut parts = Modular::new(Quadrature::midpoint(), h).unwrap();
     parts.add("loop_", whole_model.loop_).unwrap();

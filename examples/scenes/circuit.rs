@@ -202,6 +202,19 @@ pub fn lc_from_subcircuits(c: &LcCircuit) -> Result<LcFromSubcircuits, DiracErro
     )
 }
 
+/// The seed's circuit with unequal parallel capacitors (C3 = 2 C1).
+pub const UNEQUAL: LcCircuit = LcCircuit {
+    l: 1.0,
+    c1: 1.0,
+    c2: 1.0,
+    c3: 2.0,
+};
+
+/// A start of [`UNEQUAL`] in the order of [`lc_by_parts`]'s coordinates `(l, c2, c1, c3)`:
+/// equal voltages on C1 and C3, and a current 0.5 split 1 : 2 between them.
+pub const UNEQUAL_START: ([f64; 4], [f64; 4]) =
+    ([0.0, 1.0, 0.2, 0.4], [0.5, 0.5, 0.5 / 3.0, 1.0 / 3.0]);
+
 /// The circuit `c` by parts ([`Modular`]): the loop (`l`, `c2` in series) and the pair (`c1`,
 /// `c3`), each a `Modular` of its own, included as `loop` and `pair` and joined by KCL; the
 /// coordinates as [`lc_from_subcircuits`]'s. C1 ∥ C3 is a hidden constraint across the
@@ -309,9 +322,9 @@ pub fn subcircuits_report() -> Result<Report, DiracError> {
 /// hidden constraint `q_c1/c1 − q_c3/c3` across the components at every step's end, and
 /// Tellegen's theorem on the parts' port work.
 pub fn by_parts_report() -> Result<Report, DiracError> {
-    let c = LcCircuit { c3: 2.0, ..LC };
+    let c = UNEQUAL;
     let (h, steps) = (0.01, 1000);
-    let (q0, v0) = ([0.0, 1.0, 0.2, 0.4], [0.5, 0.5, 0.5 / 3.0, 1.0 / 3.0]);
+    let (q0, v0) = UNEQUAL_START;
     let start = std::time::Instant::now();
     let mut parts = lc_by_parts(&c, h)?;
     parts.start_from_velocity(&q0, &v0)?;
