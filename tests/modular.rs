@@ -757,64 +757,26 @@ impl DiracSystem<1> for StiffeningCapacitor {
 /// 2 000 steps (4e-15).
 #[test]
 fn a_nonlinear_hidden_constraint_across_components_is_held_at_every_step() {
-    let (l, c1, c2) = (1.0, 1.0, 1.0);
-    let (c3, beta) = (2.0, 0.5);
-    let h = 0.01;
-    let voltage = |q: f64| q / c3 + beta * q.powi(3);
-    let slope = |q: f64| 1.0 / c3 + 3.0 * beta * q * q;
+    let (c, beta, h) = (circuit::UNEQUAL, 0.5, 0.01);
+    let c3 = || StiffeningCapacitor { c: c.c3, beta };
+    let voltage = |q: f64| q / c.c3 + beta * q.powi(3);
+    let slope = |q: f64| 1.0 / c.c3 + 3.0 * beta * q * q;
     // Equal voltages, and a current 0.5 split so that they stay equal.
     let q3 = 0.4;
-    let v3 = 0.5 / (1.0 + c1 * slope(q3));
-    let q0 = [0.0, 1.0, c1 * voltage(q3), q3];
+    let v3 = 0.5 / (1.0 + c.c1 * slope(q3));
+    let q0 = [0.0, 1.0, c.c1 * voltage(q3), q3];
     let v0 = [0.5, 0.5, 0.5 - v3, v3];
-    let mut parts = Modular::new(Quadrature::midpoint(), h).unwrap();
-    parts.add("l", Inductor { l }).unwrap();
-    parts.add("c2", Capacitor { c: c2 }).unwrap();
-    parts.add("c1", Capacitor { c: c1 }).unwrap();
-    parts
-        .add("c3", StiffeningCapacitor { c: c3, beta })
-        .unwrap();
-    parts
-        .join(Junction::new("series").flow("l.q", 1.0).flow("c2.q", -1.0))
-        .unwrap();
-    parts
-        .join(
-            Junction::new("kcl")
-                .flow("c2.q", 1.0)
-                .flow("c1.q", -1.0)
-                .flow("c3.q", -1.0),
-        )
-        .unwrap();
+    let mut parts = circuit::lc_by_parts_with(&c, c3(), h).unwrap();
     parts.start_from_velocity(&q0, &v0).unwrap();
-    let series: Interconnection<_, _, 1, 1, 2, 1> = Interconnection::new(
-        ("l", Inductor { l }),
-        ("c2", Capacitor { c: c2 }),
-        [Junction::new("series").flow("l.q", 1.0).flow("c2.q", -1.0)],
-    )
-    .unwrap();
-    let pair: Interconnection<_, _, 1, 1, 2, 0> = Interconnection::new(
-        ("c1", Capacitor { c: c1 }),
-        ("c3", StiffeningCapacitor { c: c3, beta }),
-        [],
-    )
-    .unwrap();
-    let circuit = Interconnection::new(
-        ("loop", series),
-        ("pair", pair),
-        [Junction::new("kcl")
-            .flow("loop.c2.q", 1.0)
-            .flow("pair.c1.q", -1.0)
-            .flow("pair.c3.q", -1.0)],
-    )
-    .unwrap();
-    let mut whole = Stepper::new(circuit, Quadrature::midpoint(), h).unwrap();
+    let whole = circuit::lc_from_subcircuits_with(&c, c3()).unwrap();
+    let mut whole = Stepper::new(whole, Quadrature::midpoint(), h).unwrap();
     whole
         .start_from_velocity(SVector::from(q0), SVector::from(v0))
         .unwrap();
     let hidden = std::cell::Cell::new(0.0_f64);
     let worst = lockstep(&mut parts, &mut whole, 2_000, &[0, 1], |parts| {
         let q = parts.q();
-        hidden.set(hidden.get().max((q[2] / c1 - voltage(q[3])).abs()));
+        hidden.set(hidden.get().max((q[2] / c.c1 - voltage(q[3])).abs()));
     });
     println!(
         "nonlinear pair: apart by {worst:e}, hidden constraint {:e}",

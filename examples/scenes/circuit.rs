@@ -172,34 +172,47 @@ pub fn driven_report() -> Result<Report, DiracError> {
 
 /// The LC circuit's left subcircuit: the inductor in series with C2.
 pub type SeriesLoop = Interconnection<Inductor, Capacitor, 1, 1, 2, 1>;
-/// C1 and C3, joined only through the rest of the circuit.
-pub type CapacitorPair = Interconnection<Capacitor, Capacitor, 1, 1, 2, 0>;
+/// C1 and C3 (a capacitor, or another model of one coordinate), joined only through the rest of
+/// the circuit.
+pub type CapacitorPair<C3 = Capacitor> = Interconnection<Capacitor, C3, 1, 1, 2, 0>;
 /// The LC circuit built from its two subcircuits joined by Kirchhoff's current law.
-pub type LcFromSubcircuits = Interconnection<SeriesLoop, CapacitorPair, 2, 2, 4, 1>;
+pub type LcFromSubcircuits<C3 = Capacitor> =
+    Interconnection<SeriesLoop, CapacitorPair<C3>, 2, 2, 4, 1>;
+
+/// The loop's junction: the inductor and C2 carry one current.
+fn series() -> Junction {
+    Junction::new("series").flow("l.q", 1.0).flow("c2.q", -1.0)
+}
+
+/// KCL where C2's current splits into C1's and C3's, the loop and the pair included as `loop`
+/// and `pair`.
+fn kcl() -> Junction {
+    Junction::new("kcl")
+        .flow("loop.c2.q", 1.0)
+        .flow("pair.c1.q", -1.0)
+        .flow("pair.c3.q", -1.0)
+}
 
 /// The circuit `c` from five components: the loop (inductor and C2 carry one current), the pair
 /// (C1, C3), and KCL at the node where C2's current splits into C1's and C3's. Coordinates:
 /// `loop.l.q, loop.c2.q, pair.c1.q, pair.c3.q` (the monolithic circuit's `q_l, q_c2, q_c1,
 /// q_c3`).
 pub fn lc_from_subcircuits(c: &LcCircuit) -> Result<LcFromSubcircuits, DiracError> {
+    lc_from_subcircuits_with(c, Capacitor { c: c.c3 })
+}
+
+/// [`lc_from_subcircuits`] with `c3` in C3's place (`c.c3` unused).
+pub fn lc_from_subcircuits_with<C3: DiracSystem<1>>(
+    c: &LcCircuit,
+    c3: C3,
+) -> Result<LcFromSubcircuits<C3>, DiracError> {
     let series = Interconnection::new(
         ("l", Inductor { l: c.l }),
         ("c2", Capacitor { c: c.c2 }),
-        [Junction::new("series").flow("l.q", 1.0).flow("c2.q", -1.0)],
+        [series()],
     )?;
-    let pair = Interconnection::new(
-        ("c1", Capacitor { c: c.c1 }),
-        ("c3", Capacitor { c: c.c3 }),
-        [],
-    )?;
-    Interconnection::new(
-        ("loop", series),
-        ("pair", pair),
-        [Junction::new("kcl")
-            .flow("loop.c2.q", 1.0)
-            .flow("pair.c1.q", -1.0)
-            .flow("pair.c3.q", -1.0)],
-    )
+    let pair = Interconnection::new(("c1", Capacitor { c: c.c1 }), ("c3", c3), [])?;
+    Interconnection::new(("loop", series), ("pair", pair), [kcl()])
 }
 
 /// The seed's circuit with unequal parallel capacitors (C3 = 2 C1).
@@ -220,22 +233,26 @@ pub const UNEQUAL_START: ([f64; 4], [f64; 4]) =
 /// coordinates as [`lc_from_subcircuits`]'s. C1 ∥ C3 is a hidden constraint across the
 /// components, `q_c1/c1 = q_c3/c3`, held at every step's end.
 pub fn lc_by_parts(c: &LcCircuit, h: f64) -> Result<Modular, DiracError> {
-    let mut series = Modular::new(Quadrature::midpoint(), h)?;
-    series.add("l", Inductor { l: c.l })?;
-    series.add("c2", Capacitor { c: c.c2 })?;
-    series.join(Junction::new("series").flow("l.q", 1.0).flow("c2.q", -1.0))?;
+    lc_by_parts_with(c, Capacitor { c: c.c3 }, h)
+}
+
+/// [`lc_by_parts`] with `c3` in C3's place (`c.c3` unused).
+pub fn lc_by_parts_with<C3: DiracSystem<1> + Send + 'static>(
+    c: &LcCircuit,
+    c3: C3,
+    h: f64,
+) -> Result<Modular, DiracError> {
+    let mut series_loop = Modular::new(Quadrature::midpoint(), h)?;
+    series_loop.add("l", Inductor { l: c.l })?;
+    series_loop.add("c2", Capacitor { c: c.c2 })?;
+    series_loop.join(series())?;
     let mut pair = Modular::new(Quadrature::midpoint(), h)?;
     pair.add("c1", Capacitor { c: c.c1 })?;
-    pair.add("c3", Capacitor { c: c.c3 })?;
+    pair.add("c3", c3)?;
     let mut circuit = Modular::new(Quadrature::midpoint(), h)?;
-    circuit.include("loop", series)?;
+    circuit.include("loop", series_loop)?;
     circuit.include("pair", pair)?;
-    circuit.join(
-        Junction::new("kcl")
-            .flow("loop.c2.q", 1.0)
-            .flow("pair.c1.q", -1.0)
-            .flow("pair.c3.q", -1.0),
-    )?;
+    circuit.join(kcl())?;
     Ok(circuit)
 }
 

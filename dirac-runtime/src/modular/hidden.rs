@@ -97,8 +97,9 @@ impl Hidden {
         // The first component with degenerate coordinates whose forms are not constant.
         let mut varying: Option<usize> = None;
         for (c, component) in components.iter().enumerate() {
-            let range = component.first..component.first + component.part.coordinates();
-            let found = component.part.degenerate(&q[range.clone()], &v[range]);
+            let found = component
+                .part
+                .degenerate(&q[range_of(component)], &v[range_of(component)]);
             let name =
                 |i: usize| format!("{}.{}", component.name, component.part.coordinate_name(i));
             if let Some(i) = found.turning {
