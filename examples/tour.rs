@@ -83,6 +83,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     ] {
         reports.push(rolling_ball::report(point)?);
     }
+    reports.push(scenes::shafted_body::report()?);
     reports.push(scenes::satellite::report()?);
     scenes::print_table(&reports);
     scenes::save_table(&reports, "output/tour.csv")?;

@@ -88,6 +88,9 @@ pub struct GroupEulerLagrange<S, const N: usize, C: ConfigurationSpace<N>> {
     /// Where the force and one-form rows put their Jacobian when Newton asks for the residual
     /// alone.
     scratch: DMatrix<f64>,
+    /// The junctions' impulse on the model as a component of a modular interconnection and its
+    /// share on `p_k`'s equation (see [`set_coupling`](Self::set_coupling)); `None` alone.
+    coupling: Option<(SVector<f64, N>, f64)>,
 }
 
 impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
@@ -126,8 +129,41 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             covectors: StepCovectors::zero(),
             covectors_pending: false,
             scratch: DMatrix::zeros(0, 0),
+            coupling: None,
             discrete,
         })
+    }
+
+    /// The junctions' impulse `ι = Σ_j μ_j a_j` on this component over the next step, a
+    /// covector read in the chart at each end of the step: its share `σ ι` enters the rows of
+    /// `p_k`'s equation (in the chart at `q_k`) and the rest the momentum `p_{k+1}` (in the chart
+    /// at `q_{k+1}`). A junction's form is thus the same covector in the chart at every point
+    /// (on a rotation, a fixed covector of the body angular velocity) and, as a constant form on
+    /// `Rⁿ`, gives the same positions for any `σ`: the start's and the next step's shares meet
+    /// in one chart. `σ` is the interconnection's.
+    pub(crate) fn set_coupling(&mut self, impulse: &SVector<f64, N>, share: f64) {
+        self.coupling = Some((*impulse, share));
+    }
+
+    /// The one-forms read in the chart at `q`, at `ξ = 0` (rows over the chart coordinates).
+    pub(crate) fn forms(&self, q: &Point<C, N, f64>) -> DMatrix<f64> {
+        self.forms_at(q)
+    }
+
+    /// `∂ℓ/∂ξ̇` and `∂²ℓ/∂ξ̇²` at `(0, ξ̇)` in the chart at `q`.
+    pub(crate) fn legendre_in_chart(
+        &self,
+        q: &Point<C, N, f64>,
+        xi_dot: &SVector<f64, N>,
+    ) -> (SVector<f64, N>, nalgebra::SMatrix<f64, N, N>) {
+        let l = seeded(
+            &self.chart(q),
+            &SVector::zeros(),
+            xi_dot,
+            Seed::VELOCITY,
+            Seed::VELOCITY,
+        );
+        (l.first, l.mixed)
     }
 
     /// The discrete Lagrangian.
@@ -372,6 +408,13 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
         );
         self.covectors_pending = lagrangian.is_none();
         let mut covectors = lagrangian.unwrap_or_else(StepCovectors::zero);
+        if let Some((impulse, share)) = self.coupling {
+            // The end's share is added to `p_{k+1}` in its own chart (`advance`).
+            for i in 0..N {
+                residual[i] += share * impulse[i];
+            }
+            covectors.impulse += impulse;
+        }
         if !S::FORCES && S::ONE_FORMS == 0 {
             self.covectors = covectors;
             return scale;
@@ -457,6 +500,16 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             self.covectors_pending,
             step,
         )?;
+        if let Some((impulse, share)) = self.coupling {
+            let zero = SVector::zeros();
+            let end = space.pull_back(&next.q, &zero, &next.p) + impulse * (1.0 - share);
+            next.p = self
+                .covector(&next.q, &zero, end)
+                .ok_or_else(|| DiracError::NonFinite {
+                    what: format!("the momentum after step {step} (try a smaller step)"),
+                    value: f64::NAN,
+                })?;
+        }
         let points = <C::Manifold as Manifold<N>>::point_components(&next.q);
         let momenta = <C::Manifold as Manifold<N>>::tangent_components(&next.p);
         if !finite(&points) || !finite(&momenta) {

@@ -36,10 +36,10 @@ pub trait Manifold<const N: usize>:
     Copy + Debug + Default + PartialEq + Send + Sync + 'static
 {
     /// A point over the scalar `D`.
-    type Point<D: Scalar>: Copy + Debug + PartialEq;
+    type Point<D: Scalar>: Copy + Debug + PartialEq + Send + Sync;
     /// A tangent vector over `D` as the model reads velocities; covectors are held in the same
     /// representation.
-    type Tangent<D: Scalar>: Copy + Debug + PartialEq;
+    type Tangent<D: Scalar>: Copy + Debug + PartialEq + Send + Sync;
 
     /// Number of the model's variables (named by
     /// [`DiracSystem::coordinate_name`](crate::DiracSystem::coordinate_name)).
@@ -69,6 +69,11 @@ pub trait Manifold<const N: usize>:
     /// The numbers that represent a tangent vector or covector, in the order of
     /// [`tangent_names`](Self::tangent_names).
     fn tangent_components(vector: &Self::Tangent<f64>) -> Vec<f64>;
+
+    /// The point the numbers `values` represent (the inverse of
+    /// [`point_components`](Self::point_components)); `None` for the wrong count. The point
+    /// may lie off the manifold: [`violation`](Self::violation) says whether it does.
+    fn point_from_components(values: &[f64]) -> Option<Self::Point<f64>>;
 
     /// Names of the numbers of a point, from the names of the model's variables.
     fn point_names(variables: &[String]) -> Vec<String>;
@@ -131,6 +136,10 @@ impl<const N: usize> Manifold<N> for Vectors {
 
     fn tangent_components(vector: &SVector<f64, N>) -> Vec<f64> {
         vector.iter().copied().collect()
+    }
+
+    fn point_from_components(values: &[f64]) -> Option<SVector<f64, N>> {
+        (values.len() == N).then(|| SVector::from_column_slice(values))
     }
 
     fn point_names(variables: &[String]) -> Vec<String> {

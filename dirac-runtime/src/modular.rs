@@ -48,29 +48,30 @@
 //! # Ok::<(), dirac_runtime::DiracError>(())
 //! ```
 
+mod component;
 mod hidden;
 
 use std::collections::{HashMap, HashSet};
 
-use nalgebra::{DMatrix, DVector, SVector};
+use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use crate::banded::Banded;
 use crate::bordered::Bordered;
-use crate::configuration_space::Euclidean;
+use crate::configuration_space::ConfigurationSpace;
 use crate::constraint_point::ConstraintPoint;
-use crate::derivatives::{Seed, degenerate, seeded};
 use crate::discrete_lagrangian::DiscreteLagrangian;
 use crate::error::DiracError;
 use crate::euler_lagrange::EulerLagrange;
-use crate::hidden_constraint::{HiddenConstraints, Rows, constant_forms, degenerate_rows};
+use crate::group_euler_lagrange::GroupEulerLagrange;
 use crate::interconnection::Junction;
 use crate::jacobian::Jacobian;
+use crate::manifold::Manifold;
 use crate::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport, exceeds, largest};
 use crate::predictor::Predictor;
 use crate::quadrature::Quadrature;
-use crate::step_equations::{State, StepEquations};
 use crate::system::DiracSystem;
+use component::{Model, Part};
 use hidden::Hidden;
 
 /// Components per parallel task.
@@ -100,6 +101,8 @@ pub struct Modular {
     constrained: Option<usize>,
     /// The number of coordinates of all components.
     total: usize,
+    /// The number of position numbers of all components.
+    total_positions: usize,
     /// The run (boxed: a step takes it out and puts it back).
     run: Option<Box<Running>>,
 }
@@ -111,6 +114,8 @@ struct Component {
     part: Box<dyn Part>,
     /// Its first coordinate among all.
     first: usize,
+    /// Its first position number among all.
+    position: usize,
     /// Its first unknown among a step's.
     offset: usize,
     /// The junction terms on it: `(junction, coordinate, coefficient)`.
@@ -197,6 +202,7 @@ impl Modular {
             junction_names: HashSet::new(),
             constrained: None,
             total: 0,
+            total_positions: 0,
             run: None,
         })
     }
@@ -228,6 +234,100 @@ impl Modular {
     where
         S: DiracSystem<M> + Send + 'static,
     {
+        self.check_name(name)?;
+        let discrete = DiscreteLagrangian::new(system, self.quadrature.clone(), self.h);
+        self.insert(name, Box::new(Model::new(EulerLagrange::new(discrete)?)))
+    }
+
+    /// Adds the component `system`, a model on the configuration space `space` (rotations, with
+    /// ordinary coordinates or not: a [`Product`](crate::product::Product)), stepped by its
+    /// discrete Euler–Lagrange equations in the moving chart
+    /// ([`GroupEulerLagrange`]), as the instance `name`.
+    ///
+    /// Its coordinates, which junctions name, are the chart's: a rotation `R` gives
+    /// `name.R_x`, `name.R_y`, `name.R_z`, the body angular velocity `Ω` (`Ṙ = R Ω̂`), so a
+    /// junction on them is a fixed covector of `Ω` (a shaft along a body axis). Its velocities
+    /// and momenta ([`velocities`](Self::velocities), [`p`](Self::p)) are `Ω` and the body
+    /// angular momentum; its positions ([`q`](Self::q)) are its point's numbers, a rotation's
+    /// nine entries row by row ([`position_names`](Self::position_names)). A step holds a
+    /// junction `a · ξ = …` on the step's chart increment `ξ` (`R_{k+1} = R_k τ(ξ)`); its
+    /// impulse acts as `a` in the body's axes at both ends of the step (half at each, with the
+    /// midpoint). So, as a constant form on `Rⁿ`, a junction gives the same positions wherever
+    /// on the step its impulse is held: those of one model on the product space whose one-forms
+    /// are the junctions read in the chart at the step's start (`ConstraintPoint::Start`), whose
+    /// multipliers are the averages of two consecutive ones here.
+    ///
+    /// Fails as [`add`](Self::add) does, and on a space with unit vectors (their chart's frame
+    /// turns with the point: a junction on it would not be a fixed form). A component with a
+    /// coordinate without kinetic energy is refused at the start.
+    ///
+    /// ```
+    /// use dirac_runtime::modular::Modular;
+    /// use dirac_runtime::product::{Configuration, Product, Rates};
+    /// use dirac_runtime::{DiracSystem, Junction, Quadrature, Scalar};
+    /// use nalgebra::SVector;
+    ///
+    /// /// A free rigid body, L = ½ Ωᵀ J Ω, with its rotation named R.
+    /// struct Body;
+    /// impl DiracSystem<3, Product<0, 1, 0>> for Body {
+    ///     fn lagrangian<D: Scalar>(&self, _q: &Configuration<D, 0, 1, 0>, v: &Rates<D, 0, 1, 0>) -> D {
+    ///         let w = v.rotation[0];
+    ///         (w[0] * w[0] + w[1] * w[1] * 2.0 + w[2] * w[2] * 3.0) * 0.5
+    ///     }
+    ///     fn coordinate_name(&self, _i: usize) -> String {
+    ///         "R".into()
+    ///     }
+    /// }
+    /// /// A flywheel on the body's third axis.
+    /// struct Wheel;
+    /// impl DiracSystem<1> for Wheel {
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] * 0.5
+    ///     }
+    /// }
+    /// let mut model = Modular::new(Quadrature::midpoint(), 0.01)?;
+    /// model.add_on_space("body", Body, Product::cayley())?;
+    /// model.add("wheel", Wheel)?;
+    /// model.join(Junction::new("shaft").flow("body.R_z", 1.0).flow("wheel.q0", -1.0))?;
+    /// assert_eq!(model.coordinate_names(), ["body.R_x", "body.R_y", "body.R_z", "wheel.q0"]);
+    /// assert_eq!(model.positions(), 10);
+    /// // At rest, spinning about the third axis at 1 rad/s.
+    /// let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    /// model.start_from_velocity(&identity, &[0.0, 0.0, 1.0, 1.0])?;
+    /// model.run(100)?;
+    /// // About a principal axis the spin stays: about one radian turned, by the body and the wheel.
+    /// let (q, v) = (model.q(), model.velocities()?);
+    /// assert!((q[0] - 1.0_f64.cos()).abs() < 1e-4 && (q[9] - 1.0).abs() < 1e-4);
+    /// assert!((v[2] - 1.0).abs() < 1e-12 && (v[3] - 1.0).abs() < 1e-12);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn add_on_space<S, C, const N: usize>(
+        &mut self,
+        name: &str,
+        system: S,
+        space: C,
+    ) -> Result<(), DiracError>
+    where
+        S: DiracSystem<N, C::Manifold> + Send + 'static,
+        C: ConfigurationSpace<N> + Send + 'static,
+    {
+        self.check_name(name)?;
+        let tangent = <C::Manifold as Manifold<N>>::zero::<f64>();
+        if <C::Manifold as Manifold<N>>::tangent_components(&tangent).len() != N {
+            return Err(DiracError::Unsupported(format!(
+                "{name}: unit vectors in a modular interconnection (their chart's frame turns \
+                 with the point, so a junction on its coordinates would not be a fixed form)"
+            )));
+        }
+        let discrete = DiscreteLagrangian::on_space(system, space, self.quadrature.clone(), self.h);
+        self.insert(
+            name,
+            Box::new(Model::new(GroupEulerLagrange::new(discrete)?)),
+        )
+    }
+
+    /// Refuses an instance name that is empty, contains `.`, or is taken.
+    fn check_name(&self, name: &str) -> Result<(), DiracError> {
         let invalid = |why: String| Err(DiracError::InvalidInterconnection(why));
         if name.is_empty() || name.contains('.') {
             return invalid(format!(
@@ -237,8 +337,12 @@ impl Modular {
         if self.instances.contains_key(name) || self.nested.contains(name) {
             return invalid(format!("two instances are named {name:?}: name them apart"));
         }
-        let discrete = DiscreteLagrangian::new(system, self.quadrature.clone(), self.h);
-        let part: Box<dyn Part> = Box::new(Model::new(EulerLagrange::new(discrete)?));
+        Ok(())
+    }
+
+    /// Adds `part` as the instance `name` (checked).
+    fn insert(&mut self, name: &str, part: Box<dyn Part>) -> Result<(), DiracError> {
+        let invalid = |why: String| Err(DiracError::InvalidInterconnection(why));
         if let Some(other) = self.constrained.map(|c| &self.components[c])
             && part.one_forms()
             && other.part.point() != part.point()
@@ -251,7 +355,8 @@ impl Modular {
                 part.point()
             ));
         }
-        let coordinates: Vec<String> = (0..M)
+        let m = part.coordinates();
+        let coordinates: Vec<String> = (0..m)
             .map(|i| format!("{name}.{}", part.coordinate_name(i)))
             .collect();
         if let Some((i, coordinate)) = coordinates
@@ -272,16 +377,19 @@ impl Modular {
         if part.one_forms() && self.constrained.is_none() {
             self.constrained = Some(index);
         }
+        let positions = part.positions();
         self.components.push(Component {
             name: name.to_string(),
             part,
             first: self.total,
+            position: self.total_positions,
             offset: 0,
             couplings: Vec::new(),
-            impulse: vec![0.0; M],
+            impulse: vec![0.0; m],
             scale: 0.0,
         });
-        self.total += M;
+        self.total += m;
+        self.total_positions += positions;
         self.end_run();
         Ok(())
     }
@@ -319,11 +427,7 @@ impl Modular {
     /// ```
     pub fn include(&mut self, name: &str, other: Modular) -> Result<(), DiracError> {
         let invalid = |why: String| Err(DiracError::InvalidInterconnection(why));
-        if name.is_empty() || name.contains('.') {
-            return invalid(format!(
-                "the instance name {name:?} must be non-empty and without '.'"
-            ));
-        }
+        self.check_name(name)?;
         if other.quadrature != self.quadrature || other.h != self.h {
             return invalid(format!(
                 "{name} steps with {} and h = {}, this interconnection with {} and h = {}",
@@ -332,9 +436,6 @@ impl Modular {
                 self.quadrature.name(),
                 self.h
             ));
-        }
-        if self.instances.contains_key(name) || self.nested.contains(name) {
-            return invalid(format!("two instances are named {name:?}: name them apart"));
         }
         let prefix = format!("{name}.");
         if let Some(j) = other
@@ -365,6 +466,8 @@ impl Modular {
         for mut component in other.components {
             component.name = format!("{prefix}{}", component.name);
             component.first = self.total;
+            component.position = self.total_positions;
+            self.total_positions += component.part.positions();
             for i in 0..component.part.coordinates() {
                 let coordinate =
                     format!("{}.{}", component.name, component.part.coordinate_name(i));
@@ -459,6 +562,25 @@ impl Modular {
             .collect()
     }
 
+    /// The number of position numbers of all components: a coordinate each on `Rⁿ`, a
+    /// rotation's nine entries (see [`add_on_space`](Self::add_on_space)).
+    pub fn positions(&self) -> usize {
+        self.total_positions
+    }
+
+    /// `instance.number` for every position number, in the components' order (a rotation `R`
+    /// of instance `body`: `body.R_11`, `body.R_12`, …, `body.R_33`); on `Rⁿ` these are the
+    /// [`coordinate_names`](Self::coordinate_names).
+    pub fn position_names(&self) -> Vec<String> {
+        self.components
+            .iter()
+            .flat_map(|c| {
+                (0..c.part.positions())
+                    .map(move |i| format!("{}.{}", c.name, c.part.position_name(i)))
+            })
+            .collect()
+    }
+
     /// The junctions' names, in the order of their multipliers.
     pub fn junction_names(&self) -> Vec<String> {
         self.junctions.iter().map(|j| j.name.clone()).collect()
@@ -528,10 +650,10 @@ impl Modular {
     /// checks changes nothing; one refused by the first step's trial solve (singular) leaves
     /// the interconnection not started.
     pub fn start_from_velocity(&mut self, q: &[f64], v: &[f64]) -> Result<(), DiracError> {
-        let n = self.coordinates();
-        if q.len() != n || v.len() != n {
+        let (n, m) = (self.coordinates(), self.positions());
+        if q.len() != m || v.len() != n {
             return Err(DiracError::Dimension(format!(
-                "{} positions and {} velocities for {n} coordinates",
+                "{} positions and {} velocities for {m} position numbers and {n} coordinates",
                 q.len(),
                 v.len()
             )));
@@ -545,9 +667,10 @@ impl Modular {
         let mut started = Vec::with_capacity(self.components.len());
         for component in &self.components {
             let range = component.first..component.first + component.part.coordinates();
+            let at = component.position..component.position + component.part.positions();
             let state = component
                 .part
-                .checked_start(&q[range.clone()], &v[range], tolerance)
+                .checked_start(&q[at], &v[range], tolerance)
                 .map_err(|e| in_component(&component.name, e))?;
             started.push(state);
         }
@@ -887,21 +1010,25 @@ impl Modular {
         self.run.as_ref().map_or(0, |run| run.steps)
     }
 
-    /// Every coordinate's position, in the order of
-    /// [`coordinate_names`](Self::coordinate_names) (zeros before a start).
+    /// Every position number, in the order of [`position_names`](Self::position_names): on
+    /// `Rⁿ` the coordinates' positions (zeros before a start; a rotation's identity).
     pub fn q(&self) -> DVector<f64> {
-        self.gather(|part| part.q())
+        let mut all = DVector::zeros(self.positions());
+        for component in &self.components {
+            let values = component.part.q();
+            all.as_mut_slice()[component.position..component.position + values.len()]
+                .copy_from_slice(&values);
+        }
+        all
     }
 
-    /// Every coordinate's momentum.
+    /// Every coordinate's momentum, in the order of
+    /// [`coordinate_names`](Self::coordinate_names) (on a rotation, the body angular
+    /// momentum).
     pub fn p(&self) -> DVector<f64> {
-        self.gather(|part| part.p())
-    }
-
-    fn gather(&self, read: impl Fn(&dyn Part) -> Vec<f64>) -> DVector<f64> {
         let mut all = DVector::zeros(self.coordinates());
         for component in &self.components {
-            let values = read(component.part.as_ref());
+            let values = component.part.p();
             all.as_mut_slice()[component.first..component.first + values.len()]
                 .copy_from_slice(&values);
         }
@@ -1203,371 +1330,6 @@ impl VelocityLayout {
                 component.name,
                 i - component.part.coordinates()
             )
-        }
-    }
-}
-
-/// A component's Legendre rows at its position: `∂L/∂v`, `∂²L/∂v²` and its own constraint
-/// forms (one-forms, then holonomic differentials; rows over its coordinates).
-struct Legendre {
-    momentum: Vec<f64>,
-    hessian: DMatrix<f64>,
-    forms: DMatrix<f64>,
-}
-
-/// What [`Part::degenerate`] finds at a start.
-struct Degenerate {
-    /// The coordinates without kinetic energy.
-    coordinates: Vec<usize>,
-    /// Their momenta `∂L/∂v` (must be zero).
-    momenta: Vec<(usize, f64)>,
-    /// One of them whose momentum depends on the position, if any.
-    turning: Option<usize>,
-    /// The component's one-forms and holonomic differentials (rows over its coordinates).
-    forms: DMatrix<f64>,
-}
-
-/// A component's step equations and state, behind a type-erased face: components of different
-/// models and sizes sit in one interconnection.
-trait Part: Send + std::fmt::Debug {
-    fn coordinates(&self) -> usize;
-    fn coordinate_name(&self, i: usize) -> String;
-    fn one_forms(&self) -> bool;
-    fn point(&self) -> ConstraintPoint;
-    fn inputs(&self) -> usize;
-    fn input_name(&self, i: usize) -> String;
-    /// Sets input `i` (finite); whether it changed.
-    fn set_input(&mut self, i: usize, value: f64) -> bool;
-    /// The number of unknowns of a step (after [`begin`](Self::begin)).
-    fn unknowns(&self) -> usize;
-    fn unknown_name(&self, column: usize) -> String;
-    /// The checked state at `(q, v)` (its momentum `∂L/∂v`), at time 0.
-    fn checked_start(&self, q: &[f64], v: &[f64], tolerance: f64) -> Result<Started, DiracError>;
-    /// The degenerate coordinates at `(q, v)`.
-    fn degenerate(&self, q: &[f64], v: &[f64]) -> Degenerate;
-    /// Begins a run from a state [`checked_start`](Self::checked_start) returned.
-    fn begin(&mut self, state: Started);
-    /// Forgets the run (a start that failed after `begin`).
-    fn stop(&mut self);
-    /// Prepares the step and writes its predictor (read by
-    /// [`unknowns_of_step`](Self::unknowns_of_step)) from its part of the previous solutions'
-    /// extrapolation, where there is one.
-    fn predict(&mut self, previous: Option<&[f64]>);
-    /// The unknowns of the step last predicted or assembled.
-    fn unknowns_of_step(&self) -> &[f64];
-    /// The residual at `x` with the junctions' impulse (into its own buffer), the Jacobian
-    /// into `jacobian`; the size of the residual's terms.
-    fn assemble(
-        &mut self,
-        impulse: &[f64],
-        share: f64,
-        x: &[f64],
-        jacobian: Option<&mut DMatrix<f64>>,
-    ) -> f64;
-    fn residual(&self) -> &[f64];
-    /// Proposes the state after the step solved by `x`; its constraint violation.
-    fn advance(&mut self, x: &[f64], step: u64) -> Result<f64, DiracError>;
-    /// Coordinate `i` of the proposed step `q_{k+1} − q_k`.
-    fn proposed_step(&self, i: usize) -> f64;
-    /// Makes the proposed state current, at time `t`.
-    fn accept(&mut self, t: f64);
-    /// Drops a proposed state.
-    fn discard(&mut self);
-    /// Coordinate `i` of the last step taken, `q_{k+1} − q_k` (0 before one).
-    fn last_step(&self, i: usize) -> f64;
-    fn q(&self) -> Vec<f64>;
-    fn p(&self) -> Vec<f64>;
-    /// The number of its own constraints (one-forms and holonomic).
-    fn constraints(&self) -> usize;
-    /// The velocity of the last step at its end (the initial velocity before one).
-    fn velocity_hint(&self) -> Vec<f64>;
-    /// The Legendre rows at its position with velocity `v`.
-    fn legendre(&self, v: &[f64]) -> Legendre;
-    /// The energy at its position with velocity `v`.
-    fn energy(&self, v: &[f64]) -> f64;
-    /// The rows of its coordinates `dead` without their multipliers at `(q, v, t)`, with its
-    /// inputs (see [`degenerate_rows`]).
-    fn degenerate_rows(
-        &self,
-        q: &[f64],
-        v: &[f64],
-        t: f64,
-        dead: &[usize],
-        jacobians: bool,
-    ) -> Rows;
-    /// Whether its constraint forms are constant at `q`.
-    fn constant_forms(&self, q: &[f64]) -> bool;
-    /// The proposed state's position and velocity (after [`advance`](Self::advance)).
-    fn proposed(&self) -> Option<(&[f64], &[f64])>;
-    /// Moves coordinate `i` of the proposed position by `delta`.
-    fn shift_proposed(&mut self, i: usize, delta: f64);
-    /// The Lagrangian finite at the proposed state (after it was moved).
-    fn check_proposed(&self, step: u64) -> Result<(), DiracError>;
-}
-
-/// A checked initial state, type-erased.
-type Started = Box<dyn std::any::Any + Send>;
-
-/// A model on `R^M` as a component.
-struct Model<S: DiracSystem<M>, const M: usize> {
-    equations: EulerLagrange<S, M, Euclidean>,
-    state: Option<State<M>>,
-    before: Option<State<M>>,
-    proposed: Option<State<M>>,
-    x: DVector<f64>,
-    residual: DVector<f64>,
-    previous: DVector<f64>,
-}
-
-impl<S: DiracSystem<M>, const M: usize> std::fmt::Debug for Model<S, M> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Model")
-            .field("coordinates", &M)
-            .field("state", &self.state)
-            .finish()
-    }
-}
-
-impl<S: DiracSystem<M>, const M: usize> Model<S, M> {
-    fn new(equations: EulerLagrange<S, M, Euclidean>) -> Self {
-        let n = equations.unknowns();
-        Self {
-            equations,
-            state: None,
-            before: None,
-            proposed: None,
-            x: DVector::zeros(n),
-            residual: DVector::zeros(n),
-            previous: DVector::zeros(n),
-        }
-    }
-
-    fn state(&self) -> &State<M> {
-        self.state
-            .as_ref()
-            .expect("a component steps only in a run")
-    }
-}
-
-impl<S: DiracSystem<M> + Send, const M: usize> Part for Model<S, M> {
-    fn coordinates(&self) -> usize {
-        M
-    }
-
-    fn coordinate_name(&self, i: usize) -> String {
-        self.equations.coordinate_name(i)
-    }
-
-    fn one_forms(&self) -> bool {
-        S::ONE_FORMS > 0
-    }
-
-    fn point(&self) -> ConstraintPoint {
-        self.equations.constraint_point()
-    }
-
-    fn inputs(&self) -> usize {
-        S::INPUTS
-    }
-
-    fn input_name(&self, i: usize) -> String {
-        self.equations.input_name(i)
-    }
-
-    fn set_input(&mut self, i: usize, value: f64) -> bool {
-        let changed = self.equations.inputs()[i] != value;
-        self.equations.inputs_mut()[i] = value;
-        changed
-    }
-
-    fn unknowns(&self) -> usize {
-        self.equations.unknowns()
-    }
-
-    fn unknown_name(&self, column: usize) -> String {
-        self.equations.unknown_name(column)
-    }
-
-    fn checked_start(&self, q: &[f64], v: &[f64], tolerance: f64) -> Result<Started, DiracError> {
-        let (q, v) = (SVector::from_column_slice(q), SVector::from_column_slice(v));
-        let p = self.equations.momentum(&q, &v)?;
-        let state = State::<M>::new(0.0, q, p, v);
-        self.equations.check_component_start(&state, tolerance)?;
-        Ok(Box::new(state))
-    }
-
-    fn degenerate(&self, q: &[f64], v: &[f64]) -> Degenerate {
-        let (q, v) = (SVector::from_column_slice(q), SVector::from_column_slice(v));
-        let system = self.equations.discrete().system();
-        let coordinates = degenerate(system, &q, &v);
-        let p = crate::legendre::momentum(system, &q, &v);
-        let turning = EulerLagrange::<S, M, Euclidean>::turning(system, &q, &v, &coordinates);
-        Degenerate {
-            turning,
-            momenta: coordinates.iter().map(|&i| (i, p[i])).collect(),
-            coordinates,
-            forms: HiddenConstraints::forms(system, &q),
-        }
-    }
-
-    fn begin(&mut self, state: Started) {
-        let state = *state
-            .downcast::<State<M>>()
-            .expect("this component's state");
-        self.equations.begin_as_component(&state);
-        let n = self.equations.unknowns();
-        (self.x, self.residual, self.previous) =
-            (DVector::zeros(n), DVector::zeros(n), DVector::zeros(n));
-        self.state = Some(state);
-        (self.before, self.proposed) = (None, None);
-    }
-
-    fn stop(&mut self) {
-        (self.state, self.before, self.proposed) = (None, None, None);
-    }
-
-    fn predict(&mut self, previous: Option<&[f64]>) {
-        let state = *self.state();
-        let previous = previous.map(|p| {
-            self.previous.copy_from_slice(p);
-            &self.previous
-        });
-        self.equations.predict(&state, previous, &mut self.x);
-    }
-
-    fn unknowns_of_step(&self) -> &[f64] {
-        self.x.as_slice()
-    }
-
-    fn assemble(
-        &mut self,
-        impulse: &[f64],
-        share: f64,
-        x: &[f64],
-        jacobian: Option<&mut DMatrix<f64>>,
-    ) -> f64 {
-        let state = *self.state();
-        self.equations
-            .set_coupling(&SVector::from_column_slice(impulse), share);
-        self.x.copy_from_slice(x);
-        self.equations
-            .assemble(&state, &self.x, &mut self.residual, jacobian)
-    }
-
-    fn residual(&self) -> &[f64] {
-        self.residual.as_slice()
-    }
-
-    fn advance(&mut self, x: &[f64], step: u64) -> Result<f64, DiracError> {
-        let state = *self.state();
-        self.x.copy_from_slice(x);
-        let (next, violation) = self.equations.advance(&state, &self.x, step)?;
-        self.proposed = Some(next);
-        Ok(violation)
-    }
-
-    fn proposed_step(&self, i: usize) -> f64 {
-        self.proposed
-            .as_ref()
-            .map_or(0.0, |next| next.q[i] - self.state().q[i])
-    }
-
-    fn accept(&mut self, t: f64) {
-        if let Some(mut next) = self.proposed.take() {
-            next.t = t;
-            self.before = self.state.replace(next);
-        }
-    }
-
-    fn discard(&mut self) {
-        self.proposed = None;
-    }
-
-    fn last_step(&self, i: usize) -> f64 {
-        match (&self.before, &self.state) {
-            (Some(before), Some(now)) => now.q[i] - before.q[i],
-            _ => 0.0,
-        }
-    }
-
-    fn q(&self) -> Vec<f64> {
-        self.state
-            .as_ref()
-            .map_or(vec![0.0; M], |s| s.q.as_slice().to_vec())
-    }
-
-    fn p(&self) -> Vec<f64> {
-        self.state
-            .as_ref()
-            .map_or(vec![0.0; M], |s| s.p.as_slice().to_vec())
-    }
-
-    fn constraints(&self) -> usize {
-        S::ONE_FORMS + S::HOLONOMIC
-    }
-
-    fn velocity_hint(&self) -> Vec<f64> {
-        self.state().velocity.as_slice().to_vec()
-    }
-
-    fn legendre(&self, v: &[f64]) -> Legendre {
-        let (system, q) = (self.equations.discrete().system(), &self.state().q);
-        let v = SVector::from_column_slice(v);
-        let l = seeded(system, q, &v, Seed::VELOCITY, Seed::VELOCITY);
-        Legendre {
-            momentum: l.first.as_slice().to_vec(),
-            hessian: DMatrix::from_column_slice(M, M, l.mixed.as_slice()),
-            forms: HiddenConstraints::forms(system, q),
-        }
-    }
-
-    fn energy(&self, v: &[f64]) -> f64 {
-        let system = self.equations.discrete().system();
-        crate::legendre::energy(system, &self.state().q, &SVector::from_column_slice(v))
-    }
-
-    fn degenerate_rows(
-        &self,
-        q: &[f64],
-        v: &[f64],
-        t: f64,
-        dead: &[usize],
-        jacobians: bool,
-    ) -> Rows {
-        let (q, v) = (SVector::from_column_slice(q), SVector::from_column_slice(v));
-        let system = self.equations.discrete().system();
-        degenerate_rows(
-            system,
-            dead,
-            (&q, &v, t),
-            self.equations.inputs(),
-            jacobians,
-        )
-    }
-
-    fn constant_forms(&self, q: &[f64]) -> bool {
-        let system = self.equations.discrete().system();
-        constant_forms(system, &SVector::from_column_slice(q))
-    }
-
-    fn proposed(&self) -> Option<(&[f64], &[f64])> {
-        let next = self.proposed.as_ref()?;
-        Some((next.q.as_slice(), next.velocity.as_slice()))
-    }
-
-    fn shift_proposed(&mut self, i: usize, delta: f64) {
-        if let Some(next) = self.proposed.as_mut() {
-            next.q[i] += delta;
-        }
-    }
-
-    fn check_proposed(&self, step: u64) -> Result<(), DiracError> {
-        match &self.proposed {
-            Some(next) => self
-                .equations
-                .discrete()
-                .check_end(&next.q, &next.velocity, step),
-            None => Ok(()),
         }
     }
 }

@@ -321,6 +321,24 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Manifold<N>
         out
     }
 
+    fn point_from_components(values: &[f64]) -> Option<Configuration<f64, K, A, B>> {
+        if values.len() != K + 9 * A + 3 * B {
+            return None;
+        }
+        let rotations = &values[K..K + 9 * A];
+        let directions = &values[K + 9 * A..];
+        Some(Configuration {
+            vector: SVector::from_column_slice(&values[..K]),
+            // Row by row, as `point_components` writes them.
+            rotation: std::array::from_fn(|a| {
+                Matrix3::from_row_slice(&rotations[9 * a..9 * a + 9])
+            }),
+            direction: std::array::from_fn(|b| {
+                Vector3::from_column_slice(&directions[3 * b..3 * b + 3])
+            }),
+        })
+    }
+
     fn point_names(variables: &[String]) -> Vec<String> {
         let mut names: Vec<String> = variables[..K].to_vec();
         for r in &variables[K..K + A] {
@@ -804,6 +822,22 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A point's numbers give the point back, and the wrong count gives none.
+    #[test]
+    fn a_point_is_its_numbers() {
+        let space = Product::<1, 2, 1>::cayley();
+        let xi = SVector::<f64, 9>::from_fn(|i, _| 0.1 * (i as f64 + 1.0) - 0.45);
+        let q = space.retract(&<Product<1, 2, 1> as Manifold<9>>::origin(), &xi);
+        let numbers = <Product<1, 2, 1> as Manifold<9>>::point_components(&q);
+        assert_eq!(numbers.len(), 1 + 18 + 3);
+        let back = <Product<1, 2, 1> as Manifold<9>>::point_from_components(&numbers);
+        assert_eq!(back, Some(q));
+        assert_eq!(
+            <Product<1, 2, 1> as Manifold<9>>::point_from_components(&numbers[1..]),
+            None
+        );
+    }
 
     /// The chart maps of `R × SO(3) × S²` keep the pairing of momenta and velocities: a chart
     /// covector pushed to the manifold pairs with the pushed velocity as it paired in the chart,

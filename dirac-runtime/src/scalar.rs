@@ -16,6 +16,6 @@ use num_dual::DualNum;
 /// }
 /// assert_eq!(spring_energy(2.0, 3.0_f64), 9.0);
 /// ```
-pub trait Scalar: DualNum<Primitive = f64> + Copy {}
+pub trait Scalar: DualNum<Primitive = f64> + Copy + Send + Sync {}
 
-impl<T: DualNum<Primitive = f64> + Copy> Scalar for T {}
+impl<T: DualNum<Primitive = f64> + Copy + Send + Sync> Scalar for T {}

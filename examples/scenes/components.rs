@@ -54,6 +54,13 @@ pub struct Damper {
     pub c: f64,
 }
 
+/// A flywheel on a shaft, its coordinate its angle: L = ½ i θ̇².
+#[dirac_system(coordinates(theta), lagrangian = 0.5 * i * dot(theta).powi(2))]
+#[derive(Debug, Clone, Copy)]
+pub struct Flywheel {
+    pub i: f64,
+}
+
 /// A mass on a spring to the ground: L = ½ m ẋ² − ½ k x².
 #[dirac_system(coordinates(x), lagrangian = 0.5 * m * dot(x).powi(2) - 0.5 * k * x.powi(2))]
 #[derive(Debug, Clone, Copy)]

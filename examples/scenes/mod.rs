@@ -30,6 +30,7 @@ pub mod rigid_chain;
 pub mod rolling_ball;
 pub mod rolling_disk;
 pub mod satellite;
+pub mod shafted_body;
 pub mod spherical_pendulum;
 pub mod study;
 

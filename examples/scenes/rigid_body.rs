@@ -121,10 +121,13 @@ pub fn symmetric(
 }
 
 /// The heavy top's motion as an ODE in the unit quaternion `q` (attitude) and the body momentum
-/// `Π`: `q̇ = ½ q ⊗ (0, Ω)`, `Π̇ = Π × Ω + m g (Rᵀe₃) × ρ`, `Ω = J⁻¹Π`.
+/// `Π`: `q̇ = ½ q ⊗ (0, Ω)`, `Π̇ = Π × Ω + m g (Rᵀe₃) × ρ − i Ω₃ e₃ × Ω`, `Ω = J⁻¹Π`. The last
+/// term is a flywheel of inertia `i` whose rate is `Ω₃` and whose momentum does not turn with
+/// the body (`J` then holds `i` on its third axis; see `shafted_body`).
 struct QuaternionOde {
     top: HeavyTop,
     inverse: Matrix3<f64>,
+    wheel: f64,
 }
 
 type Y = ode_solvers::SVector<f64, 7>;
@@ -142,7 +145,8 @@ impl System<f64, Y> for QuaternionOde {
         let r = rotation_of(&[w, x, yq, z]);
         let up = r.transpose() * Vector3::z();
         let rho = Vector3::from(self.top.rho);
-        let torque = up.cross(&rho) * (self.top.m * self.top.g);
+        let torque = up.cross(&rho) * (self.top.m * self.top.g)
+            - Vector3::z().cross(&omega) * (self.wheel * omega[2]);
         let rate = pi.cross(&omega) + torque;
         dy[4] = rate[0];
         dy[5] = rate[1];
@@ -215,12 +219,30 @@ pub fn reference(
     t_end: f64,
     tolerance: f64,
 ) -> Result<(Matrix3<f64>, Vector3<f64>), String> {
-    let j = Matrix3::from_fn(|a, b| top.j[a][b]);
+    with_wheel(top, 0.0, r0, omega0, t_end, tolerance)
+}
+
+/// [`reference`] with a flywheel of inertia `wheel` on the third body axis (see
+/// [`QuaternionOde`]); the momentum returned is `J Ω` with `J` the body's and the wheel's.
+pub fn with_wheel(
+    top: &HeavyTop,
+    wheel: f64,
+    r0: &Matrix3<f64>,
+    omega0: &Vector3<f64>,
+    t_end: f64,
+    tolerance: f64,
+) -> Result<(Matrix3<f64>, Vector3<f64>), String> {
+    let mut j = Matrix3::from_fn(|a, b| top.j[a][b]);
+    j[(2, 2)] += wheel;
     let inverse = j.try_inverse().ok_or("a singular inertia")?;
     let pi0 = j * omega0;
     let q0 = quaternion_of(r0);
     let y0 = Y::from([q0[0], q0[1], q0[2], q0[3], pi0[0], pi0[1], pi0[2]]);
-    let ode = QuaternionOde { top: *top, inverse };
+    let ode = QuaternionOde {
+        top: *top,
+        inverse,
+        wheel,
+    };
     let end = super::peers::dop853_end(ode, y0, t_end, tolerance)?;
     Ok((
         rotation_of(&[end[0], end[1], end[2], end[3]]),

@@ -99,7 +99,7 @@ impl Hidden {
         for (c, component) in components.iter().enumerate() {
             let found = component
                 .part
-                .degenerate(&q[range_of(component)], &v[range_of(component)]);
+                .degenerate(&q[positions_of(component)], &v[range_of(component)]);
             let name =
                 |i: usize| format!("{}.{}", component.name, component.part.coordinate_name(i));
             if let Some(i) = found.turning {
@@ -119,7 +119,7 @@ impl Hidden {
                 )));
             }
             if !found.coordinates.is_empty()
-                && !component.part.constant_forms(&q[range_of(component)])
+                && !component.part.constant_forms(&q[positions_of(component)])
             {
                 varying.get_or_insert(c);
             }
@@ -219,7 +219,7 @@ impl Hidden {
             let other: Vec<f64> = v[range.clone()].iter().map(|x| x + 1.0 + x.abs()).collect();
             for velocity in [&v[range.clone()], &other[..]] {
                 let rows = component.part.degenerate_rows(
-                    &q[range.clone()],
+                    &q[positions_of(component)],
                     velocity,
                     0.0,
                     &owner.coordinates,
@@ -315,7 +315,7 @@ impl Hidden {
         for owner in &self.owners {
             let component = &components[owner.component];
             let (q, v) = match at {
-                At::Given(q, v) => (&q[range_of(component)], &v[range_of(component)]),
+                At::Given(q, v) => (&q[positions_of(component)], &v[range_of(component)]),
                 At::Proposed => component.part.proposed().ok_or_else(|| {
                     in_component(
                         &component.name,
@@ -418,11 +418,11 @@ impl Hidden {
         components: &[Component],
         ranked: usize,
     ) -> Result<Vec<Coupling>, DiracError> {
-        let mut q = vec![0.0; components.iter().map(|c| c.part.coordinates()).sum()];
-        let mut v = q.clone();
+        let mut q = vec![0.0; components.iter().map(|c| c.part.positions()).sum()];
+        let mut v = vec![0.0; components.iter().map(|c| c.part.coordinates()).sum()];
         for owner in &self.owners {
             let component = &components[owner.component];
-            q[range_of(component)].copy_from_slice(&component.part.q());
+            q[positions_of(component)].copy_from_slice(&component.part.q());
             v[range_of(component)].copy_from_slice(&component.part.velocity_hint());
         }
         let at = self.evaluate(components, At::Given(&q, &v), 0.0, true)?;
@@ -495,6 +495,11 @@ impl Projection for Across<'_> {
 /// The coordinates of `component` among all.
 fn range_of(component: &Component) -> std::ops::Range<usize> {
     component.first..component.first + component.part.coordinates()
+}
+
+/// The position numbers of `component` among all (its coordinates, on `Rⁿ`).
+fn positions_of(component: &Component) -> std::ops::Range<usize> {
+    component.position..component.position + component.part.positions()
 }
 
 /// A basis of the null space of the matrix of sparse `rows` (`(column, value)` entries) over
