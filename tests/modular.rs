@@ -8,7 +8,9 @@ mod scenes;
 use dirac::interconnection::{Interconnection, Junction};
 use dirac::nalgebra::DVector;
 use dirac::prelude::*;
-use scenes::components::{Capacitor, Damper, Inductor, Mass, MassSpring, Resistor, Source, Spring};
+use scenes::components::{
+    Capacitor, Damper, Inductor, Mass, MassSpring, Modulated, Resistor, Source, Spring,
+};
 use scenes::{circuit, ladder, motor};
 
 /// Steps `parts` and `whole` side by side `steps` times, running `check` on the parts after each
@@ -961,28 +963,6 @@ struct Wire;
 impl DiracSystem<1> for Wire {
     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, _v: &SVector<D, 1>) -> D {
         q[0] * 0.0
-    }
-}
-
-/// A capacitor whose voltage is modulated in time: `V = q − cos(t) q`.
-struct Modulated;
-
-impl DiracSystem<1> for Modulated {
-    const FORCES: bool = true;
-    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, _v: &SVector<D, 1>) -> D {
-        -(q[0] * q[0]) * 0.5
-    }
-    fn force<D: Scalar>(
-        &self,
-        q: &SVector<D, 1>,
-        _v: &SVector<D, 1>,
-        t: f64,
-        _u: &[D],
-    ) -> SVector<D, 1> {
-        SVector::from([q[0] * t.cos()])
-    }
-    fn coordinate_name(&self, _i: usize) -> String {
-        "q".into()
     }
 }
 

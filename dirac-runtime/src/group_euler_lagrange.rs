@@ -413,7 +413,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             for i in 0..N {
                 residual[i] += share * impulse[i];
             }
-            covectors.impulse += impulse;
+            covectors.impulse += impulse * share;
         }
         if !S::FORCES && S::ONE_FORMS == 0 {
             self.covectors = covectors;

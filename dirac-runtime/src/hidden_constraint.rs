@@ -453,6 +453,18 @@ pub(crate) struct Rows {
     pub scale: f64,
 }
 
+impl Rows {
+    /// No rows, over `columns` coordinates.
+    pub(crate) fn empty(columns: usize) -> Self {
+        Self {
+            value: DVector::zeros(0),
+            by_q: DMatrix::zeros(0, columns),
+            by_v: DMatrix::zeros(0, columns),
+            scale: 0.0,
+        }
+    }
+}
+
 /// Hidden constraints `c(q) = 0` held by moving `q` along free directions `Z`: what [`hold`]
 /// reads and moves. A model's own ([`HiddenConstraints::project`]) and an interconnection's
 /// across its components (the modular step) are held alike.

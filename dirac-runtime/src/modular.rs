@@ -9,7 +9,7 @@
 //!
 //! ```text
 //! R_c(x_c) + σ Σ_j μ_j a_j^c = 0      (the rows of p_k's equation; σ the impulse's share)
-//! Σ_c a_j^c · ξ^c              = 0      (junction j, ξ^c = q_{k+1}^c − q_k^c)
+//! Σ_c a_j^c · ξ^c              = 0      (junction j, ξ^c = q_{k+1}^c − q_k^c on Rⁿ)
 //! ```
 //!
 //! and `p_{k+1}^c` gains `(1 − σ) Σ_j μ_j a_j^c`: exactly the monolithic equations. Newton's
@@ -153,7 +153,8 @@ struct Running {
 
 /// The flows and work through the junctions over the last step of a [`Modular`]
 /// interconnection: efforts `e_j = μ_j / h` and each component's port work
-/// `W_c = Σ_j e_j ⟨a_j^c, q_{k+1}^c − q_k^c⟩`.
+/// `W_c = Σ_j e_j ⟨a_j^c, ξ^c⟩`, `ξ^c` the component's step in its chart (`q_{k+1}^c − q_k^c` on
+/// `Rⁿ`, read off the stored positions).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PortWork {
     /// The junctions' efforts.
@@ -255,11 +256,12 @@ impl Modular {
     /// midpoint). So, as a constant form on `Rⁿ`, a junction gives the same positions wherever
     /// on the step its impulse is held: those of one model on the product space whose one-forms
     /// are the junctions read in the chart at the step's start (`ConstraintPoint::Start`), whose
-    /// multipliers are the averages of two consecutive ones here.
+    /// multiplier at a step is `(1 − σ) μ_{k−1} + σ μ_k` of the multipliers `μ` here (`μ_{−1} = 0`).
     ///
-    /// Fails as [`add`](Self::add) does, and on a space with unit vectors (their chart's frame
-    /// turns with the point: a junction on it would not be a fixed form). A component with a
-    /// coordinate without kinetic energy is refused at the start.
+    /// Fails as [`add`](Self::add) does, on a space without rotations (use `add`), and on a
+    /// space with unit vectors (their chart's frame turns with the point: a junction on it would
+    /// not be a fixed form). A component with a coordinate without kinetic energy is refused at
+    /// the start.
     ///
     /// ```
     /// use dirac_runtime::modular::Modular;
@@ -312,6 +314,11 @@ impl Modular {
         C: ConfigurationSpace<N> + Send + 'static,
     {
         self.check_name(name)?;
+        if <C::Manifold as Manifold<N>>::VARIABLES == N {
+            return Err(DiracError::Unsupported(format!(
+                "{name}: add_on_space takes spaces with rotations; add a model on Rⁿ with `add`"
+            )));
+        }
         let tangent = <C::Manifold as Manifold<N>>::zero::<f64>();
         if <C::Manifold as Manifold<N>>::tangent_components(&tangent).len() != N {
             return Err(DiracError::Unsupported(format!(
@@ -634,8 +641,10 @@ impl Modular {
         Ok(())
     }
 
-    /// Starts a run at time 0 from the positions `q` and velocities `v` of every coordinate
-    /// (in the order of [`coordinate_names`](Self::coordinate_names)). Each component's state
+    /// Starts a run at time 0 from the positions `q` (in the order of
+    /// [`position_names`](Self::position_names): on `Rⁿ` the coordinates') and the velocities
+    /// `v` of every coordinate (in the order of [`coordinate_names`](Self::coordinate_names): on
+    /// a rotation the body angular velocity). Each component's state
     /// is checked as a [`Stepper`](crate::Stepper) checks a model's, its degenerate rows
     /// excepted; the junctions must hold, `a_j · v = 0`. Coordinates without kinetic energy
     /// whose rows no impulse reaches combine into hidden constraints across the components
@@ -1043,7 +1052,8 @@ impl Modular {
 
     /// The largest constraint violation of the last step: the components' own (as
     /// [`Stepper::constraint_violation`](crate::Stepper::constraint_violation)) and the
-    /// junctions' `|Σ_c a_j^c · (q_{k+1}^c − q_k^c)|`.
+    /// junctions' `|Σ_c a_j^c · ξ^c|` (`ξ^c` the component's step in its chart, `q_{k+1}^c −
+    /// q_k^c` on `Rⁿ`).
     pub fn constraint_violation(&self) -> Result<f64, DiracError> {
         Ok(self.running()?.violation)
     }
@@ -1104,9 +1114,10 @@ impl Modular {
     }
 
     /// Each component's energy `E_c = ⟨∂L_c/∂v, v_c⟩ − L_c` at the current state, with the
-    /// [`velocities`](Self::velocities). With the midpoint rule, quadratic Lagrangians and the
-    /// constraint point `Midpoint`, `E_c(k+1) − E_c(k)` equals the component's port work over
-    /// the step ([`ports`](Self::ports)) to round-off.
+    /// [`velocities`](Self::velocities). On `Rⁿ`, with the midpoint rule, quadratic Lagrangians
+    /// and the constraint point `Midpoint`, `E_c(k+1) − E_c(k)` equals the component's port work
+    /// over the step ([`ports`](Self::ports)) to round-off (on rotations it does not: the
+    /// energy's error is of second order).
     pub fn energies(&self) -> Result<Vec<f64>, DiracError> {
         let v = self.velocities()?;
         Ok(self

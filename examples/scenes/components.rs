@@ -109,3 +109,31 @@ pub struct Arm {
     pub inertia: f64,
     pub mgd: f64,
 }
+
+/// A capacitor whose voltage is modulated in time: `L = −q²/2` and the force `cos(t) q`, so the
+/// voltage is `q − cos(t) q`. The modulation vanishes at `q = 0`: a test that the time
+/// dependence of a hidden constraint is found away from the start.
+#[derive(Debug, Clone, Copy)]
+pub struct Modulated;
+
+impl DiracSystem<1> for Modulated {
+    const FORCES: bool = true;
+
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, _v: &SVector<D, 1>) -> D {
+        -(q[0] * q[0]) * 0.5
+    }
+
+    fn force<D: Scalar>(
+        &self,
+        q: &SVector<D, 1>,
+        _v: &SVector<D, 1>,
+        t: f64,
+        _u: &[D],
+    ) -> SVector<D, 1> {
+        SVector::from([q[0] * t.cos()])
+    }
+
+    fn coordinate_name(&self, _i: usize) -> String {
+        "q".into()
+    }
+}

@@ -399,12 +399,7 @@ where
             dead.is_empty(),
             "no coordinates without kinetic energy here"
         );
-        Rows {
-            value: DVector::zeros(0),
-            by_q: DMatrix::zeros(0, N),
-            by_v: DMatrix::zeros(0, N),
-            scale: 0.0,
-        }
+        Rows::empty(N)
     }
 
     fn constant_forms(&self, _q: &SVector<f64, N>) -> bool {
@@ -688,13 +683,16 @@ impl<E: ComponentEquations<N> + 'static, const N: usize> Part for Model<E, N> {
         dead: &[usize],
         jacobians: bool,
     ) -> Rows {
-        let (q, v) = (SVector::from_column_slice(q), SVector::from_column_slice(v));
+        // Coordinates without kinetic energy are on Rⁿ, where positions are coordinates.
+        let Some(q) = coordinates::<N>(q) else {
+            return Rows::empty(N);
+        };
+        let v = SVector::from_column_slice(v);
         self.equations.degenerate_rows(&q, &v, t, dead, jacobians)
     }
 
     fn constant_forms(&self, q: &[f64]) -> bool {
-        self.equations
-            .constant_forms(&SVector::from_column_slice(q))
+        coordinates::<N>(q).is_some_and(|q| self.equations.constant_forms(&q))
     }
 
     fn proposed(&self) -> Option<(&[f64], &[f64])> {
@@ -720,4 +718,9 @@ impl<E: ComponentEquations<N> + 'static, const N: usize> Part for Model<E, N> {
             None => Ok(()),
         }
     }
+}
+
+/// Positions as coordinates, where they are (on `Rⁿ`).
+fn coordinates<const N: usize>(q: &[f64]) -> Option<SVector<f64, N>> {
+    (q.len() == N).then(|| SVector::from_column_slice(q))
 }

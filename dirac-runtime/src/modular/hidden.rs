@@ -249,7 +249,7 @@ impl Hidden {
         let size = 1e-2 * (1.0 + largest(q.iter().copied()));
         let shift = &self.basis * DVector::from_element(self.count(), size);
         for (k, &(c, i)) in self.dead.iter().enumerate() {
-            moved[components[c].first + i] += shift[k];
+            moved[components[c].position + i] += shift[k];
         }
         for point in [q, &moved[..]] {
             let Ok(here) = self.evaluate(components, At::Given(point, v), 0.0, false) else {
