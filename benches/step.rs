@@ -505,6 +505,20 @@ fn modular(c: &mut Criterion) {
     group.bench_function("seed_lc/modular", |b| {
         b.iter(|| black_box(parts.step()).expect("step"))
     });
+    // A rigid body turning a flywheel through a shaft: one model on R × SO(3), and by parts
+    // (the body on SO(3), the wheel on R).
+    use scenes::shafted_body::{self, WHEEL};
+    let begin = scenes::rigid_body::free_start();
+    let body = scenes::rigid_body::ASYMMETRIC;
+    let mut one = shafted_body::one_model(body, WHEEL, h, begin).expect("valid scene");
+    group.bench_function("shafted_body/one_model", |b| {
+        b.iter(|| black_box(one.step()).expect("step"))
+    });
+    let mut parts = shafted_body::by_parts(body, WHEEL, Product::cayley(), h).expect("valid scene");
+    shafted_body::start(&mut parts, begin).expect("consistent start");
+    group.bench_function("shafted_body/modular", |b| {
+        b.iter(|| black_box(parts.step()).expect("step"))
+    });
     let (q0, v0) = ladder::chain_wave(3, 0.5);
     let mut ring = Stepper::new(
         ladder::chain(1.0, 1.0).expect("valid ring"),

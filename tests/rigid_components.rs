@@ -71,19 +71,7 @@ fn a_component_on_r_times_so3_with_its_own_one_form_steps_as_on_its_own() {
     parts
         .start_from_velocity(&q, &[w0[2], w0[0], w0[1], w0[2]])
         .unwrap();
-    let mut alone =
-        Stepper::on_manifold(model, Product::cayley(), Quadrature::midpoint(), h).unwrap();
-    let q0 = Configuration {
-        vector: SVector::from([0.0]),
-        rotation: [r0],
-        direction: [],
-    };
-    let v0 = Rates {
-        vector: SVector::from([w0[2]]),
-        rotation: [w0],
-        direction: [],
-    };
-    alone.start_from_velocity(q0, v0).unwrap();
+    let mut alone = shafted_body::one_model(ASYMMETRIC, WHEEL, h, (r0, w0)).unwrap();
     let mut worst: f64 = 0.0;
     for _ in 0..1000 {
         parts.step().unwrap();
@@ -113,23 +101,7 @@ fn the_body_and_flywheel_by_parts_step_to_the_one_models_positions() {
     let (h, begin) = (0.01, rigid_body::free_start());
     let mut parts = by_parts(ASYMMETRIC, WHEEL, Product::cayley(), h).unwrap();
     shafted_body::start(&mut parts, begin).unwrap();
-    let whole = BodyOnShaft {
-        body: ASYMMETRIC,
-        wheel: WHEEL,
-    };
-    let mut one =
-        Stepper::on_manifold(whole, Product::cayley(), Quadrature::midpoint(), h).unwrap();
-    let q0 = Configuration {
-        vector: SVector::from([0.0]),
-        rotation: [begin.0],
-        direction: [],
-    };
-    let v0 = Rates {
-        vector: SVector::from([begin.1[2]]),
-        rotation: [begin.1],
-        direction: [],
-    };
-    one.start_from_velocity(q0, v0).unwrap();
+    let mut one = shafted_body::one_model(ASYMMETRIC, WHEEL, h, begin).unwrap();
     let (mut worst, mut impulse, mut before): (f64, f64, f64) = (0.0, 0.0, 0.0);
     for _ in 0..2000 {
         parts.step().unwrap();

@@ -92,6 +92,30 @@ impl DiracSystem<4, Product<1, 1, 0>> for BodyOnShaft {
     }
 }
 
+/// [`BodyOnShaft`] stepped with the midpoint rule (Cayley), started as [`start`] starts the
+/// parts: attitude `r0`, body angular velocity `omega0`, the wheel at angle 0 turning at `Ω₃`.
+pub fn one_model(
+    body: FreeBody,
+    wheel: f64,
+    h: f64,
+    (r0, omega0): (Matrix3<f64>, Vector3<f64>),
+) -> Result<ManifoldStepper<BodyOnShaft, 4, Product<1, 1, 0>>, DiracError> {
+    let model = BodyOnShaft { body, wheel };
+    let mut one = Stepper::on_manifold(model, Product::cayley(), Quadrature::midpoint(), h)?;
+    let q0 = Configuration {
+        vector: SVector::from([0.0]),
+        rotation: [r0],
+        direction: [],
+    };
+    let v0 = Rates {
+        vector: SVector::from([omega0[2]]),
+        rotation: [omega0],
+        direction: [],
+    };
+    one.start_from_velocity(q0, v0)?;
+    Ok(one)
+}
+
 /// The body's attitude and `J'Ω` at `t_end` by Dop853 at `tolerance` (see the [module](self)).
 pub fn reference(
     body: &FreeBody,
