@@ -1073,10 +1073,11 @@ impl Modular {
     }
 
     /// The junctions' multipliers of the last step: their impulses over it (zeros before the
-    /// first step). With the midpoint's share `σ = ½` they alternate step by step about the
-    /// smooth impulses at the steps' nodes, `(μ_{k−1} + μ_k)/2`, by a mode the start leaves
-    /// (on the shafted body, about 1 % of them); the positions depend on the node impulses
-    /// only, and each step's energy balance holds with its own `μ_k`.
+    /// first step). With the midpoint's share `σ = ½` they can alternate step by step about
+    /// the smooth impulses at the steps' nodes, `(μ_{k−1} + μ_k)/2`, by a mode the start leaves
+    /// where the impulse changes fast (about 1 % of them on the shafted body; nothing visible on
+    /// the LC circuits); the positions depend on the node impulses only, and each step's energy
+    /// balance holds with its own `μ_k`.
     pub fn multipliers(&self) -> Result<&[f64], DiracError> {
         Ok(&self.running()?.multipliers)
     }
