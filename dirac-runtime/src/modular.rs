@@ -141,11 +141,8 @@ struct Coupling {
 struct Running {
     newton: Newton<Bordered>,
     unknowns: DVector<f64>,
-    /// The history of the steps' unknowns, each junction's multiplier replaced by its impulse
-    /// at the step's start node (see [`Modular::node_impulses`]).
+    /// The history of the steps' unknowns (the junctions' as impulses at the steps' nodes).
     predictor: Predictor,
-    /// What the predictor records (scratch).
-    recorded: DVector<f64>,
     steps: u64,
     /// The junctions' multipliers (impulses) of the last step.
     multipliers: Vec<f64>,
@@ -731,13 +728,15 @@ impl Modular {
             newton: Newton::with_jacobian(jacobian, self.options)?,
             unknowns: DVector::zeros(unknowns),
             predictor: Predictor::new(unknowns),
-            recorded: DVector::zeros(unknowns),
             steps: 0,
             multipliers: vec![0.0; self.junctions.len()],
             violation: 0.0,
             report: None,
             hidden,
         });
+        let multipliers = unknowns - self.junctions.len()..unknowns;
+        let share = self.junction_point().share();
+        run.predictor.share_impulses(Some((multipliers, share)));
         // A model the step does not determine (dependent junctions, a component singular on
         // its own) is refused here, before the first step, naming the unknowns.
         let trial = self.solve(&mut run, true);
@@ -836,17 +835,11 @@ impl Modular {
             let range = component.offset..component.offset + component.part.unknowns();
             run.unknowns.as_mut_slice()[range].copy_from_slice(component.part.unknowns_of_step());
         }
-        let share = self.junction_point().share();
         match previous {
-            // The node impulses are smooth; the multipliers follow from them and the last ones.
-            Some(p) => {
-                for (junction, last) in self.junctions.iter().zip(&run.multipliers) {
-                    let rank = junction.rank;
-                    run.unknowns[first + rank] = (p[first + rank] - (1.0 - share) * last) / share;
-                }
-            }
+            Some(p) => run.unknowns.as_mut_slice()[first..].copy_from_slice(&p.as_slice()[first..]),
             None => run.unknowns.as_mut_slice()[first..].fill(0.0),
         }
+        let share = self.junction_point().share();
         let (components, junctions) = (&mut self.components, &self.junctions);
         let evaluate =
             |x: &DVector<f64>, r: &mut DVector<f64>, blocks: Option<&mut Vec<DMatrix<f64>>>| {
@@ -998,8 +991,7 @@ impl Modular {
             component.part.accept(t);
         }
         let first = run.unknowns.len() - self.junctions.len();
-        self.node_impulses(&mut run, first);
-        run.predictor.record(&run.recorded);
+        run.predictor.record(&run.unknowns);
         for (multiplier, junction) in run.multipliers.iter_mut().zip(&self.junctions) {
             *multiplier = run.unknowns[first + junction.rank];
         }
@@ -1008,22 +1000,6 @@ impl Modular {
         run.report = Some(report);
         self.run = Some(run);
         Ok(())
-    }
-
-    /// Writes the step's unknowns into `run.recorded` with each junction's multiplier `μ_k`
-    /// replaced by its impulse at the step's start node, `ν_k = (1 − σ) μ_{k−1} + σ μ_k` (the
-    /// last step's end share and this step's start share). The positions depend on the `ν`
-    /// alone, which are smooth in time; `μ_k = (ν_k − (1 − σ) μ_{k−1}) / σ` then carries, with
-    /// `σ = ½`, a mode `(−1)^k` of the start's making that extrapolating the `μ` mispredicts
-    /// (a Newton evaluation and a Jacobian more per step, measured on the shafted body). The
-    /// predictor extrapolates the `ν` and the step's first guess of `μ` follows from them.
-    fn node_impulses(&self, run: &mut Running, first: usize) {
-        let share = self.junction_point().share();
-        run.recorded.copy_from(&run.unknowns);
-        for (junction, last) in self.junctions.iter().zip(&run.multipliers) {
-            let at = first + junction.rank;
-            run.recorded[at] = (1.0 - share) * last + share * run.unknowns[at];
-        }
     }
 
     /// Advances `steps` steps; stops at the first error, with the state of the step before it.
