@@ -500,9 +500,14 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             self.covectors_pending,
             step,
         )?;
-        if let Some((impulse, share)) = self.coupling {
+        // The end's share of the junctions' impulse, in the chart at `q_{k+1}` (none to add for
+        // a component no junction pulls, or a share of 1).
+        let end_share = self
+            .coupling
+            .map(|(impulse, share)| impulse * (1.0 - share));
+        if let Some(end_share) = end_share.filter(|e| e.iter().any(|x| *x != 0.0)) {
             let zero = SVector::zeros();
-            let end = space.pull_back(&next.q, &zero, &next.p) + impulse * (1.0 - share);
+            let end = space.pull_back(&next.q, &zero, &next.p) + end_share;
             next.p = self
                 .covector(&next.q, &zero, end)
                 .ok_or_else(|| DiracError::NonFinite {
