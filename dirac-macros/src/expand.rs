@@ -351,7 +351,14 @@ fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
             }
         }
     });
+    let entire = closed.entire.then(|| {
+        quote!(
+            const LAGRANGIAN_ENTIRE: bool = true;
+        )
+    });
     quote! {
+        #entire
+
         #[inline]
         #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
         fn lagrangian_gradient(

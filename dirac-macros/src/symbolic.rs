@@ -185,6 +185,43 @@ impl Graph {
         self.value(id) == Some(x)
     }
 
+    /// Whether every node is finite wherever the state is (short of overflow): sums, products,
+    /// integer powers, division by what the state does not change and functions defined on
+    /// every real; no division by the state, root, logarithm or inverse with a bounded domain.
+    fn entire(&self) -> bool {
+        use Function::*;
+        self.nodes.iter().enumerate().all(|(id, node)| {
+            !self.state[id]
+                || match node {
+                    Node::Number(_)
+                    | Node::Constant(_)
+                    | Node::Variable(_)
+                    | Node::Add(..)
+                    | Node::Sub(..)
+                    | Node::Mul(..)
+                    | Node::Neg(_) => true,
+                    Node::Powi(_, k) => *k >= 0,
+                    Node::Div(_, b) => !self.state[*b],
+                    Node::Call(f, _) => matches!(
+                        f,
+                        Sin | Cos
+                            | Atan
+                            | Sinh
+                            | Cosh
+                            | Tanh
+                            | Asinh
+                            | Exp
+                            | Exp2
+                            | ExpM1
+                            | Cbrt
+                            | Abs
+                            | Signum
+                    ),
+                    Node::Powf(..) | Node::Atan2(..) => false,
+                }
+        })
+    }
+
     /// `f(a, b)` folded when both are numbers and the result is finite.
     fn folded(&mut self, a: Id, b: Id, f: fn(f64, f64) -> f64) -> Option<Id> {
         let x = f(self.value(a)?, self.value(b)?);
@@ -762,6 +799,8 @@ fn binary(a: TokenStream, op: TokenStream, b: TokenStream) -> TokenStream {
 /// a scope where the parameters are bound by name and `__q`, `__v` are the `f64` state.
 pub struct ClosedForm {
     pub gradient: TokenStream,
+    /// Whether `L` is finite at every finite state short of overflow ([`Graph::entire`]).
+    pub entire: bool,
     /// `None` when the second derivatives exceed the size bound.
     pub hessian: Option<TokenStream>,
 }
@@ -789,6 +828,8 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
         n,
     }
     .read(expr)?;
+    // Read before any derivative joins the graph: the property is the Lagrangian's own.
+    let entire = graph.entire();
     let first: Vec<Id> = (0..2 * n)
         .map(|i| graph.derivative(lagrangian, i))
         .collect();
@@ -815,6 +856,7 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
             if graph.nodes.len() > MAX_GRAPH {
                 return Some(ClosedForm {
                     gradient,
+                    entire,
                     hessian: None,
                 });
             }
@@ -862,6 +904,7 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
     };
     Some(ClosedForm {
         gradient,
+        entire,
         hessian: Some(hessian),
     })
 }

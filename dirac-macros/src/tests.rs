@@ -440,3 +440,40 @@ fn the_runtime_is_reached_by_the_given_path() {
             .contains("takes the path of the runtime crate")
     );
 }
+
+/// A Lagrangian is declared finite at every finite state only when it is built of operations
+/// defined on every real; a root, a logarithm or a division by the state keeps the check of `L`
+/// at each step's end.
+#[test]
+fn only_lagrangians_without_a_domain_are_declared_entire() {
+    let item = "struct S { m: f64, k: [f64; 2] }";
+    let declared = |lagrangian: &str| {
+        let output = expand(
+            &format!("coordinates(x, y), lagrangian = {lagrangian}"),
+            item,
+        )
+        .unwrap();
+        assert!(!is_error(&output) && parses(&output), "{output}");
+        output
+            .to_string()
+            .contains("const LAGRANGIAN_ENTIRE : bool = true")
+    };
+    for entire in [
+        "0.5 * m * dot(x).powi(2) + cos(x - y) * dot(y) - k[0] * x.powi(4)",
+        "dot(x) * dot(y) / m - exp(x) + atan(y) + x.abs()",
+        "0.5 * dot(x).powi(2) - sqrt(m) * x",
+    ] {
+        assert!(declared(entire), "{entire}");
+    }
+    for restricted in [
+        "0.5 * dot(x).powi(2) - sqrt(x)",
+        "0.5 * dot(x).powi(2) - ln(y)",
+        "0.5 * dot(x).powi(2) - m / x",
+        "0.5 * dot(x).powi(2) - x.powi(-2)",
+        "0.5 * dot(x).powi(2) - tan(x)",
+        "0.5 * dot(x).powi(2) - acos(y)",
+        "0.5 * dot(x).powi(2) - x.powf(m)",
+    ] {
+        assert!(!declared(restricted), "{restricted}");
+    }
+}

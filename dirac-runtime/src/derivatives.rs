@@ -330,7 +330,10 @@ pub(crate) fn seeded<F: PhaseFunction<N>, const N: usize>(
 
 /// `w · m`, or zeros when `w` is zero (whatever `m` holds).
 #[inline]
-fn weighted<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>, w: f64) -> SMatrix<f64, R, C> {
+pub(crate) fn weighted<const R: usize, const C: usize>(
+    m: &SMatrix<f64, R, C>,
+    w: f64,
+) -> SMatrix<f64, R, C> {
     if w == 0.0 { SMatrix::zeros() } else { m * w }
 }
 

@@ -19,7 +19,7 @@ use crate::closed_form::LagrangianHessian;
 use crate::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors, Tangent};
 use crate::derivatives::{
     InChart, PhaseFunction, Seed, directional_gradient, gradients, hessian, moving_row, seeded,
-    third_derivative,
+    third_derivative, weighted,
 };
 use crate::error::DiracError;
 use crate::manifold::Vectors;
@@ -51,6 +51,17 @@ pub struct DiscreteLagrangian<S, const N: usize, C = Euclidean> {
     space: C,
     quadrature: Quadrature,
     h: f64,
+    /// A degree-1 step's nodes with their weights (none for higher degrees).
+    pair: Vec<PairNode>,
+}
+
+/// Node `i` of a degree-1 step: its weight `w = h b_i`, the path's basis `ℓ_0(c_i), ℓ_1(c_i)`
+/// and its rates `ℓ'_0(c_i)/h, ℓ'_1(c_i)/h`, read once for every step.
+#[derive(Debug, Clone, Copy)]
+struct PairNode {
+    w: f64,
+    a: [f64; 2],
+    d: [f64; 2],
 }
 
 impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
@@ -65,11 +76,25 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
 {
     /// `L_d` for step `h`, with the step's points `R_{q_k}(ξ_j)` in `space`.
     pub fn on_space(system: S, space: C, quadrature: Quadrature, h: f64) -> Self {
+        let pair = match quadrature.degree() {
+            1 => (0..quadrature.weights().len())
+                .map(|i| PairNode {
+                    w: h * quadrature.weights()[i],
+                    a: [quadrature.ell(i, 0), quadrature.ell(i, 1)],
+                    d: [
+                        quadrature.ell_prime(i, 0) / h,
+                        quadrature.ell_prime(i, 1) / h,
+                    ],
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
         Self {
             system,
             space,
             quadrature,
             h,
+            pair,
         }
     }
 
@@ -123,13 +148,18 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
 
     /// Refuses the end of step `step` where `L(q, v)` is not finite. The quadrature may never
     /// evaluate `L` at `q_{k+1}` (the midpoint rule does not): a step that leaves the
-    /// Lagrangian's domain is refused here, not found later as NaN energies.
+    /// Lagrangian's domain is refused here, not found later as NaN energies. A Lagrangian
+    /// finite at every finite state ([`DiracSystem::LAGRANGIAN_ENTIRE`]) has no domain to
+    /// leave, and the stepper has already refused a position or momentum that is not finite.
     pub(crate) fn check_end(
         &self,
         q: &Point<C, N, f64>,
         v: &Tangent<C, N, f64>,
         step: u64,
     ) -> Result<(), DiracError> {
+        if S::LAGRANGIAN_ENTIRE {
+            return Ok(());
+        }
         let lagrangian = self.system.lagrangian(q, v);
         if lagrangian.is_finite() {
             return Ok(());
@@ -248,9 +278,15 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             return self.euler_lagrange_moving(base, increments, momentum, residual, jacobian);
         }
         let s = self.quadrature.degree();
+        if s == 1
+            && let Some(rows) =
+                self.pair_in_closed_form(base, &increments[0], momentum, residual, &mut jacobian)
+        {
+            return rows;
+        }
         let h = self.h;
-        residual.fill(0.0);
-        residual.rows_mut(0, N).copy_from(momentum);
+        residual.as_mut_slice().fill(0.0);
+        residual.fixed_rows_mut::<N>(0).copy_from(momentum);
         let mut impulse = SVector::zeros();
         let mut end = SVector::zeros();
         let mut magnitude = momentum.abs();
@@ -281,7 +317,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                         velocity: d(0),
                     };
                     let first = directional_gradient(&chart, &xi, &xi_dot, seed);
-                    let mut r = residual.rows_mut(0, N);
+                    let mut r = residual.fixed_rows_mut::<N>(0);
                     r += first * w;
                     magnitude += first.abs() * w;
                     continue;
@@ -306,7 +342,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                         let mut block = jacobian.fixed_view_mut::<N, N>(0, 0);
                         block += l.mixed * w;
                     }
-                    let mut r = residual.rows_mut(0, N);
+                    let mut r = residual.fixed_rows_mut::<N>(0);
                     r += l.first * w;
                     impulse += (l.first + l.second) * w;
                     end += l.second * w;
@@ -338,7 +374,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                 (lq.abs() + lv.abs() * s as f64 / h) * w
             };
             for j in 0..s {
-                let mut r = residual.rows_mut(j * N, N);
+                let mut r = residual.fixed_rows_mut::<N>(j * N);
                 r += (lq * a(j) + lv * d(j)) * w;
             }
         }
@@ -347,6 +383,64 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             complete.then_some(StepCovectors { impulse, end }),
             magnitude.amax(),
         )
+    }
+
+    /// [`euler_lagrange`](Self::euler_lagrange) of a degree-1 step (one pair of slots, `ξ` the
+    /// end point's increment) from the Lagrangian's closed-form derivatives: the same sums in
+    /// the same order as the general path, without its loops over the step's points. `None`,
+    /// with nothing written, where the model has no closed forms.
+    fn pair_in_closed_form(
+        &self,
+        base: &Point<C, N, f64>,
+        xi: &SVector<f64, N>,
+        momentum: &SVector<f64, N>,
+        residual: &mut DVector<f64>,
+        jacobian: &mut Option<&mut DMatrix<f64>>,
+    ) -> Option<(Option<StepCovectors<N>>, f64)> {
+        let chart = self.in_chart(base);
+        let mut row = *momentum;
+        let mut magnitude = momentum.abs();
+        let mut impulse = SVector::zeros();
+        let mut end = SVector::zeros();
+        let mut block = SMatrix::<f64, N, N>::zeros();
+        for &PairNode {
+            w,
+            a: [a0, a1],
+            d: [d0, d1],
+        } in &self.pair
+        {
+            let (node, rate) = (xi * a1, xi * d1);
+            if jacobian.is_some() {
+                // As `seeded` along the directions of ξ_0 and ξ_1.
+                let l = chart.closed_hessian(&node, &rate)?;
+                let g = &l.gradient;
+                let first = weighted(&g.q, a0) + weighted(&g.v, d0);
+                let second = weighted(&g.q, a1) + weighted(&g.v, d1);
+                block += (weighted(&l.qq, a0 * a1)
+                    + weighted(&l.qv, a0 * d1)
+                    + weighted(&l.qv.transpose(), d0 * a1)
+                    + weighted(&l.vv, d0 * d1))
+                    * w;
+                row += first * w;
+                impulse += (first + second) * w;
+                end += second * w;
+                magnitude += first.abs() * w;
+            } else {
+                let g = chart.closed_gradient(&node, &rate)?;
+                let first = g.q * a0 + g.v * d0;
+                row += first * w;
+                impulse += g.q * w;
+                end += (g.q * a1 + g.v * d1) * w;
+                magnitude += first.abs() * w;
+            }
+        }
+        residual.fixed_rows_mut::<N>(0).copy_from(&row);
+        residual.as_mut_slice()[N..].fill(0.0);
+        if let Some(jacobian) = jacobian.as_deref_mut() {
+            let mut target = jacobian.fixed_view_mut::<N, N>(0, 0);
+            target += block;
+        }
+        Some((Some(StepCovectors { impulse, end }), magnitude.amax()))
     }
 
     /// [`euler_lagrange`](Self::euler_lagrange) on a space whose charts have non-affine
@@ -365,7 +459,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     ) -> (Option<StepCovectors<N>>, f64) {
         let (quad, h) = (&self.quadrature, self.h);
         let s = quad.degree();
-        residual.fill(0.0);
+        residual.as_mut_slice().fill(0.0);
         let moving = moving_row(
             &self.system,
             &self.space,
@@ -375,7 +469,9 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             increments,
             jacobian.is_some(),
         );
-        residual.rows_mut(0, N).copy_from(&(momentum + moving.row));
+        residual
+            .fixed_rows_mut::<N>(0)
+            .copy_from(&(momentum + moving.row));
         let mut magnitude = momentum.abs() + moving.magnitude;
         if let Some(jacobian) = jacobian.as_deref_mut() {
             for (m, block) in moving.blocks.iter().enumerate() {
@@ -417,7 +513,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             end += (lq * a(s) + lv * d(s)) * w;
             magnitude += (lq.abs() + lv.abs() * s as f64 / h) * w;
             for j in 1..s {
-                let mut r = residual.rows_mut(j * N, N);
+                let mut r = residual.fixed_rows_mut::<N>(j * N);
                 r += (lq * a(j) + lv * d(j)) * w;
             }
         }

@@ -803,12 +803,15 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         // Left to `advance` where the residual did not need them.
         self.covectors_pending = lagrangian.is_none();
         let mut covectors = lagrangian.unwrap_or_else(StepCovectors::zero);
+        let more_rows = !self.collocated.is_empty() || S::FORCES || Self::constrained();
         let jacobian = match jacobian {
             Some(jacobian) => jacobian,
-            None => {
-                scratch.fill(0.0);
+            // The rows beyond the discrete Lagrangian's write their derivatives as they go.
+            None if more_rows => {
+                scratch.as_mut_slice().fill(0.0);
                 scratch
             }
+            None => scratch,
         };
         if !self.collocated.is_empty() {
             // A mixed Lagrangian: the rows of the coordinates linear in their velocities are
@@ -1081,10 +1084,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// `ξ_j = c_j h ξ̇` along the state's velocity with zero multipliers.
     fn predict(&mut self, state: &State<N>, previous: Option<&DVector<f64>>, x: &mut DVector<f64>) {
         let space = self.discrete.space();
-        let xi_dot = space
-            .chart_velocity(&state.q, &state.velocity)
-            .unwrap_or_else(SVector::zeros);
-        self.layout.predict(previous, &xi_dot, self.discrete.h(), x);
+        let xi_dot = || {
+            space
+                .chart_velocity(&state.q, &state.velocity)
+                .unwrap_or_else(SVector::zeros)
+        };
+        self.layout.predict(previous, xi_dot, self.discrete.h(), x);
         self.momentum = space.pull_back(&state.q, &SVector::zeros(), &state.p);
         for (lifted, &u) in self.lifted_inputs.iter_mut().zip(&self.inputs) {
             *lifted = Dual::from(u);
@@ -1473,18 +1478,30 @@ pub(crate) fn stale_factorisation() -> DiracError {
 }
 
 /// `Err(NonFinite)` naming the first coordinate of `x` that is not finite.
+#[inline]
 pub(crate) fn check_finite<S: DiracSystem<N>, const N: usize>(
     system: &S,
     what: &str,
     x: &SVector<f64, N>,
 ) -> Result<(), DiracError> {
-    match x.iter().position(|v| !v.is_finite()) {
-        None => Ok(()),
-        Some(i) => Err(DiracError::NonFinite {
-            what: format!("{what} of {}", system.coordinate_name(i)),
-            value: x[i],
-        }),
+    if x.as_slice().iter().all(|v| v.is_finite()) {
+        return Ok(());
     }
+    not_finite(system, what, x)
+}
+
+/// The error of [`check_finite`], off every step's path.
+#[cold]
+fn not_finite<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    what: &str,
+    x: &SVector<f64, N>,
+) -> Result<(), DiracError> {
+    let i = x.iter().position(|v| !v.is_finite()).unwrap_or(0);
+    Err(DiracError::NonFinite {
+        what: format!("{what} of {}", system.coordinate_name(i)),
+        value: x[i],
+    })
 }
 
 /// `newton` if it is sized for `n` unknowns, else a solver with its options sized for `n`, kept

@@ -229,7 +229,7 @@ pub(crate) fn symmetric_projection<
     // The first half of the projection.
     let start = seeded(system, q, &zero, Seed::POSITION, Seed::VELOCITY).mixed;
     let kick = start * shift;
-    residual.fill(0.0);
+    residual.as_mut_slice().fill(0.0);
     residual.rows_mut(0, N).copy_from(&(p + kick));
     let mut block = jacobian.fixed_view_mut::<N, N>(0, column);
     block += start;

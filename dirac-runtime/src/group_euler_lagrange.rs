@@ -378,10 +378,12 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
         x: &mut DVector<f64>,
     ) {
         let space = self.discrete.space();
-        let xi_dot = space
-            .chart_velocity(&state.q, &state.velocity)
-            .unwrap_or_else(SVector::zeros);
-        self.layout.predict(previous, &xi_dot, self.discrete.h(), x);
+        let xi_dot = || {
+            space
+                .chart_velocity(&state.q, &state.velocity)
+                .unwrap_or_else(SVector::zeros)
+        };
+        self.layout.predict(previous, xi_dot, self.discrete.h(), x);
         self.momentum = space.pull_back(&state.q, &SVector::zeros(), &state.p);
         for (lifted, &u) in self.lifted_inputs.iter_mut().zip(&self.inputs) {
             *lifted = Dual::from(u);
@@ -426,7 +428,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
         let jacobian = match jacobian {
             Some(jacobian) => jacobian,
             None => {
-                self.scratch.fill(0.0);
+                self.scratch.as_mut_slice().fill(0.0);
                 &mut self.scratch
             }
         };

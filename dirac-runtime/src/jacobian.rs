@@ -96,7 +96,7 @@ impl Jacobian for Dense {
     }
 
     fn clear(&mut self) {
-        self.matrix.fill(0.0);
+        self.matrix.as_mut_slice().fill(0.0);
     }
 
     fn fits(&self, n: usize) -> bool {

@@ -41,22 +41,26 @@ impl Layout {
 
     /// The predictor of a step: `previous` (the stepper's extrapolation of the last solutions)
     /// where there is one of the right size, else the path `ξ_j = c_j h ξ̇` along the chart
-    /// velocity `xi_dot` (`c_j = j/s`) with zero multipliers.
+    /// velocity `xi_dot()` (`c_j = j/s`) with zero multipliers.
     pub(crate) fn predict<const N: usize>(
         &self,
         previous: Option<&nalgebra::DVector<f64>>,
-        xi_dot: &nalgebra::SVector<f64, N>,
+        xi_dot: impl FnOnce() -> nalgebra::SVector<f64, N>,
         h: f64,
         x: &mut nalgebra::DVector<f64>,
     ) {
         match previous {
-            Some(previous) if previous.len() == x.len() => x.copy_from(previous),
+            Some(previous) if previous.len() == x.len() => {
+                x.copy_from_slice(previous.as_slice());
+            }
             _ => {
-                x.fill(0.0);
+                let xi_dot = xi_dot();
+                x.as_mut_slice().fill(0.0);
                 let s = self.points;
                 for j in 1..=s {
                     let c = j as f64 / s as f64;
-                    x.rows_mut(self.point(j), N).copy_from(&(xi_dot * (c * h)));
+                    x.fixed_rows_mut::<N>(self.point(j))
+                        .copy_from(&(xi_dot * (c * h)));
                 }
             }
         }

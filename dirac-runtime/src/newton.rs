@@ -416,7 +416,7 @@ impl<J: Jacobian> Newton<J> {
             return Err(NewtonFailure::Dimension { expected: n, got });
         }
         // `amax` skips a NaN that a later entry follows: test every entry.
-        if !self.residual.iter().all(|r| r.is_finite()) {
+        if !self.residual.as_slice().iter().all(|r| r.is_finite()) {
             return Err(NewtonFailure::NonFinite);
         }
         if with_jacobian {
@@ -431,8 +431,8 @@ impl<J: Jacobian> Newton<J> {
             self.factorised = true;
         }
         Ok(Evaluation {
-            residual: self.residual.amax(),
-            tolerance: self.tolerance(scale, self.jacobian_norm, x.amax()),
+            residual: amax(&self.residual),
+            tolerance: self.tolerance(scale, self.jacobian_norm, amax(x)),
         })
     }
 
@@ -476,8 +476,8 @@ impl<J: Jacobian> Newton<J> {
     {
         let mut length = 1.0;
         while length >= 1e-10 {
-            self.trial.copy_from(x);
-            self.trial.axpy(-length, &self.update, 1.0);
+            self.trial.copy_from_slice(x.as_slice());
+            subtract(&mut self.trial, length, &self.update);
             let trial = std::mem::take(&mut self.trial);
             let at_trial = self.evaluate(&trial, evaluate, true);
             self.trial = trial;
@@ -680,14 +680,14 @@ impl<J: Jacobian> Newton<J> {
         let mut kept_ratio: f64 = 0.0;
         loop {
             // The correction at x, with the factorised Jacobian: x's distance from the root.
-            self.update.copy_from(&self.residual);
+            self.update.copy_from_slice(self.residual.as_slice());
             self.jacobian.solve(self.update.as_mut_slice());
-            if !self.update.iter().all(|u| u.is_finite()) {
+            if !self.update.as_slice().iter().all(|u| u.is_finite()) {
                 return Err(self.failed(NewtonFailure::NonFinite));
             }
-            let update = self.update.amax();
+            let update = amax(&self.update);
             // Below this an update is round-off: never asked for, never measured.
-            let noise = options.step_tolerance.max(64.0 * f64::EPSILON) * (1.0 + x.amax());
+            let noise = options.step_tolerance.max(64.0 * f64::EPSILON) * (1.0 + amax(x));
             let within = at_x.residual <= at_x.tolerance;
             // The Jacobian of the iterate before the last update, or of this one.
             let current = jacobian_at.is_some_and(|at| at + 1 >= updates);
@@ -696,7 +696,7 @@ impl<J: Jacobian> Newton<J> {
             // of that step off (and that last step refines x: the midpoint rule keeps a stiff
             // spring's energy to round-off over 10⁶ steps only with it); or, with an older
             // Jacobian (a linear rate), its own correction is at round-off.
-            let round_off = round_off(x.amax());
+            let round_off = round_off(amax(x));
             let settled = at_x.residual == 0.0
                 || if current {
                     previous.is_some_and(|before| before <= noise)
@@ -767,7 +767,7 @@ impl<J: Jacobian> Newton<J> {
                 jacobian_at = Some(updates + 1);
                 length
             } else {
-                x.axpy(-1.0, &self.update, 1.0);
+                subtract(x, 1.0, &self.update);
                 evaluations += 1;
                 // After an update below the step tolerance the next point is the root to
                 // round-off: its correction needs no Jacobian of its own.
@@ -779,7 +779,7 @@ impl<J: Jacobian> Newton<J> {
                     {
                         // An update of an older Jacobian left the residual's domain: back to
                         // the iterate it came from, with its own Jacobian.
-                        x.axpy(1.0, &self.update, 1.0);
+                        subtract(x, -1.0, &self.update);
                         at_x = self.refresh(x, &mut evaluate)?;
                         (jacobian_at, previous) = (Some(updates), None);
                         (jacobians, evaluations) = (jacobians + 1, evaluations + 1);
@@ -826,6 +826,18 @@ impl<J: Jacobian> Newton<J> {
             self.factorised = false;
         }
         failure
+    }
+}
+
+/// `max |x_i|` (nalgebra's `amax`, over the slice: the iterations here are on every solve's path).
+fn amax(x: &DVector<f64>) -> f64 {
+    x.as_slice().iter().fold(0.0, |m: f64, x| m.max(x.abs()))
+}
+
+/// `x − length · update`, entry by entry.
+fn subtract(x: &mut DVector<f64>, length: f64, update: &DVector<f64>) {
+    for (x, u) in x.as_mut_slice().iter_mut().zip(update.as_slice()) {
+        *x -= length * u;
     }
 }
 

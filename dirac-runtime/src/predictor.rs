@@ -97,14 +97,14 @@ impl Predictor {
             self.clear(x.len());
         }
         self.solutions.rotate_right(1);
-        self.solutions[0].copy_from(x);
+        self.solutions[0].copy_from_slice(x.as_slice());
         if let Some((range, share)) = &self.shared {
             // The multipliers before the first step of a history are zero (a start).
             for i in range.clone() {
                 self.solutions[0][i] = (1.0 - share) * self.last[i] + share * x[i];
             }
         }
-        self.last.copy_from(x);
+        self.last.copy_from_slice(x.as_slice());
         self.count = if self.detached {
             1
         } else {
@@ -124,23 +124,27 @@ impl Predictor {
             return None;
         }
         let [a, b, c, d] = &self.solutions;
+        let (a, b, c, d) = (a.as_slice(), b.as_slice(), c.as_slice(), d.as_slice());
+        let next = self.extrapolated.as_mut_slice();
+        // Element by element on the slices (the same operations, in the same order, as the
+        // polynomial's weights applied vector by vector).
         match self.count {
             0 => return None,
-            1 => self.extrapolated.copy_from(a),
+            1 => next.copy_from_slice(a),
             2 => {
-                self.extrapolated.copy_from(a);
-                self.extrapolated.axpy(-1.0, b, 2.0);
+                for (e, (a, b)) in next.iter_mut().zip(a.iter().zip(b)) {
+                    *e = 2.0 * a - b;
+                }
             }
             3 => {
-                self.extrapolated.copy_from(c);
-                self.extrapolated.axpy(3.0, a, 1.0);
-                self.extrapolated.axpy(-3.0, b, 1.0);
+                for (e, ((a, b), c)) in next.iter_mut().zip(a.iter().zip(b).zip(c)) {
+                    *e = (c + 3.0 * a) - 3.0 * b;
+                }
             }
             _ => {
-                self.extrapolated.copy_from(a);
-                self.extrapolated.axpy(-6.0, b, 4.0);
-                self.extrapolated.axpy(4.0, c, 1.0);
-                self.extrapolated.axpy(-1.0, d, 1.0);
+                for (e, (((a, b), c), d)) in next.iter_mut().zip(a.iter().zip(b).zip(c).zip(d)) {
+                    *e = ((4.0 * a - 6.0 * b) + 4.0 * c) - d;
+                }
             }
         }
         if let Some((range, share)) = &self.shared {

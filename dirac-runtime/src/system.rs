@@ -53,6 +53,13 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// Number of named inputs the forces read.
     const INPUTS: usize = 0;
 
+    /// Whether `L` is finite at every finite `(q, v)` short of overflow: built from sums,
+    /// products, integer powers, division by what the state does not change and functions
+    /// defined on every real (no root, logarithm or division by the state). A step then skips
+    /// the check that `L` is finite at its end, since there is no domain to leave. `false` by
+    /// default; `#[dirac_system]` derives it from a Lagrangian written as an expression.
+    const LAGRANGIAN_ENTIRE: bool = false;
+
     /// The continuous Lagrangian `L(q, v)` at position `q` and velocity `v`.
     fn lagrangian<D: Scalar>(&self, q: &M::Point<D>, v: &M::Tangent<D>) -> D;
 
