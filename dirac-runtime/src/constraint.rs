@@ -57,6 +57,22 @@ pub(crate) fn one_form_in_chart<
     (value, Some(derivative))
 }
 
+/// One-form `a` read in the chart centred at `base`, at `xi`: the row `Ã_a(ξ)` alone, without
+/// the dual numbers of its derivative (the same numbers as [`one_form_in_chart`]'s row).
+pub(crate) fn one_form_value_in_chart<
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+    const N: usize,
+>(
+    system: &S,
+    space: &C,
+    base: &Point<C, N, f64>,
+    xi: &SVector<f64, N>,
+    a: usize,
+) -> SVector<f64, N> {
+    space.pull_back(base, xi, &system.one_form(&space.retract(base, xi), a))
+}
+
 /// Refuses constraints that are dependent at `q` (a one-form or a holonomic constraint's
 /// differential that combines others: the multipliers would not be unique and the step's KKT
 /// matrix singular), naming them.
@@ -169,13 +185,14 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
 {
     /// The one-forms of a degree-1 step, held at its constraint point `ξ_c = θ ξ_s`: adds
     /// `σ Ã(ξ_c)ᵀμ` to the rows of `p_k`'s equation, writes the rows `Ã(ξ_c) ξ_s`, fills the
-    /// matching Jacobian entries, and returns the impulse `Ã(ξ_c)ᵀμ` (its end point's share is
+    /// matching Jacobian entries where one is asked for (else the one-forms are read without
+    /// their derivatives), and returns the impulse `Ã(ξ_c)ᵀμ` (its end point's share is
     /// `1 − σ`) with the size of the rows' terms.
     pub(crate) fn add_one_forms(
         &self,
         x: &DVector<f64>,
         residual: &mut DVector<f64>,
-        jacobian: &mut DMatrix<f64>,
+        mut jacobian: Option<&mut DMatrix<f64>>,
     ) -> (SVector<f64, N>, f64) {
         let Self {
             system,
@@ -192,9 +209,19 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         let mut scale = 0.0_f64;
         let xi_c = step * theta;
         for a in 0..S::ONE_FORMS {
-            let (row, derivative) = one_form_in_chart(system, space, base, &xi_c, a);
             let col = layout.one_form(a);
             let mu = x[col];
+            let Some(jacobian) = jacobian.as_deref_mut() else {
+                let row = one_form_value_in_chart(system, space, base, &xi_c, a);
+                impulse += row * mu;
+                for i in 0..N {
+                    residual[i] += share * mu * row[i];
+                }
+                residual[col] = row.dot(&step);
+                scale = scale.max(row.abs().dot(&step.abs()));
+                continue;
+            };
+            let (row, derivative) = one_form_in_chart(system, space, base, &xi_c, a);
             impulse += row * mu;
             for i in 0..N {
                 residual[i] += share * mu * row[i];
@@ -226,13 +253,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     StepConstraints<'_, S, C, N>
 {
     /// Adds the constraint forces to the rows of `p_k`'s equation, writes the constraint rows,
-    /// fills the matching Jacobian entries, and returns the constraint impulses (total, and the
-    /// share on the end point) with the size of the terms of the constraint rows.
+    /// fills the matching Jacobian entries where one is asked for, and returns the constraint
+    /// impulses (total, and the share on the end point) with the size of the terms of the
+    /// constraint rows.
     pub(crate) fn add(
         &self,
         x: &DVector<f64>,
         residual: &mut DVector<f64>,
-        jacobian: &mut DMatrix<f64>,
+        mut jacobian: Option<&mut DMatrix<f64>>,
     ) -> (StepCovectors<N>, f64) {
         let Self {
             system,
@@ -247,13 +275,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let step = x.fixed_rows::<N>(step_col).into_owned();
         let share = point.share();
         let (mut impulse, mut scale) = if layout.points() == 1 {
-            self.add_one_forms(x, residual, jacobian)
+            self.add_one_forms(x, residual, jacobian.as_deref_mut())
         } else {
             (SVector::zeros(), 0.0)
         };
         let mut end = impulse * (1.0 - share);
         if layout.points() > 1 && S::ONE_FORMS > 0 {
-            let (forces, size) = self.add_at_nodes(x, residual, jacobian);
+            let (forces, size) = self.add_at_nodes(x, residual, jacobian.as_deref_mut());
             impulse += forces.impulse;
             end += forces.end;
             scale = scale.max(size);
@@ -264,7 +292,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             impulse += force_form * lambda;
             for i in 0..N {
                 residual[i] += lambda * force_form[i];
-                jacobian[(i, col)] += force_form[i];
+            }
+            if let Some(jacobian) = jacobian.as_deref_mut() {
+                for i in 0..N {
+                    jacobian[(i, col)] += force_form[i];
+                }
             }
             let (g, form) = holonomic_in_chart(system, space, base, &step, b);
             residual[col] = g;
@@ -276,8 +308,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 holonomic(system, &end_point, b).1
             };
             scale = scale.max(model_form.abs().dot(&end_point.abs()).max(g.abs()));
-            for j in 0..N {
-                jacobian[(col, step_col + j)] = form[j];
+            if let Some(jacobian) = jacobian.as_deref_mut() {
+                for j in 0..N {
+                    jacobian[(col, step_col + j)] = form[j];
+                }
             }
         }
         if layout.points() > 1 {
@@ -298,7 +332,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         &self,
         x: &DVector<f64>,
         residual: &mut DVector<f64>,
-        jacobian: &mut DMatrix<f64>,
+        mut jacobian: Option<&mut DMatrix<f64>>,
     ) -> (StepCovectors<N>, f64) {
         let (system, layout, base, quad, h) =
             (self.system, self.layout, self.base, self.quadrature, self.h);
@@ -321,6 +355,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                     let lj = w * quad.ell(i, j);
                     for r in 0..N {
                         residual[j * N + r] += lj * mu * row[r];
+                        let Some(jacobian) = jacobian.as_deref_mut() else {
+                            continue;
+                        };
                         jacobian[(j * N + r, col)] += lj * row[r];
                         let Some(derivative) = &derivative else {
                             continue;
@@ -336,6 +373,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 // A_a(Q_i) · Q̇_i, scaled by h to read as a displacement.
                 residual[col] = h * row.dot(&xi_dot);
                 scale = scale.max(h * row.abs().dot(&xi_dot.abs()));
+                let Some(jacobian) = jacobian.as_deref_mut() else {
+                    continue;
+                };
                 let turning = derivative.map_or_else(SVector::zeros, |d| d.transpose() * xi_dot);
                 for k in 1..=s {
                     for m in 0..N {
@@ -355,7 +395,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         &self,
         x: &DVector<f64>,
         residual: &mut DVector<f64>,
-        jacobian: &mut DMatrix<f64>,
+        mut jacobian: Option<&mut DMatrix<f64>>,
     ) -> (SVector<f64, N>, f64) {
         let (system, layout, base) = (self.system, self.layout, self.base);
         let mut impulse = SVector::<f64, N>::zeros();
@@ -368,15 +408,19 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 let col = layout.holonomic_at(j, b);
                 let lambda = x[col];
                 let (g, form) = holonomic(system, &point, b);
-                let curvature = crate::derivatives::holonomic_hessian(system, &point, b);
                 impulse += form * lambda;
                 for i in 0..N {
                     residual[row + i] += lambda * form[i];
-                    jacobian[(row + i, col)] += form[i];
-                    for m in 0..N {
-                        jacobian[(row + i, column + m)] += lambda * curvature[(i, m)];
+                }
+                if let Some(jacobian) = jacobian.as_deref_mut() {
+                    let curvature = crate::derivatives::holonomic_hessian(system, &point, b);
+                    for i in 0..N {
+                        jacobian[(row + i, col)] += form[i];
+                        for m in 0..N {
+                            jacobian[(row + i, column + m)] += lambda * curvature[(i, m)];
+                        }
+                        jacobian[(col, column + i)] = form[i];
                     }
-                    jacobian[(col, column + i)] = form[i];
                 }
                 residual[col] = g;
                 scale = scale.max(form.abs().dot(&point.abs()).max(g.abs()));

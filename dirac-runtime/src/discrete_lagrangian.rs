@@ -62,6 +62,9 @@ struct PairNode {
     w: f64,
     a: [f64; 2],
     d: [f64; 2],
+    /// Whether a basis value or rate is zero here (the node is an end of the step): its terms
+    /// are then left out, not multiplied by zero, as `seeded` leaves them.
+    vanishing: bool,
 }
 
 impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
@@ -78,13 +81,18 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     pub fn on_space(system: S, space: C, quadrature: Quadrature, h: f64) -> Self {
         let pair = match quadrature.degree() {
             1 => (0..quadrature.weights().len())
-                .map(|i| PairNode {
-                    w: h * quadrature.weights()[i],
-                    a: [quadrature.ell(i, 0), quadrature.ell(i, 1)],
-                    d: [
+                .map(|i| {
+                    let a = [quadrature.ell(i, 0), quadrature.ell(i, 1)];
+                    let d = [
                         quadrature.ell_prime(i, 0) / h,
                         quadrature.ell_prime(i, 1) / h,
-                    ],
+                    ];
+                    PairNode {
+                        w: h * quadrature.weights()[i],
+                        a,
+                        d,
+                        vanishing: a.contains(&0.0) || d.contains(&0.0),
+                    }
                 })
                 .collect(),
             _ => Vec::new(),
@@ -407,20 +415,35 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             w,
             a: [a0, a1],
             d: [d0, d1],
+            vanishing,
         } in &self.pair
         {
             let (node, rate) = (xi * a1, xi * d1);
             if jacobian.is_some() {
-                // As `seeded` along the directions of ξ_0 and ξ_1.
+                // As `seeded` along the directions of ξ_0 and ξ_1 (which multiplies by a
+                // weight only where it is not zero).
                 let l = chart.closed_hessian(&node, &rate)?;
                 let g = &l.gradient;
-                let first = weighted(&g.q, a0) + weighted(&g.v, d0);
-                let second = weighted(&g.q, a1) + weighted(&g.v, d1);
-                block += (weighted(&l.qq, a0 * a1)
-                    + weighted(&l.qv, a0 * d1)
-                    + weighted(&l.qv.transpose(), d0 * a1)
-                    + weighted(&l.vv, d0 * d1))
-                    * w;
+                let (first, second, mixed) = if vanishing {
+                    (
+                        weighted(&g.q, a0) + weighted(&g.v, d0),
+                        weighted(&g.q, a1) + weighted(&g.v, d1),
+                        weighted(&l.qq, a0 * a1)
+                            + weighted(&l.qv, a0 * d1)
+                            + weighted(&l.qv.transpose(), d0 * a1)
+                            + weighted(&l.vv, d0 * d1),
+                    )
+                } else {
+                    (
+                        g.q * a0 + g.v * d0,
+                        g.q * a1 + g.v * d1,
+                        l.qq * (a0 * a1)
+                            + l.qv * (a0 * d1)
+                            + l.qv.transpose() * (d0 * a1)
+                            + l.vv * (d0 * d1),
+                    )
+                };
+                block += mixed * w;
                 row += first * w;
                 impulse += (first + second) * w;
                 end += second * w;

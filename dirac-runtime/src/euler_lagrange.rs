@@ -803,22 +803,20 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         // Left to `advance` where the residual did not need them.
         self.covectors_pending = lagrangian.is_none();
         let mut covectors = lagrangian.unwrap_or_else(StepCovectors::zero);
-        let more_rows = !self.collocated.is_empty() || S::FORCES || Self::constrained();
-        let jacobian = match jacobian {
-            Some(jacobian) => jacobian,
-            // The rows beyond the discrete Lagrangian's write their derivatives as they go.
-            None if more_rows => {
-                scratch.as_mut_slice().fill(0.0);
-                scratch
-            }
-            None => scratch,
-        };
+        // Collocated rows and forces write their derivatives as they go: without a Jacobian
+        // asked for, into `scratch`. Constraint rows take none then.
+        let sink = !self.collocated.is_empty() || S::FORCES;
+        if jacobian.is_none() && sink {
+            scratch.as_mut_slice().fill(0.0);
+        }
         if !self.collocated.is_empty() {
             // A mixed Lagrangian: the rows of the coordinates linear in their velocities are
             // collocated, the others stay variational.
+            let jacobian = jacobian.as_deref_mut().unwrap_or(&mut *scratch);
             scale = scale.max(self.collocate(state, residual, jacobian));
         }
         if S::FORCES {
+            let jacobian = jacobian.as_deref_mut().unwrap_or(&mut *scratch);
             let (forces, size) = discrete.add_forces(
                 &state.q,
                 &self.increments,

@@ -421,18 +421,20 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             self.covectors = covectors;
             return scale;
         }
-        let n = x.len();
-        if self.scratch.shape() != (n, n) {
-            self.scratch = DMatrix::zeros(n, n);
-        }
-        let jacobian = match jacobian {
-            Some(jacobian) => jacobian,
-            None => {
-                self.scratch.as_mut_slice().fill(0.0);
-                &mut self.scratch
-            }
-        };
         if S::FORCES {
+            // Forces write their derivatives as they go: without a Jacobian asked for, into
+            // `scratch`. Constraint rows take none then.
+            let n = x.len();
+            if self.scratch.shape() != (n, n) {
+                self.scratch = DMatrix::zeros(n, n);
+            }
+            let jacobian = match jacobian.as_deref_mut() {
+                Some(jacobian) => jacobian,
+                None => {
+                    self.scratch.as_mut_slice().fill(0.0);
+                    &mut self.scratch
+                }
+            };
             let (forces, size) = discrete.add_forces(
                 &state.q,
                 &self.increments,

@@ -1146,7 +1146,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// theorem needs it there; the solve may have ended with an earlier one) and returns the
     /// state the step started from.
     fn factorise_at_root(&mut self) -> Result<State<N, E::Manifold>, DiracError> {
-        let state = self.state.ok_or(DiracError::NotStarted)?;
+        let Some(state) = self.state else {
+            return Err(DiracError::NotStarted);
+        };
         let equations = &mut self.equations;
         self.newton
             .factorise_at(&self.unknowns, |x, r, j| {
@@ -1158,7 +1160,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
 
     /// Solves the next step without making it current: the state is unchanged whatever happens.
     fn solve_step(&mut self) -> Result<Proposal<N, E::Manifold>, DiracError> {
-        let state = self.state.ok_or(DiracError::NotStarted)?;
+        let Some(state) = self.state else {
+            return Err(DiracError::NotStarted);
+        };
         // The last solutions extrapolated (see `predictor`).
         let predictor = self.predictor.predict();
         let equations = &mut self.equations;
@@ -1398,7 +1402,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn v(&self) -> Result<Tangent<E, N>, DiracError> {
-        let state = self.state.ok_or(DiracError::NotStarted)?;
+        let Some(state) = self.state else {
+            return Err(DiracError::NotStarted);
+        };
         self.velocity_at(state.t, &state.q, &state.p, &state.velocity, true)
     }
 
@@ -1422,7 +1428,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn energy(&self) -> Result<f64, DiracError> {
-        let state = self.state.ok_or(DiracError::NotStarted)?;
+        let Some(state) = self.state else {
+            return Err(DiracError::NotStarted);
+        };
         self.energy_of(&state, self.steps)
     }
 

@@ -142,7 +142,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn interpolate(&self, t: f64) -> Result<Sample<N, E::Manifold>, DiracError> {
-        let after = self.state.ok_or(DiracError::NotStarted)?;
+        let Some(after) = self.state else {
+            return Err(DiracError::NotStarted);
+        };
         let before = self.before.ok_or_else(|| {
             DiracError::InvalidRun("dense output needs a step: none was taken yet".into())
         })?;
@@ -203,7 +205,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         mut run: Run<'_, N, E::Manifold>,
         solution: &mut Solution<N, E::Manifold>,
     ) -> Result<(), DiracError> {
-        let start = self.state.ok_or(DiracError::NotStarted)?;
+        let Some(start) = self.state else {
+            return Err(DiracError::NotStarted);
+        };
         let h = self.h();
         let (total, saveat) = run.plan(start.t, h)?;
         let saveat = saveat.map(<[f64]>::to_vec);
@@ -326,7 +330,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             if let Some(status) = stop {
                 if saveat.is_none() && !sampled {
                     if !exact {
-                        let state = self.state.ok_or(DiracError::NotStarted)?;
+                        let Some(state) = self.state else {
+                            return Err(DiracError::NotStarted);
+                        };
                         current.v = self.sample_velocity(&state, &current.v)?;
                     }
                     self.save(trajectory, &current, None)?;
