@@ -139,6 +139,14 @@ fn trajectories_write_csv_with_named_columns() {
 #[dirac_system(coordinates(q), lagrangian = 0.5 * dot(q).powi(2) - sqrt(1.0 - q))]
 struct Edge;
 
+/// The macro declares a Lagrangian finite everywhere only where its expression has no domain:
+/// the pendulum's, not `Edge`'s, whose step ends are checked.
+#[test]
+fn only_a_lagrangian_without_a_domain_skips_the_end_check() {
+    assert!(<Pendulum as DiracSystem<1>>::LAGRANGIAN_ENTIRE);
+    assert!(!<Edge as DiracSystem<1>>::LAGRANGIAN_ENTIRE);
+}
+
 #[test]
 fn an_initial_state_outside_the_lagrangians_domain_is_refused() {
     let mut stepper = Stepper::new(Edge, Quadrature::midpoint(), 0.1).unwrap();

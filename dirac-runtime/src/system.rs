@@ -58,6 +58,24 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// defined on every real (no root, logarithm or division by the state). A step then skips
     /// the check that `L` is finite at its end, since there is no domain to leave. `false` by
     /// default; `#[dirac_system]` derives it from a Lagrangian written as an expression.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// struct Pendulum;
+    /// impl DiracSystem<1> for Pendulum {
+    ///     // v²/2 + cos q is finite wherever q and v are.
+    ///     const LAGRANGIAN_ENTIRE: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] * 0.5 + q[0].cos()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Pendulum, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run(10)?;
+    /// assert!(stepper.energy()?.is_finite());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
     const LAGRANGIAN_ENTIRE: bool = false;
 
     /// The continuous Lagrangian `L(q, v)` at position `q` and velocity `v`.
