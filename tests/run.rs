@@ -390,3 +390,27 @@ fn serde_round_trips() {
         );
     }
 }
+
+/// A recorded sample's energy is the model's `⟨∂L/∂v, v⟩ − L` at the sample's position and
+/// velocity, bit for bit, whether the velocity solve brought it (the chord step of closed-form
+/// derivatives, unconstrained models) or the stepper evaluated it after (constrained ones).
+#[test]
+fn recorded_energies_are_the_energy_at_the_recorded_state() {
+    use scenes::{double_pendulum, knife_edge};
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let mut stepper = double_pendulum::stepper(quadrature, 0.01).unwrap();
+        let trajectory = stepper.run(300).unwrap();
+        for k in 0..trajectory.len() {
+            let (q, v) = (&trajectory.q()[k], &trajectory.v()[k]);
+            let energy = dirac::legendre::energy(&double_pendulum::SCENE, q, v);
+            assert_eq!(energy, trajectory.energy()[k], "sample {k}");
+        }
+    }
+    let mut stepper = knife_edge::stepper(ConstraintPoint::Midpoint, 0.01).unwrap();
+    let trajectory = stepper.run(300).unwrap();
+    for k in 0..trajectory.len() {
+        let (q, v) = (&trajectory.q()[k], &trajectory.v()[k]);
+        let energy = dirac::legendre::energy(&knife_edge::SCENE, q, v);
+        assert_eq!(energy, trajectory.energy()[k], "sample {k}");
+    }
+}

@@ -1255,6 +1255,26 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             .map(|(v, _)| v)
     }
 
+    /// A model with no constraints, hidden ones included, and kinetic energy in every velocity
+    /// takes the plain Legendre inversion, whose chord step brings the energy with it.
+    fn velocity_and_energy_in_run(
+        &self,
+        newton: &mut Newton,
+        t: f64,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+    ) -> Result<(SVector<f64, N>, Option<f64>), NewtonFailure> {
+        let plain = self.hidden.as_ref().is_some_and(|hidden| {
+            hidden.coordinates().is_empty() && hidden.dynamic() == 0 && hidden.count() == 0
+        });
+        if !Self::constrained() && plain && newton.unknowns() == N {
+            return legendre::velocity_with_energy(self.discrete.system(), newton, q, p, guess);
+        }
+        self.velocity_in_run(newton, t, q, p, guess)
+            .map(|v| (v, None))
+    }
+
     fn energy(&self, q: &SVector<f64, N>, _p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64 {
         legendre::energy(self.discrete.system(), q, v)
     }

@@ -63,7 +63,7 @@ pub(crate) fn velocity<F: PhaseFunction<N>, const N: usize>(
     dead: &[usize],
 ) -> Result<SVector<f64, N>, NewtonFailure> {
     if dead.is_empty()
-        && let Some(v) = chord_velocity(system, newton, q, p, guess)
+        && let Some((v, _)) = chord_velocity(system, newton, q, p, guess)
     {
         return Ok(v);
     }
@@ -92,6 +92,23 @@ pub(crate) fn velocity<F: PhaseFunction<N>, const N: usize>(
     Ok(SVector::from_column_slice(x.as_slice()))
 }
 
+/// [`velocity`] of a model all of whose velocities carry kinetic energy, with the energy
+/// `⟨∂L/∂v, v⟩ − L` at the velocity found where the solve evaluated `L` there on its way (the
+/// chord step of closed-form derivatives): the numbers [`energy`] gives, without evaluating `L`
+/// again. `None` for the energy where the general solve ran.
+pub(crate) fn velocity_with_energy<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    newton: &mut Newton,
+    q: &SVector<f64, N>,
+    p: &SVector<f64, N>,
+    guess: &SVector<f64, N>,
+) -> Result<(SVector<f64, N>, Option<f64>), NewtonFailure> {
+    if let Some((v, energy)) = chord_velocity(system, newton, q, p, guess) {
+        return Ok((v, Some(energy)));
+    }
+    velocity(system, newton, q, p, guess, &[]).map(|v| (v, None))
+}
+
 /// One Newton step from `guess` with the Hessian `∂²L/∂v²` there, in fixed size, taken where
 /// `L` has closed-form second derivatives: exact for a Lagrangian quadratic in the velocities
 /// (any mechanical one), it costs a Hessian and a gradient where the general solve adds its
@@ -100,14 +117,15 @@ pub(crate) fn velocity<F: PhaseFunction<N>, const N: usize>(
 /// Jacobian from an earlier iterate: the residual within tolerance and the correction there at
 /// round-off. A Hessian whose condition number `‖H‖∞‖H⁻¹‖∞` exceeds the inverse of the
 /// solver's singular tolerance is left to the general solve, which refuses it as singular.
-/// `None` sends the caller to the general solve.
+/// `None` sends the caller to the general solve. With the velocity comes the energy there,
+/// `⟨∂L/∂v, v⟩ − L`, from the gradient the acceptance test evaluated.
 fn chord_velocity<F: PhaseFunction<N>, const N: usize>(
     system: &F,
     newton: &Newton,
     q: &SVector<f64, N>,
     p: &SVector<f64, N>,
     guess: &SVector<f64, N>,
-) -> Option<SVector<f64, N>> {
+) -> Option<(SVector<f64, N>, f64)> {
     let hessian = system.closed_hessian(q, guess)?;
     let inverse = hessian.vv.try_inverse()?;
     let mut sums = [0.0; N];
@@ -123,7 +141,8 @@ fn chord_velocity<F: PhaseFunction<N>, const N: usize>(
     let update = inverse * residual;
     let scale = at_v.v.abs().sup(&p.abs()).amax();
     let finite = v.iter().chain(residual.iter()).all(|x| x.is_finite());
-    (finite && newton.accepts(residual.amax(), scale, norm, v.amax(), update.amax())).then_some(v)
+    let accepted = newton.accepts(residual.amax(), scale, norm, v.amax(), update.amax());
+    (finite && accepted).then(|| (v, at_v.v.dot(&v) - at_v.value))
 }
 
 /// The Legendre transform of a constrained model: solves
@@ -374,8 +393,13 @@ mod tests {
         let mass = SMatrix::<f64, 2, 2>::new(2.0, 1.0, 1.0, 3.0);
         let (q, p) = (vector![0.3, -0.2], vector![1.0, -2.0]);
         let exact = mass.try_inverse().unwrap() * p;
-        let v = chord_velocity(&Quadratic(mass), &newton(2), &q, &p, &vector![50.0, -70.0]);
-        assert!((v.unwrap() - exact).amax() < 1e-14, "{v:?} against {exact}");
+        let chord = chord_velocity(&Quadratic(mass), &newton(2), &q, &p, &vector![50.0, -70.0]);
+        let (v, energy) = chord.unwrap();
+        assert!((v - exact).amax() < 1e-14, "{v:?} against {exact}");
+        // ½ vᵀMv + q_0 q_1, and the numbers `energy` gives at that velocity.
+        let closed = 0.5 * exact.dot(&(mass * exact)) + q[0] * q[1];
+        assert!((energy - closed).abs() < 1e-14, "{energy} against {closed}");
+        assert_eq!(energy, super::energy(&Quadratic(mass), &q, &v));
     }
 
     #[test]
@@ -391,7 +415,7 @@ mod tests {
         assert!((v[0] - 2.0_f64.asinh()).abs() < 1e-15);
         // From a guess 1e-9 off, one step is at round-off from the root: accepted.
         let close = vector![2.0_f64.asinh() + 1e-9];
-        let v = chord_velocity(&Speed::Cosh, &newton(1), &q, &p, &close).unwrap();
+        let (v, _) = chord_velocity(&Speed::Cosh, &newton(1), &q, &p, &close).unwrap();
         assert!((v[0] - 2.0_f64.asinh()).abs() < 1e-15);
     }
 

@@ -234,6 +234,21 @@ pub trait StepEquations<const N: usize> {
         self.velocity(newton, t, q, p, guess)
     }
 
+    /// [`velocity_in_run`](Self::velocity_in_run) with the energy at the velocity found, where
+    /// the solve gives it on its way with the numbers [`energy`](Self::energy) would (`None`:
+    /// the caller asks `energy`). By default `None`.
+    fn velocity_and_energy_in_run(
+        &self,
+        newton: &mut Newton,
+        t: f64,
+        q: &Point<Self, N>,
+        p: &Tangent<Self, N>,
+        guess: &Tangent<Self, N>,
+    ) -> Result<(Tangent<Self, N>, Option<f64>), NewtonFailure> {
+        self.velocity_in_run(newton, t, q, p, guess)
+            .map(|v| (v, None))
+    }
+
     /// The velocity at `(q, p)` at time `t`, solved from `guess` by `newton` (sized for
     /// [`velocity_unknowns`](Self::velocity_unknowns)) where it is implicit.
     fn velocity(

@@ -978,13 +978,13 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         solved.map_err(|f| self.failure(Problem::Velocity, f))
     }
 
-    /// The velocity of a recorded `state`, reached after `steps` steps, solved from `guess` in
-    /// the stepper's own workspace.
+    /// The velocity of a recorded `state`, solved from `guess` in the stepper's own workspace,
+    /// with the energy there where the solve gives it on its way.
     fn sample_velocity(
         &mut self,
         state: &State<N, E::Manifold>,
         guess: &Tangent<E, N>,
-    ) -> Result<Tangent<E, N>, DiracError> {
+    ) -> Result<(Tangent<E, N>, Option<f64>), DiracError> {
         let unknowns = self.equations.velocity_unknowns();
         if self.velocity.fast.unknowns() != unknowns {
             self.velocity = VelocitySolver::new(unknowns, self.newton.options())?;
@@ -993,7 +993,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let equations = &self.equations;
         let solved = self
             .velocity
-            .solve(|newton| equations.velocity_in_run(newton, t, q, p, guess));
+            .solve(|newton| equations.velocity_and_energy_in_run(newton, t, q, p, guess));
         solved.map_err(|f| self.failure(Problem::Velocity, f))
     }
 

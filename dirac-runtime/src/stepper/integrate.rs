@@ -223,7 +223,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                 .saturating_add(2),
         };
         trajectory.reserve(samples.min(1 << 20));
-        let v = self.sample_velocity(&start, &start.velocity)?;
+        let (v, _) = self.sample_velocity(&start, &start.velocity)?;
         let mut current = sample(&start, v);
         let mut saved = 0;
         match &saveat {
@@ -255,10 +255,11 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                 // extrapolated by half the change since the last one, it is O(h²) off.
                 let hint = proposal.next.velocity;
                 let guess = <E::Manifold as Manifold<N>>::extrapolate(&hint, &current.v, 0.5);
-                let v = self.sample_velocity(&proposal.next, &guess)?;
-                let energy = match sampled {
-                    true => Some(self.energy_at(&proposal.next, &v, self.steps + 1)?),
-                    false => None,
+                let (v, solved) = self.sample_velocity(&proposal.next, &guess)?;
+                let energy = match (sampled, solved) {
+                    (true, Some(energy)) if energy.is_finite() => Some(energy),
+                    (true, _) => Some(self.energy_at(&proposal.next, &v, self.steps + 1)?),
+                    (false, _) => None,
                 };
                 (sample(&proposal.next, v), energy)
             } else {
@@ -333,7 +334,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                         let Some(state) = self.state else {
                             return Err(DiracError::NotStarted);
                         };
-                        current.v = self.sample_velocity(&state, &current.v)?;
+                        current.v = self.sample_velocity(&state, &current.v)?.0;
                     }
                     self.save(trajectory, &current, None)?;
                 }
