@@ -796,3 +796,28 @@ fn knife_edge_energy_with_galerkin_steps_does_not_drift() {
         );
     }
 }
+
+/// The reported violation of a degree-1 step is `|A(q_c)(q_{k+1} − q_k)|` with the one-form
+/// evaluated at the stored points (`q_c = q_k + θ(q_{k+1} − q_k)`), as a user reading the
+/// trajectory would compute it, bit for bit, at every constraint point.
+#[test]
+fn the_reported_violation_is_the_one_form_at_the_stored_points() {
+    for point in [
+        ConstraintPoint::Start,
+        ConstraintPoint::Midpoint,
+        ConstraintPoint::End,
+    ] {
+        let mut stepper = knife_edge::stepper(point, 0.05).unwrap();
+        for _ in 0..100 {
+            let q0 = stepper.q();
+            stepper.step().unwrap();
+            let xi = stepper.q() - q0;
+            let form = knife_edge::SCENE.one_form(&(q0 + xi * point.theta()), 0);
+            assert_eq!(
+                stepper.constraint_violation(),
+                form.dot(&xi).abs(),
+                "{point:?}"
+            );
+        }
+    }
+}
