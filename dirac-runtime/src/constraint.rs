@@ -225,25 +225,23 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             impulse += row * mu;
             for i in 0..N {
                 residual[i] += share * mu * row[i];
-                jacobian[(i, col)] += share * row[i];
             }
+            let mut force = jacobian.fixed_view_mut::<N, 1>(0, col);
+            force += row * share;
             // Ã_a(ξ_c) · ξ_s and its derivative in ξ_s (ξ_c moves with ξ_s by θ).
             residual[col] = row.dot(&step);
             scale = scale.max(row.abs().dot(&step.abs()));
-            for j in 0..N {
-                jacobian[(col, step_col + j)] = row[j];
-            }
-            if let Some(derivative) = derivative {
-                for i in 0..N {
-                    for j in 0..N {
-                        jacobian[(i, step_col + j)] += share * theta * mu * derivative[(i, j)];
-                    }
+            let turning = match derivative {
+                None => row,
+                Some(derivative) => {
+                    let mut block = jacobian.fixed_view_mut::<N, N>(0, step_col);
+                    block += derivative * (share * theta * mu);
+                    row + derivative.transpose() * step * theta
                 }
-                let through_point = derivative.transpose() * step * theta;
-                for j in 0..N {
-                    jacobian[(col, step_col + j)] += through_point[j];
-                }
-            }
+            };
+            jacobian
+                .fixed_view_mut::<1, N>(col, step_col)
+                .copy_from(&turning.transpose());
         }
         (impulse, scale)
     }
