@@ -143,8 +143,8 @@ struct Edge;
 /// the pendulum's, not `Edge`'s, whose step ends are checked.
 #[test]
 fn only_a_lagrangian_without_a_domain_skips_the_end_check() {
-    assert!(<Pendulum as DiracSystem<1>>::LAGRANGIAN_ENTIRE);
-    assert!(!<Edge as DiracSystem<1>>::LAGRANGIAN_ENTIRE);
+    const { assert!(<Pendulum as DiracSystem<1>>::LAGRANGIAN_ENTIRE) };
+    const { assert!(!<Edge as DiracSystem<1>>::LAGRANGIAN_ENTIRE) };
 }
 
 #[test]
