@@ -47,8 +47,7 @@ pub(crate) fn one_form_in_chart<
 ) -> (SVector<f64, N>, Option<SMatrix<f64, N, N>>) {
     if C::TRANSLATION && system.one_form_is_constant(a) {
         // On Rⁿ the chart is a translation: a constant one-form reads the same in it.
-        let row = space.pull_back(base, xi, &system.one_form(&space.retract(base, xi), a));
-        return (row, None);
+        return (one_form_value_in_chart(system, space, base, xi, a), None);
     }
     let xi = lift(xi, 1.0);
     let row = space.pull_back(base, &xi, &system.one_form(&space.retract(base, &xi), a));
@@ -211,26 +210,22 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         for a in 0..S::ONE_FORMS {
             let col = layout.one_form(a);
             let mu = x[col];
-            let Some(jacobian) = jacobian.as_deref_mut() else {
-                let row = one_form_value_in_chart(system, space, base, &xi_c, a);
-                impulse += row * mu;
-                for i in 0..N {
-                    residual[i] += share * mu * row[i];
-                }
-                residual[col] = row.dot(&step);
-                scale = scale.max(row.abs().dot(&step.abs()));
-                continue;
+            let (row, derivative) = match jacobian {
+                Some(_) => one_form_in_chart(system, space, base, &xi_c, a),
+                None => (one_form_value_in_chart(system, space, base, &xi_c, a), None),
             };
-            let (row, derivative) = one_form_in_chart(system, space, base, &xi_c, a);
             impulse += row * mu;
             for i in 0..N {
                 residual[i] += share * mu * row[i];
             }
-            let mut force = jacobian.fixed_view_mut::<N, 1>(0, col);
-            force += row * share;
             // Ã_a(ξ_c) · ξ_s and its derivative in ξ_s (ξ_c moves with ξ_s by θ).
             residual[col] = row.dot(&step);
             scale = scale.max(row.abs().dot(&step.abs()));
+            let Some(jacobian) = jacobian.as_deref_mut() else {
+                continue;
+            };
+            let mut force = jacobian.fixed_view_mut::<N, 1>(0, col);
+            force += row * share;
             let turning = match derivative {
                 None => row,
                 Some(derivative) => {

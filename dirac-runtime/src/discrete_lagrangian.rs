@@ -19,7 +19,7 @@ use crate::closed_form::LagrangianHessian;
 use crate::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors, Tangent};
 use crate::derivatives::{
     InChart, PhaseFunction, Seed, directional_gradient, gradients, hessian, moving_row, seeded,
-    third_derivative, weighted,
+    seeded_from_hessian, third_derivative,
 };
 use crate::error::DiracError;
 use crate::manifold::Vectors;
@@ -62,9 +62,6 @@ struct PairNode {
     w: f64,
     a: [f64; 2],
     d: [f64; 2],
-    /// Whether a basis value or rate is zero here (the node is an end of the step): its terms
-    /// are then left out, not multiplied by zero, as `seeded` leaves them.
-    vanishing: bool,
 }
 
 impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
@@ -81,18 +78,13 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     pub fn on_space(system: S, space: C, quadrature: Quadrature, h: f64) -> Self {
         let pair = match quadrature.degree() {
             1 => (0..quadrature.weights().len())
-                .map(|i| {
-                    let a = [quadrature.ell(i, 0), quadrature.ell(i, 1)];
-                    let d = [
+                .map(|i| PairNode {
+                    w: h * quadrature.weights()[i],
+                    a: [quadrature.ell(i, 0), quadrature.ell(i, 1)],
+                    d: [
                         quadrature.ell_prime(i, 0) / h,
                         quadrature.ell_prime(i, 1) / h,
-                    ];
-                    PairNode {
-                        w: h * quadrature.weights()[i],
-                        a,
-                        d,
-                        vanishing: a.contains(&0.0) || d.contains(&0.0),
-                    }
+                    ],
                 })
                 .collect(),
             _ => Vec::new(),
@@ -415,39 +407,27 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             w,
             a: [a0, a1],
             d: [d0, d1],
-            vanishing,
         } in &self.pair
         {
             let (node, rate) = (xi * a1, xi * d1);
             if jacobian.is_some() {
-                // As `seeded` along the directions of ξ_0 and ξ_1 (which multiplies by a
-                // weight only where it is not zero).
-                let l = chart.closed_hessian(&node, &rate)?;
-                let g = &l.gradient;
-                let (first, second, mixed) = if vanishing {
-                    (
-                        weighted(&g.q, a0) + weighted(&g.v, d0),
-                        weighted(&g.q, a1) + weighted(&g.v, d1),
-                        weighted(&l.qq, a0 * a1)
-                            + weighted(&l.qv, a0 * d1)
-                            + weighted(&l.qv.transpose(), d0 * a1)
-                            + weighted(&l.vv, d0 * d1),
-                    )
-                } else {
-                    (
-                        g.q * a0 + g.v * d0,
-                        g.q * a1 + g.v * d1,
-                        l.qq * (a0 * a1)
-                            + l.qv * (a0 * d1)
-                            + l.qv.transpose() * (d0 * a1)
-                            + l.vv * (d0 * d1),
-                    )
-                };
-                block += mixed * w;
-                row += first * w;
-                impulse += (first + second) * w;
-                end += second * w;
-                magnitude += first.abs() * w;
+                // As the general path's `seeded` along the directions of ξ_0 and ξ_1.
+                let (x, y) = (
+                    Seed {
+                        position: a0,
+                        velocity: d0,
+                    },
+                    Seed {
+                        position: a1,
+                        velocity: d1,
+                    },
+                );
+                let l = seeded_from_hessian(&chart.closed_hessian(&node, &rate)?, x, y);
+                block += l.mixed * w;
+                row += l.first * w;
+                impulse += (l.first + l.second) * w;
+                end += l.second * w;
+                magnitude += l.first.abs() * w;
             } else {
                 let g = chart.closed_gradient(&node, &rate)?;
                 let first = g.q * a0 + g.v * d0;

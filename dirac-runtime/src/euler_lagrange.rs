@@ -418,7 +418,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
         run: Option<&HiddenConstraints>,
-    ) -> Result<(SVector<f64, N>, DVector<f64>), NewtonFailure> {
+    ) -> Result<Legendre<N>, NewtonFailure> {
         let system = self.discrete.system();
         let found;
         let hidden = match run {
@@ -431,7 +431,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         if N > 0 && !Self::constrained() && hidden.coordinates().len() == N {
             // Linear in every velocity: the first-order equations fix the velocity.
             return legendre::first_order_velocity(system, newton, q, guess)
-                .map(|v| (v, DVector::zeros(0)));
+                .map(|v| Legendre::plain(v, None));
         }
         let dead = hidden.coordinates();
         let mut spare = None;
@@ -464,22 +464,25 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                     &forms,
                     guess,
                     Some(&dynamic),
-                );
+                )
+                .map(Legendre::constrained);
             }
         }
         if hidden.dynamic() > 0 {
             // With hidden constraints among the same rows, the plain inversion keeps the
             // guess on the degenerate velocities (see "Not supported yet").
             let newton = sized(newton, N, &mut spare)?;
-            return legendre::velocity(system, newton, q, p, guess, dead)
-                .map(|v| (v, DVector::zeros(0)));
+            return legendre::velocity_with_energy(system, newton, q, p, guess, dead)
+                .map(|(v, energy)| Legendre::plain(v, energy));
         }
         let forms = self.velocity_forms(q, guess, hidden);
         let newton = sized(newton, N + forms.nrows(), &mut spare)?;
         if forms.nrows() > 0 {
             legendre::constrained_velocity(system, newton, q, p, &forms, guess, None)
+                .map(Legendre::constrained)
         } else {
-            legendre::velocity(system, newton, q, p, guess, dead).map(|v| (v, DVector::zeros(0)))
+            legendre::velocity_with_energy(system, newton, q, p, guess, dead)
+                .map(|(v, energy)| Legendre::plain(v, energy))
         }
     }
 
@@ -493,7 +496,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             ..Default::default()
         };
         let mut newton = Newton::new(self.velocity_unknowns(), options)?;
-        let (v, nu) = self
+        let Legendre {
+            velocity: v,
+            multipliers: nu,
+            ..
+        } = self
             .velocity_with_multipliers(
                 &mut newton,
                 t,
@@ -1238,7 +1245,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             .as_ref()
             .filter(|hidden| hidden.matches(system, q, guess));
         self.velocity_with_multipliers(newton, t, q, p, guess, run)
-            .map(|(v, _)| v)
+            .map(|solved| solved.velocity)
     }
 
     /// As [`velocity`](StepEquations::velocity), with the run's degenerate coordinates and hidden
@@ -1252,11 +1259,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         guess: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, NewtonFailure> {
         self.velocity_with_multipliers(newton, t, q, p, guess, self.hidden.as_ref())
-            .map(|(v, _)| v)
+            .map(|solved| solved.velocity)
     }
 
-    /// A model with no constraints, hidden ones included, and kinetic energy in every velocity
-    /// takes the plain Legendre inversion, whose chord step brings the energy with it.
+    /// The plain Legendre inversion's chord step (no constraints, kinetic energy in every
+    /// velocity) brings the energy with it.
     fn velocity_and_energy_in_run(
         &self,
         newton: &mut Newton,
@@ -1265,14 +1272,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
     ) -> Result<(SVector<f64, N>, Option<f64>), NewtonFailure> {
-        let plain = self.hidden.as_ref().is_some_and(|hidden| {
-            hidden.coordinates().is_empty() && hidden.dynamic() == 0 && hidden.count() == 0
-        });
-        if !Self::constrained() && plain && newton.unknowns() == N {
-            return legendre::velocity_with_energy(self.discrete.system(), newton, q, p, guess);
-        }
-        self.velocity_in_run(newton, t, q, p, guess)
-            .map(|v| (v, None))
+        self.velocity_with_multipliers(newton, t, q, p, guess, self.hidden.as_ref())
+            .map(|solved| (solved.velocity, solved.energy))
     }
 
     fn energy(&self, q: &SVector<f64, N>, _p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64 {
@@ -1493,6 +1494,32 @@ pub(crate) fn stale_factorisation() -> DiracError {
          derivatives right after the solve that produced it)"
             .into(),
     )
+}
+
+/// An inverted Legendre transform: the velocity, the constraints' multipliers `ν` (none for the
+/// plain inversion), and the energy where the solve gave it on its way.
+struct Legendre<const N: usize> {
+    velocity: SVector<f64, N>,
+    multipliers: DVector<f64>,
+    energy: Option<f64>,
+}
+
+impl<const N: usize> Legendre<N> {
+    fn plain(velocity: SVector<f64, N>, energy: Option<f64>) -> Self {
+        Self {
+            velocity,
+            multipliers: DVector::zeros(0),
+            energy,
+        }
+    }
+
+    fn constrained((velocity, multipliers): (SVector<f64, N>, DVector<f64>)) -> Self {
+        Self {
+            velocity,
+            multipliers,
+            energy: None,
+        }
+    }
 }
 
 /// `Err(NonFinite)` naming the first coordinate of `x` that is not finite.

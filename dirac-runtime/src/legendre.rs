@@ -62,10 +62,25 @@ pub(crate) fn velocity<F: PhaseFunction<N>, const N: usize>(
     guess: &SVector<f64, N>,
     dead: &[usize],
 ) -> Result<SVector<f64, N>, NewtonFailure> {
+    velocity_with_energy(system, newton, q, p, guess, dead).map(|(v, _)| v)
+}
+
+/// [`velocity`], with the energy `⟨∂L/∂v, v⟩ − L` at the velocity found where the solve
+/// evaluated `L` there on its way (the chord step of closed-form derivatives): the numbers
+/// [`energy`] gives, without evaluating `L` again. `None` for the energy where the general
+/// solve ran.
+pub(crate) fn velocity_with_energy<F: PhaseFunction<N>, const N: usize>(
+    system: &F,
+    newton: &mut Newton,
+    q: &SVector<f64, N>,
+    p: &SVector<f64, N>,
+    guess: &SVector<f64, N>,
+    dead: &[usize],
+) -> Result<(SVector<f64, N>, Option<f64>), NewtonFailure> {
     if dead.is_empty()
-        && let Some((v, _)) = chord_velocity(system, newton, q, p, guess)
+        && let Some((v, energy)) = chord_velocity(system, newton, q, p, guess)
     {
-        return Ok(v);
+        return Ok((v, Some(energy)));
     }
     let x = newton.solve_from(guess.as_slice(), |x, r, j| {
         let v = SVector::<f64, N>::from_column_slice(x.as_slice());
@@ -89,24 +104,7 @@ pub(crate) fn velocity<F: PhaseFunction<N>, const N: usize>(
         }
         l.first.abs().sup(&p.abs()).amax()
     })?;
-    Ok(SVector::from_column_slice(x.as_slice()))
-}
-
-/// [`velocity`] of a model all of whose velocities carry kinetic energy, with the energy
-/// `⟨∂L/∂v, v⟩ − L` at the velocity found where the solve evaluated `L` there on its way (the
-/// chord step of closed-form derivatives): the numbers [`energy`] gives, without evaluating `L`
-/// again. `None` for the energy where the general solve ran.
-pub(crate) fn velocity_with_energy<S: DiracSystem<N>, const N: usize>(
-    system: &S,
-    newton: &mut Newton,
-    q: &SVector<f64, N>,
-    p: &SVector<f64, N>,
-    guess: &SVector<f64, N>,
-) -> Result<(SVector<f64, N>, Option<f64>), NewtonFailure> {
-    if let Some((v, energy)) = chord_velocity(system, newton, q, p, guess) {
-        return Ok((v, Some(energy)));
-    }
-    velocity(system, newton, q, p, guess, &[]).map(|v| (v, None))
+    Ok((SVector::from_column_slice(x.as_slice()), None))
 }
 
 /// One Newton step from `guess` with the Hessian `∂²L/∂v²` there, in fixed size, taken where
