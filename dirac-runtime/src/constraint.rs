@@ -187,6 +187,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     /// matching Jacobian entries where one is asked for (else the one-forms are read without
     /// their derivatives), and returns the impulse `Ã(ξ_c)ᵀμ` (its end point's share is
     /// `1 − σ`) with the size of the rows' terms.
+    #[inline(always)]
     pub(crate) fn add_one_forms(
         &self,
         x: &DVector<f64>,
@@ -249,6 +250,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// fills the matching Jacobian entries where one is asked for, and returns the constraint
     /// impulses (total, and the share on the end point) with the size of the terms of the
     /// constraint rows.
+    #[inline(always)]
     pub(crate) fn add(
         &self,
         x: &DVector<f64>,

@@ -279,10 +279,10 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         }
         let s = self.quadrature.degree();
         if s == 1
-            && let Some(rows) =
+            && let Some((covectors, magnitude)) =
                 self.pair_in_closed_form(base, &increments[0], momentum, residual, &mut jacobian)
         {
-            return rows;
+            return (Some(covectors), magnitude);
         }
         let h = self.h;
         residual.as_mut_slice().fill(0.0);
@@ -387,16 +387,18 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
 
     /// [`euler_lagrange`](Self::euler_lagrange) of a degree-1 step (one pair of slots, `ξ` the
     /// end point's increment) from the Lagrangian's closed-form derivatives: the same sums in
-    /// the same order as the general path, without its loops over the step's points. `None`,
-    /// with nothing written, where the model has no closed forms.
-    fn pair_in_closed_form(
+    /// the same order as the general path, without its loops over the step's points: the slot
+    /// covectors and the size of the residual's terms. `None`, with nothing written, where the
+    /// model has no closed forms.
+    #[inline(always)]
+    pub(crate) fn pair_in_closed_form(
         &self,
         base: &Point<C, N, f64>,
         xi: &SVector<f64, N>,
         momentum: &SVector<f64, N>,
         residual: &mut DVector<f64>,
         jacobian: &mut Option<&mut DMatrix<f64>>,
-    ) -> Option<(Option<StepCovectors<N>>, f64)> {
+    ) -> Option<(StepCovectors<N>, f64)> {
         let chart = self.in_chart(base);
         let mut row = *momentum;
         let mut magnitude = momentum.abs();
@@ -443,7 +445,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             let mut target = jacobian.fixed_view_mut::<N, N>(0, 0);
             target += block;
         }
-        Some((Some(StepCovectors { impulse, end }), magnitude.amax()))
+        Some((StepCovectors { impulse, end }, magnitude.amax()))
     }
 
     /// [`euler_lagrange`](Self::euler_lagrange) on a space whose charts have non-affine

@@ -76,6 +76,10 @@ pub struct EulerLagrange<S, const N: usize, C> {
     /// The run's Lagrangian has closed-form second derivatives
     /// ([`DiracSystem::lagrangian_hessian`]; found when a run begins).
     closed_form: bool,
+    /// The run's steps are of degree 1 on a translation chart, `L` has closed-form derivatives,
+    /// and nothing but constraints and a coupling joins its rows (no forces, collocated rows or
+    /// projection): [`DiscreteLagrangian::pair_in_closed_form`] assembles them directly.
+    closed_pair: bool,
     layout: Layout,
     /// Current values of the system's inputs.
     inputs: Vec<f64>,
@@ -143,6 +147,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             collocated: Vec::new(),
             first_order_scheme: FirstOrderScheme::default(),
             closed_form: false,
+            closed_pair: false,
             layout: Layout::new(N, s, S::ONE_FORMS, S::HOLONOMIC),
             inputs: vec![0.0; S::INPUTS],
             lifted_inputs: vec![Dual::from(0.0); S::INPUTS],
@@ -284,6 +289,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let projected =
             self.first_order() && self.first_order_scheme == FirstOrderScheme::SymmetricProjection;
         self.layout = self.layout.with_projection(if projected { N } else { 0 });
+        self.closed_pair = self.closed_form
+            && self.discrete.quadrature().degree() == 1
+            && self.collocated.is_empty()
+            && !S::FORCES;
     }
 
     /// Begins a run of the model as a component of a modular interconnection: its degenerate
@@ -835,6 +844,23 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             covectors += forces;
             scale = scale.max(size);
         }
+        self.add_constraints_and_coupling(state, x, residual, jacobian, covectors, scale)
+    }
+
+    /// The rows' constraint impulses and coupling added to the step's `covectors` (kept for
+    /// `advance`), with the constraint rows written: returns the size of the residual's terms,
+    /// `scale` or more.
+    #[inline(always)]
+    fn add_constraints_and_coupling(
+        &mut self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        residual: &mut DVector<f64>,
+        jacobian: Option<&mut DMatrix<f64>>,
+        mut covectors: StepCovectors<N>,
+        mut scale: f64,
+    ) -> f64 {
+        let discrete = &self.discrete;
         if Self::constrained() {
             let constraints = StepConstraints {
                 system: discrete.system(),
@@ -1114,8 +1140,24 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         state: &State<N>,
         x: &DVector<f64>,
         residual: &mut DVector<f64>,
-        jacobian: Option<&mut DMatrix<f64>>,
+        mut jacobian: Option<&mut DMatrix<f64>>,
     ) -> f64 {
+        if self.closed_pair {
+            // The end point's increment leads the unknowns of a degree-1 step.
+            let xi = x.fixed_rows::<N>(0).into_owned();
+            self.increments[0] = xi;
+            if let Some((covectors, scale)) = self.discrete.pair_in_closed_form(
+                &state.q,
+                &xi,
+                &self.momentum,
+                residual,
+                &mut jacobian,
+            ) {
+                self.covectors_pending = false;
+                return self
+                    .add_constraints_and_coupling(state, x, residual, jacobian, covectors, scale);
+            }
+        }
         for (j, z) in self.increments.iter_mut().enumerate() {
             z.copy_from(&x.fixed_rows::<N>(self.layout.point(j + 1)));
         }

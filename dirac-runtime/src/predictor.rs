@@ -42,7 +42,8 @@ pub(crate) struct Predictor {
     /// The multipliers whose impulse is shared between a step's ends, and the share `σ` on the
     /// start (see the [module](self)).
     shared: Option<(Range<usize>, f64)>,
-    /// The last accepted solution as solved (the history holds the node impulses).
+    /// The last accepted solution as solved, where the history holds node impulses instead
+    /// (elsewhere the newest solution is it).
     last: DVector<f64>,
 }
 
@@ -64,9 +65,19 @@ impl Predictor {
     /// `μ` from them (see the [module](self)); `None`, or `σ = 1`, extrapolates the `μ`. Kept
     /// across [`clear`](Self::clear)s of the same size.
     pub fn share_impulses(&mut self, shared: Option<(Range<usize>, f64)>) {
+        let before = self.shared.is_some();
         self.shared = shared.filter(|(range, share)| {
             !range.is_empty() && range.end <= self.last.len() && *share > 0.0 && *share < 1.0
         });
+        if !before && self.shared.is_some() {
+            // Until now the newest solution was the last one as solved (none after a start).
+            if self.count > 0 {
+                let [newest, ..] = &self.solutions;
+                self.last.copy_from(newest);
+            } else {
+                self.last.fill(0.0);
+            }
+        }
     }
 
     /// Forgets every solution (a start, or unknowns of another size).
@@ -103,8 +114,8 @@ impl Predictor {
             for i in range.clone() {
                 self.solutions[0][i] = (1.0 - share) * self.last[i] + share * x[i];
             }
+            self.last.copy_from_slice(x.as_slice());
         }
-        self.last.copy_from_slice(x.as_slice());
         self.count = if self.detached {
             1
         } else {
@@ -115,7 +126,11 @@ impl Predictor {
 
     /// The last accepted solution.
     pub fn last(&self) -> Option<&DVector<f64>> {
-        (self.count > 0).then_some(&self.last)
+        let last = match self.shared {
+            Some(_) => &self.last,
+            None => &self.solutions[0],
+        };
+        (self.count > 0).then_some(last)
     }
 
     /// The prediction for the next step (none before the first accepted step).
