@@ -23,7 +23,7 @@ use crate::derivatives::{
 };
 use crate::error::DiracError;
 use crate::manifold::Vectors;
-use crate::quadrature::Quadrature;
+use crate::quadrature::{MAX_DEGREE, Quadrature};
 use crate::step_equations::State;
 use crate::system::DiracSystem;
 
@@ -51,17 +51,17 @@ pub struct DiscreteLagrangian<S, const N: usize, C = Euclidean> {
     space: C,
     quadrature: Quadrature,
     h: f64,
-    /// A degree-1 step's nodes with their weights (none for higher degrees).
-    pair: Vec<PairNode>,
+    /// The quadrature's nodes with their weights, read once for every step.
+    nodes: Vec<NodeWeights>,
 }
 
-/// Node `i` of a degree-1 step: its weight `w = h b_i`, the path's basis `ℓ_0(c_i), ℓ_1(c_i)`
-/// and its rates `ℓ'_0(c_i)/h, ℓ'_1(c_i)/h`, read once for every step.
+/// Node `i` of a step of degree `s`: its weight `w = h b_i`, the path's basis
+/// `a[j] = ℓ_j(c_i)` and its rates `d[j] = ℓ'_j(c_i)/h` (`j = 0..=s`; zero beyond).
 #[derive(Debug, Clone, Copy)]
-struct PairNode {
+struct NodeWeights {
     w: f64,
-    a: [f64; 2],
-    d: [f64; 2],
+    a: [f64; MAX_DEGREE + 1],
+    d: [f64; MAX_DEGREE + 1],
 }
 
 impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
@@ -76,25 +76,27 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
 {
     /// `L_d` for step `h`, with the step's points `R_{q_k}(ξ_j)` in `space`.
     pub fn on_space(system: S, space: C, quadrature: Quadrature, h: f64) -> Self {
-        let pair = match quadrature.degree() {
-            1 => (0..quadrature.weights().len())
-                .map(|i| PairNode {
+        let s = quadrature.degree();
+        let nodes = (0..quadrature.weights().len())
+            .map(|i| {
+                let mut node = NodeWeights {
                     w: h * quadrature.weights()[i],
-                    a: [quadrature.ell(i, 0), quadrature.ell(i, 1)],
-                    d: [
-                        quadrature.ell_prime(i, 0) / h,
-                        quadrature.ell_prime(i, 1) / h,
-                    ],
-                })
-                .collect(),
-            _ => Vec::new(),
-        };
+                    a: [0.0; MAX_DEGREE + 1],
+                    d: [0.0; MAX_DEGREE + 1],
+                };
+                for j in 0..=s {
+                    node.a[j] = quadrature.ell(i, j);
+                    node.d[j] = quadrature.ell_prime(i, j) / h;
+                }
+                node
+            })
+            .collect();
         Self {
             system,
             space,
             quadrature,
             h,
-            pair,
+            nodes,
         }
     }
 
@@ -285,19 +287,23 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             return (Some(covectors), magnitude);
         }
         let h = self.h;
-        residual.as_mut_slice().fill(0.0);
-        residual.fixed_rows_mut::<N>(0).copy_from(momentum);
+        // The rows ∂L_d/∂ξ_j (j < s), summed on the stack and written once.
+        let mut rows = [SVector::<f64, N>::zeros(); MAX_DEGREE];
+        rows[0] = *momentum;
         let mut impulse = SVector::zeros();
         let mut end = SVector::zeros();
         let mut magnitude = momentum.abs();
-        let quad = &self.quadrature;
         let chart = self.in_chart(base);
         let mut closed_gradient = false;
-        for (i, &b) in quad.weights().iter().enumerate() {
-            let w = h * b;
-            let (xi, xi_dot) = self.node(i, increments);
-            let a = |j: usize| quad.ell(i, j);
-            let d = |j: usize| quad.ell_prime(i, j) / h;
+        for node in &self.nodes {
+            let (w, a, d) = (node.w, &node.a[..=s], &node.d[..=s]);
+            // The path at the node, as `Quadrature::path_at` sums it.
+            let mut xi = SVector::zeros();
+            let mut xi_dot = SVector::zeros();
+            for (z, (&a, &d)) in increments.iter().zip(a[1..].iter().zip(&d[1..])) {
+                xi += z * a;
+                xi_dot += z * d;
+            }
             // A gradient in closed form brings every slot at the cost of the residual's alone.
             let closed = match jacobian {
                 None => chart.closed_gradient(&xi, &xi_dot),
@@ -313,12 +319,11 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                 None if s == 1 && N > 2 => {
                     // The residual's slot alone: one pass along the direction of ξ_0.
                     let seed = Seed {
-                        position: a(0),
-                        velocity: d(0),
+                        position: a[0],
+                        velocity: d[0],
                     };
                     let first = directional_gradient(&chart, &xi, &xi_dot, seed);
-                    let mut r = residual.fixed_rows_mut::<N>(0);
-                    r += first * w;
+                    rows[0] += first * w;
                     magnitude += first.abs() * w;
                     continue;
                 }
@@ -330,35 +335,35 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                         &xi,
                         &xi_dot,
                         Seed {
-                            position: a(0),
-                            velocity: d(0),
+                            position: a[0],
+                            velocity: d[0],
                         },
                         Seed {
-                            position: a(1),
-                            velocity: d(1),
+                            position: a[1],
+                            velocity: d[1],
                         },
                     );
                     if let Some(jacobian) = jacobian {
                         let mut block = jacobian.fixed_view_mut::<N, N>(0, 0);
                         block += l.mixed * w;
                     }
-                    let mut r = residual.fixed_rows_mut::<N>(0);
-                    r += l.first * w;
+                    rows[0] += l.first * w;
                     impulse += (l.first + l.second) * w;
                     end += l.second * w;
                     magnitude += l.first.abs() * w;
                     continue;
                 }
                 Some(jacobian) => {
-                    // Many pairs: the Hessian of ℓ at the node, then the chain rule.
+                    // Many pairs: the Hessian of ℓ at the node, then the chain rule (row block
+                    // j: the slot ξ_j, j < s; column block k: the unknown ξ_{k+1}).
                     let l = hessian(&chart, &xi, &xi_dot);
-                    for j in 0..s {
-                        for k in 1..=s {
-                            let mut block = jacobian.fixed_view_mut::<N, N>(j * N, (k - 1) * N);
-                            block += (l.qq * (a(j) * a(k))
-                                + l.qv * (a(j) * d(k))
-                                + l.qv.transpose() * (d(j) * a(k))
-                                + l.vv * (d(j) * d(k)))
+                    for (j, (&aj, &dj)) in a[..s].iter().zip(&d[..s]).enumerate() {
+                        for (k, (&ak, &dk)) in a[1..].iter().zip(&d[1..]).enumerate() {
+                            let mut block = jacobian.fixed_view_mut::<N, N>(j * N, k * N);
+                            block += (l.qq * (aj * ak)
+                                + l.qv * (aj * dk)
+                                + l.qv.transpose() * (dj * ak)
+                                + l.vv * (dj * dk))
                                 * w;
                         }
                     }
@@ -366,18 +371,21 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                 }
             };
             impulse += lq * w;
-            end += (lq * a(s) + lv * d(s)) * w;
+            end += (lq * a[s] + lv * d[s]) * w;
             magnitude += if s == 1 {
                 // The terms summed into the residual, as the dual-number passes count them.
-                (lq * a(0) + lv * d(0)).abs() * w
+                (lq * a[0] + lv * d[0]).abs() * w
             } else {
                 (lq.abs() + lv.abs() * s as f64 / h) * w
             };
-            for j in 0..s {
-                let mut r = residual.fixed_rows_mut::<N>(j * N);
-                r += (lq * a(j) + lv * d(j)) * w;
+            for (row, (&a, &d)) in rows[..s].iter_mut().zip(a.iter().zip(d)) {
+                *row += (lq * a + lv * d) * w;
             }
         }
+        for (j, row) in rows[..s].iter().enumerate() {
+            residual.fixed_rows_mut::<N>(j * N).copy_from(row);
+        }
+        residual.as_mut_slice()[N * s..].fill(0.0);
         let complete = s > 1 || N <= 2 || jacobian.is_some() || closed_gradient;
         (
             complete.then_some(StepCovectors { impulse, end }),
@@ -405,12 +413,8 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         let mut impulse = SVector::zeros();
         let mut end = SVector::zeros();
         let mut block = SMatrix::<f64, N, N>::zeros();
-        for &PairNode {
-            w,
-            a: [a0, a1],
-            d: [d0, d1],
-        } in &self.pair
-        {
+        for node in &self.nodes {
+            let (w, [a0, a1], [d0, d1]) = (node.w, [node.a[0], node.a[1]], [node.d[0], node.d[1]]);
             let (node, rate) = (xi * a1, xi * d1);
             if jacobian.is_some() {
                 // As the general path's `seeded` along the directions of ξ_0 and ξ_1.
