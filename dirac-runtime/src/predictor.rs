@@ -239,6 +239,15 @@ mod tests {
             predicted[1],
             mu[5]
         );
+        // Switched on after a history of plain solutions, the last one stays the last solution
+        // as solved, and the next step's impulse is read from it.
+        let mut late = Predictor::new(2);
+        late.record(&DVector::from_vec(vec![0.0, mu[0]]));
+        late.share_impulses(Some((1..2, 0.5)));
+        assert_eq!(late.last().unwrap()[1], mu[0]);
+        late.record(&DVector::from_vec(vec![1.0, mu[1]]));
+        assert_eq!(late.last().unwrap()[1], mu[1]);
+        assert_eq!(late.solutions[0][1], 0.5 * mu[0] + 0.5 * mu[1]);
         // Extrapolated as it stands, the alternation is missed.
         let mut plain = Predictor::new(2);
         for (k, &m) in mu.iter().enumerate().take(5) {
