@@ -263,11 +263,12 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     /// The points are `Q_0 = base` and `Q_j = R_base(ξ_j)`; the unknowns are `ξ_1, …, ξ_s`
     /// (`Q_s = q_{k+1}`), blocks of `N`. Writes the residual
     /// `[π_k + ∂L_d/∂ξ_0; ∂L_d/∂ξ_1; …; ∂L_d/∂ξ_{s−1}]` (`π_k` the momentum in the chart) into
-    /// the first `N s` rows and, when asked for, adds its Jacobian into `jacobian` (which the
-    /// caller zeroes). Without a Jacobian only first derivatives of `L` are taken, and with one
-    /// pair of slots and more than two coordinates only those the residual needs: the slot
-    /// covectors are then left to [`slot_covectors`](Self::slot_covectors) (`None`). Returns
-    /// the slot covectors and the size of the terms summed into the residual.
+    /// the first `N s` rows (the rows after them zeroed) and, when asked for, adds its Jacobian
+    /// into `jacobian` (which the caller zeroes). Without a Jacobian only first derivatives of
+    /// `L` are taken, and with one pair of slots and more than two coordinates only those the
+    /// residual needs: the slot covectors are then left to
+    /// [`slot_covectors`](Self::slot_covectors) (`None`). Returns the slot covectors and the
+    /// size of the terms summed into the residual.
     pub(crate) fn euler_lagrange(
         &self,
         base: &Point<C, N, f64>,
@@ -407,6 +408,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         residual: &mut DVector<f64>,
         jacobian: &mut Option<&mut DMatrix<f64>>,
     ) -> Option<(StepCovectors<N>, f64)> {
+        debug_assert_eq!(self.quadrature.degree(), 1, "a pair of slots is a degree-1 step");
         let chart = self.in_chart(base);
         let mut row = *momentum;
         let mut magnitude = momentum.abs();

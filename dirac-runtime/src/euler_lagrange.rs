@@ -292,6 +292,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         self.closed_pair = self.closed_form
             && self.discrete.quadrature().degree() == 1
             && self.collocated.is_empty()
+            && !self.projected()
             && !S::FORCES;
     }
 

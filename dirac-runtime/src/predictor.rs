@@ -42,9 +42,10 @@ pub(crate) struct Predictor {
     /// The multipliers whose impulse is shared between a step's ends, and the share `σ` on the
     /// start (see the [module](self)).
     shared: Option<(Range<usize>, f64)>,
-    /// The last accepted solution as solved, where the history holds node impulses instead
-    /// (elsewhere the newest solution is it).
+    /// The last accepted solution as solved, kept once node impulses have been shared in the
+    /// history (`last_kept`); until then the newest solution is it.
     last: DVector<f64>,
+    last_kept: bool,
 }
 
 impl Predictor {
@@ -57,6 +58,7 @@ impl Predictor {
             extrapolated: DVector::zeros(n),
             shared: None,
             last: DVector::zeros(n),
+            last_kept: false,
         }
     }
 
@@ -65,11 +67,10 @@ impl Predictor {
     /// `μ` from them (see the [module](self)); `None`, or `σ = 1`, extrapolates the `μ`. Kept
     /// across [`clear`](Self::clear)s of the same size.
     pub fn share_impulses(&mut self, shared: Option<(Range<usize>, f64)>) {
-        let before = self.shared.is_some();
         self.shared = shared.filter(|(range, share)| {
             !range.is_empty() && range.end <= self.last.len() && *share > 0.0 && *share < 1.0
         });
-        if !before && self.shared.is_some() {
+        if self.shared.is_some() && !self.last_kept {
             // Until now the newest solution was the last one as solved (none after a start).
             if self.count > 0 {
                 let [newest, ..] = &self.solutions;
@@ -77,6 +78,7 @@ impl Predictor {
             } else {
                 self.last.fill(0.0);
             }
+            self.last_kept = true;
         }
     }
 
@@ -86,6 +88,7 @@ impl Predictor {
             *self = Self::new(n);
         }
         self.last.fill(0.0);
+        self.last_kept = false;
         self.count = 0;
         self.detached = false;
     }
@@ -114,6 +117,9 @@ impl Predictor {
             for i in range.clone() {
                 self.solutions[0][i] = (1.0 - share) * self.last[i] + share * x[i];
             }
+            self.last_kept = true;
+        }
+        if self.last_kept {
             self.last.copy_from_slice(x.as_slice());
         }
         self.count = if self.detached {
@@ -126,9 +132,9 @@ impl Predictor {
 
     /// The last accepted solution.
     pub fn last(&self) -> Option<&DVector<f64>> {
-        let last = match self.shared {
-            Some(_) => &self.last,
-            None => &self.solutions[0],
+        let last = match self.last_kept {
+            true => &self.last,
+            false => &self.solutions[0],
         };
         (self.count > 0).then_some(last)
     }
@@ -248,6 +254,11 @@ mod tests {
         late.record(&DVector::from_vec(vec![1.0, mu[1]]));
         assert_eq!(late.last().unwrap()[1], mu[1]);
         assert_eq!(late.solutions[0][1], 0.5 * mu[0] + 0.5 * mu[1]);
+        // Switched off again, the last solution is still the one as solved, not the impulse.
+        late.share_impulses(None);
+        assert_eq!(late.last().unwrap()[1], mu[1]);
+        late.record(&DVector::from_vec(vec![2.0, mu[2]]));
+        assert_eq!(late.last().unwrap()[1], mu[2]);
         // Extrapolated as it stands, the alternation is missed.
         let mut plain = Predictor::new(2);
         for (k, &m) in mu.iter().enumerate().take(5) {
