@@ -124,6 +124,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     /// chart, the momentum from the step's `covectors` (to which the discrete Lagrangian's own are
     /// added here when the residual left them `pending`), the velocity not yet set. `step`
     /// counts the steps before, for the error where the chart's tangent map is singular.
+    #[inline(always)]
     pub(crate) fn advanced(
         &self,
         state: &State<N, C::Manifold>,

@@ -1195,6 +1195,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         passes * (N + 1) as f64 / 2.0
     }
 
+    #[inline(always)]
     fn advance(
         &self,
         state: &State<N>,

@@ -106,6 +106,7 @@ impl Predictor {
     }
 
     /// Records an accepted step's solution.
+    #[inline(always)]
     pub fn record(&mut self, x: &DVector<f64>) {
         if x.len() != self.extrapolated.len() {
             self.clear(x.len());
@@ -140,6 +141,7 @@ impl Predictor {
     }
 
     /// The prediction for the next step (none before the first accepted step).
+    #[inline(always)]
     pub fn predict(&mut self) -> Option<&DVector<f64>> {
         if self.detached {
             return None;
