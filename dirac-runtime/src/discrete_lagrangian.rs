@@ -23,7 +23,7 @@ use crate::derivatives::{
 };
 use crate::error::DiracError;
 use crate::manifold::Vectors;
-use crate::quadrature::{MAX_DEGREE, Quadrature};
+use crate::quadrature::{MAX_DEGREE, Quadrature, path_sums};
 use crate::step_equations::State;
 use crate::system::DiracSystem;
 
@@ -62,6 +62,23 @@ struct NodeWeights {
     w: f64,
     a: [f64; MAX_DEGREE + 1],
     d: [f64; MAX_DEGREE + 1],
+}
+
+impl NodeWeights {
+    /// The path through `0, increments[0], …, increments[s−1]` at this node and its rate (the
+    /// numbers of [`Quadrature::path_at`], read from the table).
+    #[inline(always)]
+    fn path<const N: usize>(
+        &self,
+        increments: &[SVector<f64, N>],
+    ) -> (SVector<f64, N>, SVector<f64, N>) {
+        // Points 1..=s: the sums stop with the increments.
+        path_sums(
+            increments,
+            self.a[1..].iter().copied(),
+            self.d[1..].iter().copied(),
+        )
+    }
 }
 
 impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
@@ -213,7 +230,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         i: usize,
         increments: &[SVector<f64, N>],
     ) -> (SVector<f64, N>, SVector<f64, N>) {
-        self.quadrature.path_at(i, increments, self.h)
+        self.nodes[i].path(increments)
     }
 
     /// How node `i`'s position and velocity move when the step's points `0..=s` move by
@@ -299,13 +316,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         let mut closed_gradient = false;
         for node in &self.nodes {
             let (w, a, d) = (node.w, &node.a[..=s], &node.d[..=s]);
-            // The path at the node, as `Quadrature::path_at` sums it.
-            let mut xi = SVector::zeros();
-            let mut xi_dot = SVector::zeros();
-            for (z, (&a, &d)) in increments.iter().zip(a[1..].iter().zip(&d[1..])) {
-                xi += z * a;
-                xi_dot += z * d;
-            }
+            let (xi, xi_dot) = node.path(increments);
             // A gradient in closed form brings every slot at the cost of the residual's alone.
             let closed = match jacobian {
                 None => chart.closed_gradient(&xi, &xi_dot),
@@ -409,7 +420,11 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         residual: &mut DVector<f64>,
         jacobian: &mut Option<&mut DMatrix<f64>>,
     ) -> Option<(StepCovectors<N>, f64)> {
-        debug_assert_eq!(self.quadrature.degree(), 1, "a pair of slots is a degree-1 step");
+        debug_assert_eq!(
+            self.quadrature.degree(),
+            1,
+            "a pair of slots is a degree-1 step"
+        );
         let chart = self.in_chart(base);
         let mut row = *momentum;
         let mut magnitude = momentum.abs();

@@ -1302,8 +1302,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, NewtonFailure> {
-        self.velocity_with_multipliers(newton, t, q, p, guess, self.hidden.as_ref())
-            .map(|solved| solved.velocity)
+        self.velocity_and_energy_in_run(newton, t, q, p, guess)
+            .map(|(velocity, _)| velocity)
     }
 
     /// The plain Legendre inversion's chord step (no constraints, kinetic energy in every

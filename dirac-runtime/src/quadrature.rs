@@ -222,13 +222,12 @@ impl Quadrature {
         increments: &[SVector<f64, N>],
         h: f64,
     ) -> (SVector<f64, N>, SVector<f64, N>) {
-        let mut xi = SVector::zeros();
-        let mut rate = SVector::zeros();
-        for (j, z) in increments.iter().enumerate() {
-            xi += z * self.ell(node, j + 1);
-            rate += z * (self.ell_prime(node, j + 1) / h);
-        }
-        (xi, rate)
+        let points = 1..=increments.len();
+        path_sums(
+            increments,
+            points.clone().map(|j| self.ell(node, j)),
+            points.map(|j| self.ell_prime(node, j) / h),
+        )
     }
 
     /// The path through `0, points[0], …, points[s−1]` (equispaced in `[0, 1]`) at any fraction
@@ -386,6 +385,24 @@ fn gauss_lobatto(r: usize) -> (Vec<f64>, Vec<f64>) {
         weights.push(1.0 / (nf * (nf + 1.0) * p * p));
     }
     (nodes, weights)
+}
+
+/// The path through `0, increments[0], …, increments[s−1]` at one node from the basis values
+/// `ℓ_j(c_i)` and rates `ℓ'_j(c_i)/h` of its points `j = 1..=s`: `(Σ_j ℓ_j ξ_j, Σ_j ℓ'_j ξ_j / h)`,
+/// summed in the order of the points.
+#[inline(always)]
+pub(crate) fn path_sums<const N: usize>(
+    increments: &[SVector<f64, N>],
+    basis: impl Iterator<Item = f64>,
+    rates: impl Iterator<Item = f64>,
+) -> (SVector<f64, N>, SVector<f64, N>) {
+    let mut xi = SVector::zeros();
+    let mut rate = SVector::zeros();
+    for (z, (a, d)) in increments.iter().zip(basis.zip(rates)) {
+        xi += z * a;
+        rate += z * d;
+    }
+    (xi, rate)
 }
 
 #[cfg(test)]
