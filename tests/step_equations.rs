@@ -243,3 +243,56 @@ fn the_lagrangian_equations_validate_what_the_stepper_would() {
         Err(DiracError::InvalidStep { .. })
     ));
 }
+
+/// A bead on the unit sphere whose velocity is held off one direction by a one-form: a model
+/// with both kinds of constraint rows, and closed-form derivatives of `L`.
+#[dirac_system(
+    coordinates(x, y, z),
+    lagrangian = 0.5 * (dot(x).powi(2) + dot(y).powi(2) + dot(z).powi(2)) - g * z,
+    constraints(z * dx - x * dz),
+    holonomic(x * x + y * y + z * z - 1.0),
+)]
+#[derive(Debug, Clone, Copy)]
+struct HeldBead {
+    g: f64,
+}
+
+/// Every row of a step's residual is written by the assembly, whatever the vector held before
+/// (a degree-1 step with closed forms writes the Euler–Lagrange rows and leaves the rest to the
+/// constraint rows): assembling into a vector of NaN gives what assembling into zeros gives.
+#[test]
+fn the_assembly_writes_every_row_of_the_residual() {
+    use dirac::euler_lagrange::EulerLagrange;
+    let bead = HeldBead { g: 9.81 };
+    let q = vector![0.6, 0.0, -0.8];
+    let v = vector![0.0, 1.0, 0.0];
+    let state = State::new(0.0, q, v, v);
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let discrete = DiscreteLagrangian::new(bead, quadrature, 0.01);
+        let mut equations = EulerLagrange::new(discrete).unwrap();
+        equations.begin(&state);
+        let n = equations.unknowns();
+        let mut x = DVector::zeros(n);
+        equations.predict(&state, None, &mut x);
+        // Off the solution, with multipliers that are not zero.
+        for (i, xi) in x.iter_mut().enumerate() {
+            *xi += 1e-3 * (i + 1) as f64;
+        }
+        for with_jacobian in [false, true] {
+            let mut assembled = |fill: f64| {
+                let mut residual = DVector::from_element(n, fill);
+                let mut jacobian = DMatrix::zeros(n, n);
+                let scale = equations.assemble(
+                    &state,
+                    &x,
+                    &mut residual,
+                    with_jacobian.then_some(&mut jacobian),
+                );
+                (residual, jacobian, scale)
+            };
+            let (clean, stale) = (assembled(0.0), assembled(f64::NAN));
+            assert!(clean.0.iter().all(|r| r.is_finite()) && clean.0.amax() > 0.0);
+            assert_eq!(clean, stale, "{} rows, Jacobian: {with_jacobian}", n);
+        }
+    }
+}

@@ -303,6 +303,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             && let Some((covectors, magnitude)) =
                 self.pair_in_closed_form(base, &increments[0], momentum, residual, &mut jacobian)
         {
+            residual.as_mut_slice()[N..].fill(0.0);
             return (Some(covectors), magnitude);
         }
         let h = self.h;
@@ -409,8 +410,9 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     /// [`euler_lagrange`](Self::euler_lagrange) of a degree-1 step (one pair of slots, `ξ` the
     /// end point's increment) from the Lagrangian's closed-form derivatives: the same sums in
     /// the same order as the general path, without its loops over the step's points: the slot
-    /// covectors and the size of the residual's terms. `None`, with nothing written, where the
-    /// model has no closed forms.
+    /// covectors and the size of the residual's terms. Writes rows `0..N` alone: the rows after
+    /// them are the caller's to write. `None`, with nothing written, where the model has no
+    /// closed forms.
     #[inline(always)]
     pub(crate) fn pair_in_closed_form(
         &self,
@@ -462,7 +464,6 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             }
         }
         residual.fixed_rows_mut::<N>(0).copy_from(&row);
-        residual.as_mut_slice()[N..].fill(0.0);
         if let Some(jacobian) = jacobian.as_deref_mut() {
             let mut target = jacobian.fixed_view_mut::<N, N>(0, 0);
             target += block;

@@ -445,6 +445,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         }
         let dead = hidden.coordinates();
         let mut spare = None;
+        if !Self::constrained() && hidden.count() == 0 && hidden.dynamic() == 0 {
+            // No rows constrain the velocity: the plain inversion (as below with no forms).
+            let newton = sized(newton, N, &mut spare)?;
+            return legendre::velocity_with_energy(system, newton, q, p, guess, dead)
+                .map(|(v, energy)| Legendre::plain(v, energy));
+        }
         if hidden.dynamic() > 0 && hidden.count() == 0 {
             // Degenerate rows that are first-order equations (a resistor on a capacitor's
             // branch) fix their velocities through the dynamics, not through p.
@@ -1144,7 +1150,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         mut jacobian: Option<&mut DMatrix<f64>>,
     ) -> f64 {
         if self.closed_pair {
-            // The end point's increment leads the unknowns of a degree-1 step.
+            // The end point's increment leads the unknowns of a degree-1 step; the constraint
+            // rows write every row after it (there are no others without a projection).
+            debug_assert_eq!(x.len(), N + S::ONE_FORMS + S::HOLONOMIC);
             let xi = x.fixed_rows::<N>(0).into_owned();
             self.increments[0] = xi;
             if let Some((covectors, scale)) = self.discrete.pair_in_closed_form(

@@ -1160,19 +1160,19 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
 
     /// Solves the next step without making it current: the state is unchanged whatever happens.
     fn solve_step(&mut self) -> Result<Proposal<N, E::Manifold>, DiracError> {
-        let Some(state) = self.state else {
+        let Some(state) = &self.state else {
             return Err(DiracError::NotStarted);
         };
         // The last solutions extrapolated (see `predictor`).
         let predictor = self.predictor.predict();
         let equations = &mut self.equations;
-        equations.predict(&state, predictor, &mut self.unknowns);
+        equations.predict(state, predictor, &mut self.unknowns);
         self.newton.set_jacobian_cost(equations.jacobian_cost());
         let result = self.newton.solve(&mut self.unknowns, |x, r, j| {
-            equations.assemble(&state, x, r, j)
+            equations.assemble(state, x, r, j)
         });
         let report = result.map_err(|f| self.failure(Problem::Step, f))?;
-        let (mut next, violation) = self.equations.advance(&state, &self.unknowns, self.steps)?;
+        let (mut next, violation) = self.equations.advance(state, &self.unknowns, self.steps)?;
         next.t = self.start + (self.steps + 1) as f64 * self.equations.h();
         Ok(Proposal {
             next,
