@@ -267,6 +267,9 @@ fn the_assembly_writes_every_row_of_the_residual() {
     let q = vector![0.6, 0.0, -0.8];
     let v = vector![0.0, 1.0, 0.0];
     let state = State::new(0.0, q, v, v);
+    // Closed forms: the midpoint rule takes the degree-1 path that leaves rows to the
+    // constraints (`galerkin(2)` the general assembly).
+    assert!(bead.lagrangian_hessian(&q, &v).is_some());
     for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
         let discrete = DiscreteLagrangian::new(bead, quadrature, 0.01);
         let mut equations = EulerLagrange::new(discrete).unwrap();
