@@ -69,6 +69,7 @@ pub(crate) fn velocity<F: PhaseFunction<N>, const N: usize>(
 /// evaluated `L` there on its way (the chord step of closed-form derivatives): the numbers
 /// [`energy`] gives, without evaluating `L` again. `None` for the energy where the general
 /// solve ran.
+#[inline(always)]
 pub(crate) fn velocity_with_energy<F: PhaseFunction<N>, const N: usize>(
     system: &F,
     newton: &mut Newton,
@@ -82,6 +83,19 @@ pub(crate) fn velocity_with_energy<F: PhaseFunction<N>, const N: usize>(
     {
         return Ok((v, Some(energy)));
     }
+    newton_velocity(system, newton, q, p, guess, dead).map(|v| (v, None))
+}
+
+/// The general solve of [`velocity`]: Newton's method with the Hessian, from `guess`.
+#[inline(never)]
+fn newton_velocity<F: PhaseFunction<N>, const N: usize>(
+    system: &F,
+    newton: &mut Newton,
+    q: &SVector<f64, N>,
+    p: &SVector<f64, N>,
+    guess: &SVector<f64, N>,
+    dead: &[usize],
+) -> Result<SVector<f64, N>, NewtonFailure> {
     let x = newton.solve_from(guess.as_slice(), |x, r, j| {
         let v = SVector::<f64, N>::from_column_slice(x.as_slice());
         // The Hessian only when Newton asks for a Jacobian.
@@ -104,7 +118,7 @@ pub(crate) fn velocity_with_energy<F: PhaseFunction<N>, const N: usize>(
         }
         l.first.abs().sup(&p.abs()).amax()
     })?;
-    Ok((SVector::from_column_slice(x.as_slice()), None))
+    Ok(SVector::from_column_slice(x.as_slice()))
 }
 
 /// One Newton step from `guess` with the Hessian `∂²L/∂v²` there, in fixed size, taken where
