@@ -331,15 +331,7 @@ pub(crate) fn seeded_from_hessian<const N: usize>(
 ) -> Seeded<N> {
     let g = &h.gradient;
     if ![x.position, x.velocity, y.position, y.velocity].contains(&0.0) {
-        return Seeded {
-            value: g.value,
-            first: g.q * x.position + g.v * x.velocity,
-            second: g.q * y.position + g.v * y.velocity,
-            mixed: h.qq * (x.position * y.position)
-                + h.qv * (x.position * y.velocity)
-                + h.qv.transpose() * (x.velocity * y.position)
-                + h.vv * (x.velocity * y.velocity),
-        };
+        return seeded_without_zero_weights(h, x, y);
     }
     let along = |s: Seed| weighted(&g.q, s.position) + weighted(&g.v, s.velocity);
     Seeded {
@@ -350,6 +342,25 @@ pub(crate) fn seeded_from_hessian<const N: usize>(
             + weighted(&h.qv, x.position * y.velocity)
             + weighted(&h.qv.transpose(), x.velocity * y.position)
             + weighted(&h.vv, x.velocity * y.velocity),
+    }
+}
+
+/// [`seeded_from_hessian`] where no weight of `x` and `y` is zero: the plain products.
+#[inline(always)]
+pub(crate) fn seeded_without_zero_weights<const N: usize>(
+    h: &LagrangianHessian<N>,
+    x: Seed,
+    y: Seed,
+) -> Seeded<N> {
+    let g = &h.gradient;
+    Seeded {
+        value: g.value,
+        first: g.q * x.position + g.v * x.velocity,
+        second: g.q * y.position + g.v * y.velocity,
+        mixed: h.qq * (x.position * y.position)
+            + h.qv * (x.position * y.velocity)
+            + h.qv.transpose() * (x.velocity * y.position)
+            + h.vv * (x.velocity * y.velocity),
     }
 }
 

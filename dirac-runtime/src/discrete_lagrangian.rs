@@ -19,7 +19,7 @@ use crate::closed_form::LagrangianHessian;
 use crate::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors, Tangent};
 use crate::derivatives::{
     InChart, PhaseFunction, Seed, directional_gradient, gradients, hessian, moving_row, seeded,
-    seeded_from_hessian, third_derivative,
+    seeded_from_hessian, seeded_without_zero_weights, third_derivative,
 };
 use crate::error::DiracError;
 use crate::manifold::Vectors;
@@ -62,9 +62,17 @@ struct NodeWeights {
     w: f64,
     a: [f64; MAX_DEGREE + 1],
     d: [f64; MAX_DEGREE + 1],
+    /// No zero among `a[0], a[1], d[0], d[1]`: a degree-1 step's seeds take plain products.
+    pair_without_zeros: bool,
 }
 
 impl NodeWeights {
+    /// The weight, basis and rates of a degree-1 step's two points at this node.
+    #[inline(always)]
+    fn pair(&self) -> (f64, [f64; 2], [f64; 2]) {
+        (self.w, [self.a[0], self.a[1]], [self.d[0], self.d[1]])
+    }
+
     /// The path through `0, increments[0], …, increments[s−1]` at this node and its rate (the
     /// numbers of [`Quadrature::path_at`], read from the table).
     #[inline(always)]
@@ -79,6 +87,16 @@ impl NodeWeights {
             self.d[1..].iter().copied(),
         )
     }
+}
+
+/// The sums of the general assembly over a step's nodes: the rows `∂L_d/∂ξ_j` (`j < s`), the
+/// slot covectors' terms, the size of the terms, and whether the gradient came in closed form.
+struct NodeSums<const N: usize> {
+    rows: [SVector<f64, N>; MAX_DEGREE],
+    impulse: SVector<f64, N>,
+    end: SVector<f64, N>,
+    magnitude: SVector<f64, N>,
+    closed_gradient: bool,
 }
 
 impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
@@ -100,11 +118,14 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                     w: h * quadrature.weights()[i],
                     a: [0.0; MAX_DEGREE + 1],
                     d: [0.0; MAX_DEGREE + 1],
+                    pair_without_zeros: false,
                 };
                 for j in 0..=s {
                     node.a[j] = quadrature.ell(i, j);
                     node.d[j] = quadrature.ell_prime(i, j) / h;
                 }
+                node.pair_without_zeros =
+                    ![node.a[0], node.a[1], node.d[0], node.d[1]].contains(&0.0);
                 node
             })
             .collect();
@@ -306,96 +327,37 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             residual.as_mut_slice()[N..].fill(0.0);
             return (Some(covectors), magnitude);
         }
-        let h = self.h;
         // The rows ∂L_d/∂ξ_j (j < s), summed on the stack and written once.
         let mut rows = [SVector::<f64, N>::zeros(); MAX_DEGREE];
         rows[0] = *momentum;
-        let mut impulse = SVector::zeros();
-        let mut end = SVector::zeros();
-        let mut magnitude = momentum.abs();
+        let mut sums = NodeSums {
+            rows,
+            impulse: SVector::zeros(),
+            end: SVector::zeros(),
+            magnitude: momentum.abs(),
+            closed_gradient: false,
+        };
         let chart = self.in_chart(base);
-        let mut closed_gradient = false;
-        for node in &self.nodes {
-            let (w, a, d) = (node.w, &node.a[..=s], &node.d[..=s]);
-            let (xi, xi_dot) = node.path(increments);
-            // A gradient in closed form brings every slot at the cost of the residual's alone.
-            let closed = match jacobian {
-                None => chart.closed_gradient(&xi, &xi_dot),
-                _ => None,
-            };
-            let (lq, lv) = match jacobian.as_deref_mut() {
-                None if let Some(g) = closed => {
-                    closed_gradient = true;
-                    (g.q, g.v)
+        // One loop for each case, as in `pair_in_closed_form`.
+        match jacobian.as_deref_mut() {
+            Some(jacobian) => {
+                for node in &self.nodes {
+                    self.add_node_terms(&chart, node, increments, &mut sums, Some(&mut *jacobian));
                 }
-                // Up to two coordinates the hyper-dual pass costs about one first-order pass,
-                // and brings both slots: the covectors come with the residual.
-                None if s == 1 && N > 2 => {
-                    // The residual's slot alone: one pass along the direction of ξ_0.
-                    let seed = Seed {
-                        position: a[0],
-                        velocity: d[0],
-                    };
-                    let first = directional_gradient(&chart, &xi, &xi_dot, seed);
-                    rows[0] += first * w;
-                    magnitude += first.abs() * w;
-                    continue;
+            }
+            None => {
+                for node in &self.nodes {
+                    self.add_node_terms(&chart, node, increments, &mut sums, None);
                 }
-                None => gradients(&chart, &xi, &xi_dot),
-                jacobian if s == 1 => {
-                    // One pair of slots: seed the directions of ξ_0 and ξ_1 themselves.
-                    let l = seeded(
-                        &chart,
-                        &xi,
-                        &xi_dot,
-                        Seed {
-                            position: a[0],
-                            velocity: d[0],
-                        },
-                        Seed {
-                            position: a[1],
-                            velocity: d[1],
-                        },
-                    );
-                    if let Some(jacobian) = jacobian {
-                        let mut block = jacobian.fixed_view_mut::<N, N>(0, 0);
-                        block += l.mixed * w;
-                    }
-                    rows[0] += l.first * w;
-                    impulse += (l.first + l.second) * w;
-                    end += l.second * w;
-                    magnitude += l.first.abs() * w;
-                    continue;
-                }
-                Some(jacobian) => {
-                    // Many pairs: the Hessian of ℓ at the node, then the chain rule (row block
-                    // j: the slot ξ_j, j < s; column block k: the unknown ξ_{k+1}).
-                    let l = hessian(&chart, &xi, &xi_dot);
-                    for (j, (&aj, &dj)) in a[..s].iter().zip(&d[..s]).enumerate() {
-                        for (k, (&ak, &dk)) in a[1..].iter().zip(&d[1..]).enumerate() {
-                            let mut block = jacobian.fixed_view_mut::<N, N>(j * N, k * N);
-                            block += (l.qq * (aj * ak)
-                                + l.qv * (aj * dk)
-                                + l.qv.transpose() * (dj * ak)
-                                + l.vv * (dj * dk))
-                                * w;
-                        }
-                    }
-                    (l.gradient.q, l.gradient.v)
-                }
-            };
-            impulse += lq * w;
-            end += (lq * a[s] + lv * d[s]) * w;
-            magnitude += if s == 1 {
-                // The terms summed into the residual, as the dual-number passes count them.
-                (lq * a[0] + lv * d[0]).abs() * w
-            } else {
-                (lq.abs() + lv.abs() * s as f64 / h) * w
-            };
-            for (row, (&a, &d)) in rows[..s].iter_mut().zip(a.iter().zip(d)) {
-                *row += (lq * a + lv * d) * w;
             }
         }
+        let NodeSums {
+            rows,
+            impulse,
+            end,
+            magnitude,
+            closed_gradient,
+        } = sums;
         for (j, row) in rows[..s].iter().enumerate() {
             residual.fixed_rows_mut::<N>(j * N).copy_from(row);
         }
@@ -405,6 +367,102 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             complete.then_some(StepCovectors { impulse, end }),
             magnitude.amax(),
         )
+    }
+
+    /// Adds node `node`'s terms to the sums of the general assembly
+    /// ([`euler_lagrange`](Self::euler_lagrange)), and its Jacobian blocks into `jacobian` where
+    /// one is asked for. Called from one loop for each case: within one loop body the compiler
+    /// hoists what the gradient and the Hessian in closed form share above the branch between
+    /// them, which splits a `sin` from its `cos` (two calls where one `sincos` does).
+    #[inline(always)]
+    fn add_node_terms(
+        &self,
+        chart: &InChart<'_, S, C, N>,
+        node: &NodeWeights,
+        increments: &[SVector<f64, N>],
+        sums: &mut NodeSums<N>,
+        jacobian: Option<&mut DMatrix<f64>>,
+    ) {
+        let (h, s) = (self.h, self.quadrature.degree());
+        let (w, a, d) = (node.w, &node.a[..=s], &node.d[..=s]);
+        let (xi, xi_dot) = node.path(increments);
+        // A gradient in closed form brings every slot at the cost of the residual's alone.
+        let closed = match jacobian {
+            None => chart.closed_gradient(&xi, &xi_dot),
+            _ => None,
+        };
+        let (lq, lv) = match jacobian {
+            None if let Some(g) = closed => {
+                sums.closed_gradient = true;
+                (g.q, g.v)
+            }
+            // Up to two coordinates the hyper-dual pass costs about one first-order pass,
+            // and brings both slots: the covectors come with the residual.
+            None if s == 1 && N > 2 => {
+                // The residual's slot alone: one pass along the direction of ξ_0.
+                let seed = Seed {
+                    position: a[0],
+                    velocity: d[0],
+                };
+                let first = directional_gradient(chart, &xi, &xi_dot, seed);
+                sums.rows[0] += first * w;
+                sums.magnitude += first.abs() * w;
+                return;
+            }
+            None => gradients(chart, &xi, &xi_dot),
+            jacobian if s == 1 => {
+                // One pair of slots: seed the directions of ξ_0 and ξ_1 themselves.
+                let l = seeded(
+                    chart,
+                    &xi,
+                    &xi_dot,
+                    Seed {
+                        position: a[0],
+                        velocity: d[0],
+                    },
+                    Seed {
+                        position: a[1],
+                        velocity: d[1],
+                    },
+                );
+                if let Some(jacobian) = jacobian {
+                    let mut block = jacobian.fixed_view_mut::<N, N>(0, 0);
+                    block += l.mixed * w;
+                }
+                sums.rows[0] += l.first * w;
+                sums.impulse += (l.first + l.second) * w;
+                sums.end += l.second * w;
+                sums.magnitude += l.first.abs() * w;
+                return;
+            }
+            Some(jacobian) => {
+                // Many pairs: the Hessian of ℓ at the node, then the chain rule (row block
+                // j: the slot ξ_j, j < s; column block k: the unknown ξ_{k+1}).
+                let l = hessian(chart, &xi, &xi_dot);
+                for (j, (&aj, &dj)) in a[..s].iter().zip(&d[..s]).enumerate() {
+                    for (k, (&ak, &dk)) in a[1..].iter().zip(&d[1..]).enumerate() {
+                        let mut block = jacobian.fixed_view_mut::<N, N>(j * N, k * N);
+                        block += (l.qq * (aj * ak)
+                            + l.qv * (aj * dk)
+                            + l.qv.transpose() * (dj * ak)
+                            + l.vv * (dj * dk))
+                            * w;
+                    }
+                }
+                (l.gradient.q, l.gradient.v)
+            }
+        };
+        sums.impulse += lq * w;
+        sums.end += (lq * a[s] + lv * d[s]) * w;
+        sums.magnitude += if s == 1 {
+            // The terms summed into the residual, as the dual-number passes count them.
+            (lq * a[0] + lv * d[0]).abs() * w
+        } else {
+            (lq.abs() + lv.abs() * s as f64 / h) * w
+        };
+        for (row, (&a, &d)) in sums.rows[..s].iter_mut().zip(a.iter().zip(d)) {
+            *row += (lq * a + lv * d) * w;
+        }
     }
 
     /// [`euler_lagrange`](Self::euler_lagrange) of a degree-1 step (one pair of slots, `ξ` the
@@ -433,10 +491,14 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         let mut impulse = SVector::zeros();
         let mut end = SVector::zeros();
         let mut block = SMatrix::<f64, N, N>::zeros();
-        for node in &self.nodes {
-            let (w, [a0, a1], [d0, d1]) = (node.w, [node.a[0], node.a[1]], [node.d[0], node.d[1]]);
-            let (node, rate) = (xi * a1, xi * d1);
-            if jacobian.is_some() {
+        // One loop for each case: within one loop body the compiler hoists what the gradient and
+        // the Hessian share (a `sin`) above the branch and leaves its partner (the `cos`) below,
+        // where the two can no longer be one `sincos` call.
+        if jacobian.is_some() {
+            for node in &self.nodes {
+                let (w, [a0, a1], [d0, d1]) = node.pair();
+                let plain = node.pair_without_zeros;
+                let (node, rate) = (xi * a1, xi * d1);
                 // As the general path's `seeded` along the directions of ξ_0 and ξ_1.
                 let (x, y) = (
                     Seed {
@@ -448,13 +510,22 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                         velocity: d1,
                     },
                 );
-                let l = seeded_from_hessian(&chart.closed_hessian(&node, &rate)?, x, y);
+                let hessian = chart.closed_hessian(&node, &rate)?;
+                let l = if plain {
+                    seeded_without_zero_weights(&hessian, x, y)
+                } else {
+                    seeded_from_hessian(&hessian, x, y)
+                };
                 block += l.mixed * w;
                 row += l.first * w;
                 impulse += (l.first + l.second) * w;
                 end += l.second * w;
                 magnitude += l.first.abs() * w;
-            } else {
+            }
+        } else {
+            for node in &self.nodes {
+                let (w, [a0, a1], [d0, d1]) = node.pair();
+                let (node, rate) = (xi * a1, xi * d1);
                 let g = chart.closed_gradient(&node, &rate)?;
                 let first = g.q * a0 + g.v * d0;
                 row += first * w;

@@ -443,14 +443,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             return legendre::first_order_velocity(system, newton, q, guess)
                 .map(|v| Legendre::plain(v, None));
         }
+        if let Some(solved) = self.unconstrained_velocity(newton, q, p, guess, hidden) {
+            return solved.map(|(v, energy)| Legendre::plain(v, energy));
+        }
         let dead = hidden.coordinates();
         let mut spare = None;
-        if !Self::constrained() && hidden.count() == 0 && hidden.dynamic() == 0 {
-            // No rows constrain the velocity: the plain inversion (as below with no forms).
-            let newton = sized(newton, N, &mut spare)?;
-            return legendre::velocity_with_energy(system, newton, q, p, guess, dead)
-                .map(|(v, energy)| Legendre::plain(v, energy));
-        }
         if hidden.dynamic() > 0 && hidden.count() == 0 {
             // Degenerate rows that are first-order equations (a resistor on a capacitor's
             // branch) fix their velocities through the dynamics, not through p.
@@ -500,6 +497,29 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             legendre::velocity_with_energy(system, newton, q, p, guess, dead)
                 .map(|(v, energy)| Legendre::plain(v, energy))
         }
+    }
+
+    /// The plain Legendre inversion where no rows constrain the velocity (no constraints, no
+    /// hidden constraints, some kinetic energy) and `newton` has `N` unknowns, with the energy
+    /// where its chord step gives it: what [`velocity_with_multipliers`](Self::velocity_with_multipliers)
+    /// finds there, without its bookkeeping. `None` elsewhere.
+    #[inline(always)]
+    fn unconstrained_velocity(
+        &self,
+        newton: &mut Newton,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+        hidden: &HiddenConstraints,
+    ) -> Option<Result<VelocityAndEnergy<N>, NewtonFailure>> {
+        let plain = !Self::constrained()
+            && hidden.count() == 0
+            && hidden.dynamic() == 0
+            && hidden.coordinates().len() < N
+            && newton.unknowns() == N;
+        let system = self.discrete.system();
+        let dead = hidden.coordinates();
+        plain.then(|| legendre::velocity_with_energy(system, newton, q, p, guess, dead))
     }
 
     /// RATTLE's momentum projection at the end of a step: `p ← p + Σ_b ν_b dg_b(q)` with `ν`
@@ -789,7 +809,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     }
 
     /// [`StepEquations::assemble`] with `scratch` (`n × n`) taking the Jacobian of the rows
-    /// beyond the discrete Euler–Lagrange ones when none is asked for.
+    /// beyond the discrete Euler–Lagrange ones when none is asked for. Kept out of line: inlined,
+    /// it made Newton's evaluation larger for the degree-1 path too (the knife edge took 56
+    /// instructions a step more).
+    #[inline(never)]
     fn assemble_into(
         &mut self,
         state: &State<N>,
@@ -1142,6 +1165,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         }
     }
 
+    #[inline(always)]
     fn assemble(
         &mut self,
         state: &State<N>,
@@ -1324,6 +1348,11 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         p: &SVector<f64, N>,
         guess: &SVector<f64, N>,
     ) -> Result<(SVector<f64, N>, Option<f64>), NewtonFailure> {
+        if let Some(hidden) = &self.hidden
+            && let Some(solved) = self.unconstrained_velocity(newton, q, p, guess, hidden)
+        {
+            return solved;
+        }
         self.velocity_with_multipliers(newton, t, q, p, guess, self.hidden.as_ref())
             .map(|solved| (solved.velocity, solved.energy))
     }
@@ -1537,6 +1566,9 @@ struct Sensitivity<const N: usize> {
     theta: f64,
     inputs: usize,
 }
+
+/// A velocity, with the energy there where the solve that found it gives it.
+type VelocityAndEnergy<const N: usize> = (SVector<f64, N>, Option<f64>);
 
 /// The error for derivatives asked of a Newton solver that does not hold the factorisation at
 /// the solution (no solve, a failed one since, or another point).

@@ -1196,7 +1196,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         }
         self.violation = proposal.violation;
         self.steps += 1;
-        self.before = self.state.replace(proposal.next);
+        self.before = self.state;
+        self.state = Some(proposal.next);
         self.report = Some(proposal.report);
     }
 
