@@ -500,9 +500,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     }
 
     /// The plain Legendre inversion where no rows constrain the velocity (no constraints, no
-    /// hidden constraints, some kinetic energy) and `newton` has `N` unknowns, with the energy
-    /// where its chord step gives it: what [`velocity_with_multipliers`](Self::velocity_with_multipliers)
-    /// finds there, without its bookkeeping. `None` elsewhere.
+    /// hidden constraints, fewer than `N` velocities without kinetic energy: not a first-order
+    /// model) and `newton` has `N` unknowns, with the energy where its chord step gives it:
+    /// what [`velocity_with_multipliers`](Self::velocity_with_multipliers) finds there,
+    /// without its bookkeeping. `None` elsewhere.
     #[inline(always)]
     fn unconstrained_velocity(
         &self,
