@@ -821,3 +821,61 @@ fn the_reported_violation_is_the_one_form_at_the_stored_points() {
         }
     }
 }
+
+/// The violation is measured when asked, from the last accepted step: a step that fails (and
+/// changes nothing) leaves it as it was, a new constraint point does not re-measure the step
+/// already taken, and a run records at each sample what `constraint_violation` reports after
+/// that sample's step. `galerkin(2)` reads its internal point from the step's solution, which a
+/// failed step's iterations overwrite.
+#[test]
+fn the_violation_measured_on_request_is_the_last_accepted_steps() {
+    let (h, omega) = (0.05, knife_edge::OMEGA);
+    let galerkin = Quadrature::galerkin(2).unwrap();
+    let mut stepper = Stepper::new(knife_edge::SCENE, galerkin.clone(), h).unwrap();
+    stepper
+        .start_from_velocity(SVector::zeros(), vector![0.0, 0.0, omega])
+        .unwrap();
+    stepper.run(20).unwrap();
+    let before = (stepper.q(), stepper.constraint_violation());
+    // One Newton iteration cannot solve a step from a far predictor: it fails and keeps the state.
+    let options = NewtonOptions {
+        max_iterations: 1,
+        ..NewtonOptions::default()
+    };
+    let mut failing = stepper.with_newton_options(options).unwrap();
+    assert!(failing.step().is_err());
+    assert_eq!((failing.q(), failing.constraint_violation()), before);
+
+    // Step by step and by a run: the same violation at every sample.
+    let mut by_steps = Stepper::new(knife_edge::SCENE, galerkin.clone(), h).unwrap();
+    let mut by_run = Stepper::new(knife_edge::SCENE, galerkin, h).unwrap();
+    for stepper in [&mut by_steps, &mut by_run] {
+        stepper
+            .start_from_velocity(SVector::zeros(), vector![0.0, 0.0, omega])
+            .unwrap();
+    }
+    let recorded = by_run.run(30).unwrap();
+    assert_eq!(recorded.constraint_violation()[0], 0.0);
+    for k in 1..=30 {
+        by_steps.step().unwrap();
+        assert_eq!(
+            by_steps.constraint_violation(),
+            recorded.constraint_violation()[k]
+        );
+    }
+
+    // A midpoint step measured at its midpoint keeps that measure under a new constraint point;
+    // measured at the end point it would differ.
+    let mut stepper = knife_edge::stepper(ConstraintPoint::Midpoint, h).unwrap();
+    let q0 = stepper.q();
+    stepper.step().unwrap();
+    let at_midpoint = stepper.constraint_violation();
+    let xi = stepper.q() - q0;
+    let at_end = knife_edge::SCENE.one_form(&stepper.q(), 0).dot(&xi).abs();
+    assert!(
+        at_end > 1e-6 && at_midpoint < 1e-14,
+        "{at_end:e}, {at_midpoint:e}"
+    );
+    let stepper = stepper.with_constraint_point(ConstraintPoint::End);
+    assert_eq!(stepper.constraint_violation(), at_midpoint);
+}

@@ -825,7 +825,7 @@ fn raw_step<E: StepEquations<N, Manifold = dirac::Vectors>, const N: usize>(
     newton
         .solve(&mut x, |x, r, j| equations.assemble(&state, x, r, j))
         .expect("step");
-    let (next, _) = equations.advance(&state, &x, 0).unwrap();
+    let next = equations.advance(&state, &x, 0).unwrap();
     newton
         .factorise_at(&x, |x, r, j| equations.assemble(&state, x, r, j))
         .expect("a regular root");

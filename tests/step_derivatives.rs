@@ -232,7 +232,7 @@ fn raw_step<S: DiracSystem<N>, const N: usize>(
     newton
         .solve(&mut x, |x, r, j| equations.assemble(&state, x, r, j))
         .expect("step");
-    let (next, _) = equations.advance(&state, &x, 0).unwrap();
+    let next = equations.advance(&state, &x, 0).unwrap();
     // The derivatives need the Jacobian at the root, which the solve may not have evaluated.
     newton
         .factorise_at(&x, |x, r, j| equations.assemble(&state, x, r, j))

@@ -102,9 +102,17 @@ impl StepEquations<1> for ImplicitMidpoint {
         state: &State<1>,
         x: &DVector<f64>,
         _step: u64,
-    ) -> Result<(State<1>, f64), DiracError> {
-        let next = State::new(state.t(), vector![x[0]], vector![x[1]], vector![x[1]]);
-        Ok((next, 0.0))
+    ) -> Result<State<1>, DiracError> {
+        Ok(State::new(
+            state.t(),
+            vector![x[0]],
+            vector![x[1]],
+            vector![x[1]],
+        ))
+    }
+
+    fn violation(&self, _from: &State<1>, _to: &State<1>, _x: &DVector<f64>) -> f64 {
+        0.0
     }
 
     fn first_multiplier(&self) -> usize {

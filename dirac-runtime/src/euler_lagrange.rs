@@ -204,6 +204,18 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         self.layout.len() > self.layout.projection()
     }
 
+    /// The step's increment `ξ_s` of the end point solved by `x` (projected onto `p = ϑ(q)`
+    /// where the run's steps are).
+    #[inline(always)]
+    fn end_increment(&self, x: &DVector<f64>) -> SVector<f64, N> {
+        let xi = x.fixed_rows::<N>(self.layout.end_point()).into_owned();
+        if !self.projected() {
+            return xi;
+        }
+        let shift = x.fixed_rows::<N>(self.layout.projection()).into_owned();
+        first_order::projected_increment(self.discrete.quadrature(), &xi, &shift)
+    }
+
     /// Whether the run's Lagrangian is linear in every velocity.
     fn first_order(&self) -> bool {
         N > 0 && self.collocated.len() == N
@@ -1234,14 +1246,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         state: &State<N>,
         x: &DVector<f64>,
         step: u64,
-    ) -> Result<(State<N>, f64), DiracError> {
+    ) -> Result<State<N>, DiracError> {
         let space = self.discrete.space();
         let system = self.discrete.system();
-        let mut xi = x.fixed_rows::<N>(self.layout.end_point()).into_owned();
-        if self.projected() {
-            let shift = x.fixed_rows::<N>(self.layout.projection()).into_owned();
-            xi = first_order::projected_increment(self.discrete.quadrature(), &xi, &shift);
-        }
+        let xi = self.end_increment(x);
         let mut next = self.discrete.advanced(
             state,
             &xi,
@@ -1271,22 +1279,30 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             self.project_momentum(&mut next, state.t + self.discrete.h(), step)?;
         }
         self.discrete.check_end(&next.q, &next.velocity, step)?;
-        let violation = if S::ONE_FORMS > 0 && self.layout.points() > 1 {
+        Ok(next)
+    }
+
+    fn violation(&self, from: &State<N>, to: &State<N>, x: &DVector<f64>) -> f64 {
+        if !Self::constrained() {
+            return 0.0;
+        }
+        let (space, system) = (self.discrete.space(), self.discrete.system());
+        let xi = self.end_increment(x);
+        if S::ONE_FORMS > 0 && self.layout.points() > 1 {
             // Measured with the stored end point (after any projection).
             let s = self.layout.points();
-            // The path of the point assembled last (x), its end the stored one; on the stack.
+            // The path of the point `x`, its end the stored one; on the stack.
             let mut path = [SVector::<f64, N>::zeros(); MAX_DEGREE];
-            path[..s].copy_from_slice(&self.increments);
-            path[s - 1] = space.local(&state.q, &next.q).unwrap_or(xi);
+            for (j, point) in path[..s].iter_mut().enumerate() {
+                *point = x.fixed_rows::<N>(self.layout.point(j + 1)).into_owned();
+            }
+            path[s - 1] = space.local(&from.q, &to.q).unwrap_or(xi);
             let h = self.discrete.h();
             let quadrature = self.discrete.quadrature();
-            constraint::node_violation(system, quadrature, h, &state.q, &path[..s])
-        } else if Self::constrained() {
-            constraint::violation(system, space, self.point, &state.q, &next.q, &xi)
+            constraint::node_violation(system, quadrature, h, &from.q, &path[..s])
         } else {
-            0.0
-        };
-        Ok((next, violation))
+            constraint::violation(system, space, self.point, &from.q, &to.q, &xi)
+        }
     }
 
     fn first_multiplier(&self) -> usize {

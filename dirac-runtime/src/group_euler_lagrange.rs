@@ -484,8 +484,8 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
         state: &State<N, C::Manifold>,
         x: &DVector<f64>,
         step: u64,
-    ) -> Result<(State<N, C::Manifold>, f64), DiracError> {
-        let (space, system) = (self.discrete.space(), self.discrete.system());
+    ) -> Result<State<N, C::Manifold>, DiracError> {
+        let space = self.discrete.space();
         for j in 1..=self.layout.points() {
             let point = x.fixed_rows::<N>(self.layout.point(j)).into_owned();
             if let Some((variable, why)) = space.outside_chart(&point) {
@@ -529,12 +529,21 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
         }
         next.velocity = space.push_forward(&state.q, &xi, &(xi / self.discrete.h()));
         self.discrete.check_end(&next.q, &next.velocity, step)?;
-        let violation = if S::ONE_FORMS > 0 {
-            constraint::violation(system, space, self.point, &state.q, &next.q, &xi)
-        } else {
-            0.0
-        };
-        Ok((next, violation))
+        Ok(next)
+    }
+
+    fn violation(
+        &self,
+        from: &State<N, C::Manifold>,
+        to: &State<N, C::Manifold>,
+        x: &DVector<f64>,
+    ) -> f64 {
+        if S::ONE_FORMS == 0 {
+            return 0.0;
+        }
+        let (space, system) = (self.discrete.space(), self.discrete.system());
+        let xi = x.fixed_rows::<N>(self.layout.end_point()).into_owned();
+        constraint::violation(system, space, self.point, &from.q, &to.q, &xi)
     }
 
     fn first_multiplier(&self) -> usize {

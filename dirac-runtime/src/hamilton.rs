@@ -459,26 +459,6 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         rows
     }
 
-    /// The worst `|A_a(Q_c) Q̇_c h|` over the sites of the step solved by `x` (a displacement,
-    /// as the Lagrangian route reports it) and `|g_b(Q_j)|` over the path's points.
-    fn violation(&self, state: &State<N>, x: &DVector<f64>) -> f64 {
-        let mut worst: f64 = 0.0;
-        for site in &self.sites {
-            let q = state.q + self.combination(x, &site.position);
-            let displacement = self.combination(x, &site.rate);
-            for a in 0..S::ONE_FORMS {
-                worst = worst.max(self.system.one_form(&q, a).dot(&displacement).abs());
-            }
-        }
-        for j in 1..=self.degree() {
-            let point = state.q + x.fixed_rows::<N>(self.point(j));
-            for b in 0..S::HOLONOMIC {
-                worst = worst.max(self.system.holonomic(&point, b).abs());
-            }
-        }
-        worst
-    }
-
     /// `∂H/∂p` at `(q, p̃)`, with `p̃` the [`allowed_momentum`](Self::allowed_momentum).
     fn velocity_at(&self, q: &SVector<f64, N>, p: &SVector<f64, N>) -> SVector<f64, N> {
         derivatives::directional_gradient(
@@ -716,13 +696,13 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
     }
 
     /// `q_{k+1} = q_k + (Q_s − q_k)` and `p_{k+1} = p_k + impulse` (compensated sums), the
-    /// velocity `∂H/∂p` there, and the one-forms' violation at the step's sites.
+    /// velocity `∂H/∂p` there.
     fn advance(
         &self,
         state: &State<N>,
         x: &DVector<f64>,
         step: u64,
-    ) -> Result<(State<N>, f64), DiracError> {
+    ) -> Result<State<N>, DiracError> {
         let mut next = *state;
         let xi = x.fixed_rows::<N>(self.point(self.degree())).into_owned();
         compensated_add(&mut next.q, &mut next.q_carry, &xi);
@@ -742,7 +722,27 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         next.velocity = self.velocity_at(&next.q, &next.p);
         // ∂H/∂p can leave its domain where H does not (|p| at p = 0).
         finite("new velocity ∂H/∂p", &next.velocity)?;
-        Ok((next, self.violation(state, x)))
+        Ok(next)
+    }
+
+    /// The worst `|A_a(Q_c) Q̇_c h|` over the sites of the step solved by `x` (a displacement,
+    /// as the Lagrangian route reports it) and `|g_b(Q_j)|` over the path's points.
+    fn violation(&self, state: &State<N>, _to: &State<N>, x: &DVector<f64>) -> f64 {
+        let mut worst: f64 = 0.0;
+        for site in &self.sites {
+            let q = state.q + self.combination(x, &site.position);
+            let displacement = self.combination(x, &site.rate);
+            for a in 0..S::ONE_FORMS {
+                worst = worst.max(self.system.one_form(&q, a).dot(&displacement).abs());
+            }
+        }
+        for j in 1..=self.degree() {
+            let point = state.q + x.fixed_rows::<N>(self.point(j));
+            for b in 0..S::HOLONOMIC {
+                worst = worst.max(self.system.holonomic(&point, b).abs());
+            }
+        }
+        worst
     }
 
     /// By the implicit function theorem on the rows `R(x; q_k, p_k, u) = 0` with Newton's

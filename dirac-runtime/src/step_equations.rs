@@ -198,14 +198,26 @@ pub trait StepEquations<const N: usize> {
     }
 
     /// The state after the step from `state` solved by `x` (the point assembled last), without
-    /// its time, and the step's constraint violation. `step` counts the steps before this one,
-    /// for error messages.
+    /// its time. `step` counts the steps before this one, for error messages.
     fn advance(
         &self,
         state: &State<N, Self::Manifold>,
         x: &DVector<f64>,
         step: u64,
-    ) -> Result<(State<N, Self::Manifold>, f64), DiracError>;
+    ) -> Result<State<N, Self::Manifold>, DiracError>;
+
+    /// The constraint violation of the step from `from` to `to` that `x` solved (`to` as
+    /// [`advance`](Self::advance) returned it): 0 for equations without constraints. A
+    /// [`Stepper`](crate::Stepper) measures it only when asked
+    /// ([`Stepper::constraint_violation`](crate::Stepper::constraint_violation), a recorded
+    /// sample), so a step does not pay for it; it must therefore depend on nothing but its
+    /// arguments and the equations' settings.
+    fn violation(
+        &self,
+        from: &State<N, Self::Manifold>,
+        to: &State<N, Self::Manifold>,
+        x: &DVector<f64>,
+    ) -> f64;
 
     /// Where in `x` the multipliers are: they are `x[first..first + multipliers()]`.
     fn first_multiplier(&self) -> usize;

@@ -50,12 +50,11 @@ enum Problem {
     Velocity,
 }
 
-/// A solved step, not yet current: the new state, how Newton went, the constraint violation.
+/// A solved step, not yet current: the new state and how Newton went.
 #[derive(Debug, Clone, Copy)]
 struct Proposal<const N: usize, M: Manifold<N>> {
     next: State<N, M>,
     report: NewtonReport,
-    violation: f64,
 }
 
 /// A variational integrator for one system, one quadrature and one step size: Newton's method on
@@ -108,8 +107,10 @@ pub struct Stepper<S, const N: usize, E: StepEquations<N> = EulerLagrange<S, N, 
     /// The unknowns of the last accepted steps, extrapolated into the next step's predictor.
     predictor: Predictor,
     report: Option<NewtonReport>,
-    /// Constraint violation of the last step.
-    violation: f64,
+    /// Constraint violation of the last step where it is settled (0 at a start; measured
+    /// before the equations' settings change), else measured on request from `before`, `state`
+    /// and the predictor's last solution: a step does not pay for it.
+    violation: Option<f64>,
     /// Multipliers of the last step (zeros before the first).
     multipliers: Vec<f64>,
     system: PhantomData<fn() -> S>,
@@ -255,6 +256,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn with_constraint_point(mut self, point: ConstraintPoint) -> Self {
+        self.settle_violation();
         self.equations.set_constraint_point(point);
         self
     }
@@ -389,6 +391,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn with_first_order_scheme(mut self, scheme: FirstOrderScheme) -> Self {
+        self.settle_violation();
         self.equations.set_first_order_scheme(scheme);
         self
     }
@@ -509,6 +512,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
 
     /// Evaluates the constraint one-forms at `point` of each step instead of the system's default.
     pub fn with_constraint_point(mut self, point: ConstraintPoint) -> Self {
+        self.settle_violation();
         self.equations.set_constraint_point(point);
         self
     }
@@ -574,7 +578,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             unknowns: DVector::zeros(unknowns),
             predictor: Predictor::new(unknowns),
             report: None,
-            violation: 0.0,
+            violation: Some(0.0),
             system: PhantomData,
         })
     }
@@ -1066,7 +1070,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     fn reset(&mut self, state: State<N, E::Manifold>) {
-        self.violation = 0.0;
+        self.violation = Some(0.0);
         self.multipliers.fill(0.0);
         self.start = state.t;
         self.origin = Some(state);
@@ -1172,13 +1176,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             equations.assemble(state, x, r, j)
         });
         let report = result.map_err(|f| self.failure(Problem::Step, f))?;
-        let (mut next, violation) = self.equations.advance(state, &self.unknowns, self.steps)?;
+        let mut next = self.equations.advance(state, &self.unknowns, self.steps)?;
         next.t = self.start + (self.steps + 1) as f64 * self.equations.h();
-        Ok(Proposal {
-            next,
-            report,
-            violation,
-        })
+        Ok(Proposal { next, report })
     }
 
     /// Makes a solved step current; its solution is still in `unknowns`.
@@ -1194,7 +1194,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             // The solutions so far are coordinates in charts that the next one does not continue.
             self.predictor.detach();
         }
-        self.violation = proposal.violation;
+        self.violation = None;
         self.steps += 1;
         self.before = self.state;
         self.state = Some(proposal.next);
@@ -1256,7 +1256,18 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn constraint_violation(&self) -> f64 {
-        self.violation
+        if let Some(violation) = self.violation {
+            return violation;
+        }
+        match (&self.before, &self.state, self.predictor.last()) {
+            (Some(from), Some(to), Some(x)) => self.equations.violation(from, to, x),
+            _ => 0.0,
+        }
+    }
+
+    /// Measures the last step's constraint violation now, before the equations' settings change.
+    fn settle_violation(&mut self) {
+        self.violation = Some(self.constraint_violation());
     }
 
     /// The step size.

@@ -607,7 +607,8 @@ impl<E: ComponentEquations<N> + 'static, const N: usize> Part for Model<E, N> {
     fn advance(&mut self, x: &[f64], step: u64) -> Result<f64, DiracError> {
         let state = *self.state();
         self.x.copy_from_slice(x);
-        let (next, violation) = self.equations.advance(&state, &self.x, step)?;
+        let next = self.equations.advance(&state, &self.x, step)?;
+        let violation = self.equations.violation(&state, &next, &self.x);
         self.proposed = Some(next);
         // The step's end point is the first unknowns (degree 1).
         self.step = self.measured_step(SVector::from_column_slice(&x[..N]));

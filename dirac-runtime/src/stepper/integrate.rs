@@ -361,7 +361,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         if self.multipliers.is_empty() {
             trajectory.push(sample, energy)
         } else {
-            trajectory.push_constrained(sample, energy, self.violation, self.multipliers())
+            let violation = self.constraint_violation();
+            trajectory.push_constrained(sample, energy, violation, self.multipliers())
         }
     }
 }
