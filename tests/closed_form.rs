@@ -1,6 +1,7 @@
 //! The Lagrangian's derivatives that `#[dirac_system]` derives at compile time, against central
 //! differences of the Lagrangian itself (no dual numbers involved), for every function of the
-//! expression language; and which Lagrangians get them.
+//! expression language; and which Lagrangians get them. The same for the one-forms' rows and
+//! derivatives.
 
 use dirac::nalgebra::{SMatrix, SVector};
 use dirac::prelude::*;
@@ -156,8 +157,18 @@ fn every_function_is_differentiated_exactly() {
     );
 }
 
+/// A one-form that calls the user's own function: its derivative is left to dual numbers.
+#[dirac_system(
+    coordinates(x, y),
+    lagrangian = 0.5 * (dot(x).powi(2) + dot(y).powi(2)),
+    constraints(potential(x) * dx - dy),
+)]
+struct FormCallsUser;
+
 #[test]
 fn only_expressions_in_the_language_get_closed_forms() {
+    const { assert!(!<FormCallsUser as DiracSystem<2>>::ONE_FORM_DERIVATIVES) };
+    const { assert!(<KnifeEdgeScene as DiracSystem<3>>::ONE_FORM_DERIVATIVES) };
     let (q, v) = (vector![0.3], vector![0.2]);
     assert!(ByFunction.lagrangian_gradient(&q, &v).is_none());
     assert!(ByFunction.lagrangian_hessian(&q, &v).is_none());
@@ -194,4 +205,219 @@ fn a_wrong_closed_form_is_refused_at_the_start() {
         "{refused:?}"
     );
     assert!(matches!(stepper.step(), Err(DiracError::NotStarted)));
+}
+
+/// One-forms with trigonometric, exponential and rational coefficients, a coordinate array, a
+/// parameter, a differential named twice and a constant one-form beside them.
+#[dirac_system(
+    coordinates(x, y, theta[2]),
+    lagrangian = 0.5 * (dot(x).powi(2) + dot(y).powi(2) + dot(theta[0]).powi(2)
+        + dot(theta[1]).powi(2)),
+    constraints(
+        sin(theta[0]) * dx - cos(theta[0]) * dy + r * x * y * dtheta[1],
+        exp(0.1 * x) * dtheta[0] - dy / (2.0 + y * y) + atan(x) * dx + 3.0 * dx,
+        dx - dy,
+    ),
+)]
+struct Forms {
+    r: f64,
+}
+
+/// `(A_a(q), ∂A_a/∂q)` by central differences of the one-form over `f64`.
+fn differenced_form<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    a: usize,
+) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
+    let h = 1e-6;
+    let mut derivative = SMatrix::<f64, N, N>::zeros();
+    for j in 0..N {
+        let mut e = SVector::<f64, N>::zeros();
+        e[j] = h;
+        let column =
+            (system.one_form::<f64>(&(q + e), a) - system.one_form::<f64>(&(q - e), a)) / (2.0 * h);
+        derivative.set_column(j, &column);
+    }
+    (system.one_form::<f64>(q, a), derivative)
+}
+
+/// The closed form of one-form `a` at `q`: its row and its derivative, the entries not given
+/// being zero.
+fn closed_form_of<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+    a: usize,
+) -> (SVector<f64, N>, SMatrix<f64, N, N>, Vec<(usize, usize)>) {
+    let mut derivative = SMatrix::<f64, N, N>::zeros();
+    let mut given = Vec::new();
+    let row = system.one_form_with_derivative(q, a, |i, j, x| {
+        derivative[(i, j)] += x;
+        given.push((i, j));
+    });
+    (row, derivative, given)
+}
+
+#[test]
+fn one_forms_get_their_rows_and_derivatives_in_closed_form() {
+    let forms = Forms { r: 0.7 };
+    const { assert!(<Forms as DiracSystem<4>>::ONE_FORM_DERIVATIVES) };
+    for q in [
+        vector![0.3, -0.4, 0.7, 1.1],
+        vector![-1.2, 0.9, -0.5, 0.2],
+        vector![2.0, 1.7, 0.0, -2.5],
+    ] {
+        for a in 0..3 {
+            let (row, derivative, given) = closed_form_of(&forms, &q, a);
+            let (reference_row, reference) = differenced_form(&forms, &q, a);
+            let off = (row - reference_row).amax();
+            assert!(
+                off <= 4.0 * f64::EPSILON * (1.0 + reference_row.amax()),
+                "row {a}: {off:e}"
+            );
+            close(&derivative, &reference, "derivative");
+            // Only entries that are not identically zero, each once.
+            let mut unique = given.clone();
+            unique.sort();
+            unique.dedup();
+            assert_eq!(unique.len(), given.len(), "form {a}: {given:?}");
+            let expected: &[(usize, usize)] = match a {
+                0 => &[(0, 2), (1, 2), (3, 0), (3, 1)],
+                1 => &[(0, 0), (1, 1), (2, 0)],
+                _ => &[],
+            };
+            assert_eq!(unique, expected, "form {a}");
+        }
+    }
+    // The scene's knife edge: two entries, the blade's angle moving the row.
+    let q = vector![0.1, 0.2, 0.5];
+    let (row, derivative, given) = closed_form_of(&KnifeEdgeScene, &q, 0);
+    assert_eq!(given, [(0, 2), (1, 2)]);
+    assert_eq!(row, vector![0.5f64.sin(), -0.5f64.cos(), 0.0]);
+    assert_eq!(
+        (derivative[(0, 2)], derivative[(1, 2)]),
+        (0.5f64.cos(), 0.5f64.sin())
+    );
+}
+
+#[dirac_system(
+    coordinates(x, y, phi),
+    lagrangian = 0.5 * (dot(x).powi(2) + dot(y).powi(2) + dot(phi).powi(2)),
+    constraints(sin(phi) * dx - cos(phi) * dy),
+)]
+struct KnifeEdgeScene;
+
+/// A model whose one-forms the runtime differentiates by dual numbers: the knife edge's, with
+/// `one_form` alone.
+struct KnifeEdgeByDuals;
+impl DiracSystem<3> for KnifeEdgeByDuals {
+    const ONE_FORMS: usize = 1;
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+        KnifeEdgeScene.lagrangian(q, v)
+    }
+    fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, a: usize) -> SVector<D, 3> {
+        KnifeEdgeScene.one_form(q, a)
+    }
+}
+
+/// A step with the closed-form one-form solves the same equations as one with dual numbers:
+/// the two trajectories agree to round-off over 2 000 steps, at each constraint point.
+#[test]
+fn closed_form_one_forms_step_as_dual_numbers_do() {
+    for point in [
+        ConstraintPoint::Start,
+        ConstraintPoint::Midpoint,
+        ConstraintPoint::End,
+    ] {
+        let (q0, v0) = (vector![0.0, 0.0, 0.3], vector![1.0, 0.3f64.tan(), 1.0]);
+        let mut closed = Stepper::new(KnifeEdgeScene, Quadrature::midpoint(), 0.01)
+            .expect("stepper")
+            .with_constraint_point(point);
+        let mut duals = Stepper::new(KnifeEdgeByDuals, Quadrature::midpoint(), 0.01)
+            .expect("stepper")
+            .with_constraint_point(point);
+        closed.start_from_velocity(q0, v0).expect("start");
+        duals.start_from_velocity(q0, v0).expect("start");
+        for _ in 0..2000 {
+            closed.step().expect("step");
+            duals.step().expect("step");
+        }
+        let apart = (closed.q() - duals.q())
+            .amax()
+            .max((closed.p() - duals.p()).amax());
+        assert!(apart < 1e-12, "{point:?}: {apart:e}");
+        assert!(
+            (closed.q() - q0).fixed_rows::<2>(0).amax() > 0.5,
+            "the blade moved"
+        );
+    }
+}
+
+/// A one-form's hand-written closed form that is wrong, in its derivative or in its row, is
+/// refused at the start of a run.
+#[test]
+fn a_wrong_one_form_closed_form_is_refused_at_the_start() {
+    struct Wrong {
+        row_off: f64,
+        entry_off: f64,
+    }
+    impl DiracSystem<3> for Wrong {
+        const ONE_FORMS: usize = 1;
+        const ONE_FORM_DERIVATIVES: bool = true;
+        fn lagrangian<D: Scalar>(&self, q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+            KnifeEdgeScene.lagrangian(q, v)
+        }
+        fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, a: usize) -> SVector<D, 3> {
+            KnifeEdgeScene.one_form(q, a)
+        }
+        fn one_form_with_derivative(
+            &self,
+            q: &SVector<f64, 3>,
+            _a: usize,
+            mut entry: impl FnMut(usize, usize, f64),
+        ) -> SVector<f64, 3> {
+            let (sin, cos) = q[2].sin_cos();
+            entry(0, 2, cos + self.entry_off);
+            entry(1, 2, sin);
+            vector![sin + self.row_off, -cos, 0.0]
+        }
+    }
+    for (wrong, what) in [
+        (
+            Wrong {
+                row_off: 0.0,
+                entry_off: 0.0,
+            },
+            None,
+        ),
+        (
+            Wrong {
+                row_off: 0.0,
+                entry_off: 1e-3,
+            },
+            Some("derivative"),
+        ),
+        (
+            Wrong {
+                row_off: 1e-3,
+                entry_off: 0.0,
+            },
+            Some("row"),
+        ),
+    ] {
+        let mut stepper = Stepper::new(wrong, Quadrature::midpoint(), 0.1).expect("stepper");
+        let started = stepper.start_from_velocity(
+            vector![0.0, 0.0, 0.4],
+            vector![0.4f64.cos(), 0.4f64.sin(), 1.0],
+        );
+        match what {
+            None => assert!(started.is_ok(), "{started:?}"),
+            Some(what) => {
+                assert!(
+                    matches!(started, Err(DiracError::InconsistentDerivatives(ref m)) if m.contains(what)),
+                    "{started:?}"
+                );
+                assert!(matches!(stepper.step(), Err(DiracError::NotStarted)));
+            }
+        }
+    }
 }

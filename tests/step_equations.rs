@@ -307,3 +307,69 @@ fn the_assembly_writes_every_row_of_the_residual() {
         }
     }
 }
+
+/// The knife edge with its one-form in closed form (its derivative's entries alone enter the
+/// Jacobian).
+#[dirac_system(
+    coordinates(x, y, phi),
+    lagrangian = 0.5 * (dot(x).powi(2) + dot(y).powi(2)) + 0.3 * dot(phi).powi(2) + 4.9 * x,
+    constraints(sin(phi) * dx - cos(phi) * dy),
+)]
+#[derive(Debug, Clone, Copy)]
+struct Blade;
+
+/// The Jacobian the assembly adds is the derivative of its residual: against central
+/// differences, off the solution with multipliers that are not zero, at each constraint point,
+/// for a one-form in closed form and for one beside a holonomic constraint.
+#[test]
+fn the_jacobian_is_the_residuals_derivative() {
+    use dirac::euler_lagrange::EulerLagrange;
+    fn check<S: DiracSystem<3> + Copy>(system: S, q: SVector<f64, 3>, v: SVector<f64, 3>) {
+        let state = State::new(0.0, q, v, v);
+        for point in [
+            ConstraintPoint::Start,
+            ConstraintPoint::Midpoint,
+            ConstraintPoint::End,
+        ] {
+            let discrete = DiscreteLagrangian::new(system, Quadrature::midpoint(), 0.05);
+            let mut equations = EulerLagrange::new(discrete).unwrap();
+            equations.set_constraint_point(point);
+            equations.begin(&state);
+            let n = equations.unknowns();
+            let mut x = DVector::zeros(n);
+            equations.predict(&state, None, &mut x);
+            for (i, xi) in x.iter_mut().enumerate() {
+                *xi += 0.05 * (i + 1) as f64;
+            }
+            let mut residual = DVector::zeros(n);
+            let mut jacobian = DMatrix::zeros(n, n);
+            equations.assemble(&state, &x, &mut residual, Some(&mut jacobian));
+            let delta = 1e-6;
+            let mut differenced = DMatrix::zeros(n, n);
+            for j in 0..n {
+                let (mut up, mut down) = (x.clone(), x.clone());
+                up[j] += delta;
+                down[j] -= delta;
+                let (mut r_up, mut r_down) = (DVector::zeros(n), DVector::zeros(n));
+                equations.assemble(&state, &up, &mut r_up, None);
+                equations.assemble(&state, &down, &mut r_down, None);
+                differenced.set_column(j, &((r_up - r_down) / (2.0 * delta)));
+            }
+            let error = (&jacobian - &differenced).amax();
+            assert!(
+                error <= 1e-6 * (1.0 + differenced.amax()),
+                "{point:?}: {jacobian} against {differenced} (error {error:e})"
+            );
+        }
+    }
+    check(
+        Blade,
+        vector![0.1, 0.2, 0.5],
+        vector![0.5f64.cos(), 0.5f64.sin(), 1.0],
+    );
+    check(
+        HeldBead { g: 9.81 },
+        vector![0.6, 0.0, -0.8],
+        vector![0.0, 1.0, 0.0],
+    );
+}

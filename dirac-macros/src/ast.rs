@@ -167,6 +167,9 @@ pub struct Model {
     pub one_forms: Vec<Vec<Term>>,
     /// Whether each one-form's coefficients name no coordinate (the same covector at every `q`).
     pub constant_one_forms: Vec<bool>,
+    /// The bodies of `one_form_with_derivative`, one per one-form, where every one-form has
+    /// them in closed form.
+    pub one_form_derivatives: Option<Vec<proc_macro2::TokenStream>>,
     /// Each one-form as written, for error messages.
     pub one_form_names: Vec<String>,
     /// Holonomic constraints `g(q)`.

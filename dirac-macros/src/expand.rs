@@ -327,15 +327,39 @@ fn variable_names(coordinates: &[Coordinate]) -> TokenStream {
 /// `lagrangian_gradient` and `lagrangian_hessian` where the Lagrangian has closed forms: the
 /// parameters bound by name, then straight-line `f64` code.
 fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
-    let Some(closed) = &model.closed_form else {
-        return TokenStream::new();
-    };
     let parameters = model.parameters.iter().map(|p| {
         let name = &p.name;
         quote!(let #name = self.#name;)
     });
     let parameters = quote!(#(#parameters)*);
     let vector = quote!(&__dirac::nalgebra::SVector<f64, #n>);
+    let one_forms = model.one_form_derivatives.as_ref().map(|derivatives| {
+        let arms = derivatives
+            .iter()
+            .enumerate()
+            .map(|(a, body)| quote!(#a => { #body }));
+        quote! {
+            const ONE_FORM_DERIVATIVES: bool = true;
+
+            #[inline]
+            #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
+            fn one_form_with_derivative(
+                &self,
+                __q: #vector,
+                __a: usize,
+                mut __entry: impl FnMut(usize, usize, f64),
+            ) -> __dirac::nalgebra::SVector<f64, #n> {
+                #parameters
+                match __a {
+                    #(#arms)*
+                    _ => __dirac::nalgebra::SVector::<f64, #n>::zeros(),
+                }
+            }
+        }
+    });
+    let Some(closed) = &model.closed_form else {
+        return quote!(#one_forms);
+    };
     let gradient = &closed.gradient;
     let hessian = closed.hessian.as_ref().map(|hessian| {
         quote! {
@@ -358,6 +382,7 @@ fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
     });
     quote! {
         #entire
+        #one_forms
 
         #[inline]
         #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]

@@ -510,11 +510,40 @@ struct Reader<'a> {
     /// Each coordinate's name, flat offset and length (`None`: a single coordinate).
     coordinates: Vec<(syn::Ident, usize, Option<usize>)>,
     n: usize,
+    /// Whether a differential `dx`, `dtheta[i]` reads as the rate of its coordinate (a one-form).
+    differentials: bool,
 }
 
 impl Reader<'_> {
     fn coordinate(&self, ident: &syn::Ident) -> Option<&(syn::Ident, usize, Option<usize>)> {
         self.coordinates.iter().find(|(name, ..)| name == ident)
+    }
+
+    /// The coordinate whose differential `ident` is (`dx` for `x`), where differentials are read.
+    fn differential(&self, ident: &syn::Ident) -> Option<&(syn::Ident, usize, Option<usize>)> {
+        let name = ident.to_string();
+        let rest = name.strip_prefix('d').filter(|_| self.differentials)?;
+        self.coordinates.iter().find(|(name, ..)| name == rest)
+    }
+
+    /// The rate variable of a differential `dx` or `dtheta[i]` (literal `i`).
+    fn rate(&mut self, expr: &Expr) -> Option<Id> {
+        let i = match expr {
+            Expr::Path(p) => {
+                let (_, offset, length) = self.differential(p.path.get_ident()?)?;
+                length.is_none().then_some(*offset)?
+            }
+            Expr::Index(ix) => {
+                let Expr::Path(p) = &*ix.expr else {
+                    return None;
+                };
+                let (_, offset, length) = self.differential(p.path.get_ident()?)?;
+                let i = literal_index(&ix.index)?;
+                (i < (*length)?).then_some(offset + i)?
+            }
+            _ => return None,
+        };
+        Some(self.graph.intern(Node::Variable(self.n + i)))
     }
 
     /// The flat index of `x` or `theta[i]` (literal `i`).
@@ -554,14 +583,24 @@ impl Reader<'_> {
             }
             Expr::Path(p) => match p.path.get_ident().and_then(|i| self.coordinate(i)) {
                 Some(_) => Some(self.graph.intern(Node::Variable(self.flat_index(expr)?))),
+                None if p
+                    .path
+                    .get_ident()
+                    .and_then(|i| self.differential(i))
+                    .is_some() =>
+                {
+                    self.rate(expr)
+                }
                 None => Some(self.graph.constant(p.to_token_stream())),
             },
             Expr::Index(ix) => {
                 let Expr::Path(p) = &*ix.expr else {
                     return None;
                 };
-                match p.path.get_ident().and_then(|i| self.coordinate(i)) {
+                let ident = p.path.get_ident();
+                match ident.and_then(|i| self.coordinate(i)) {
                     Some(_) => Some(self.graph.intern(Node::Variable(self.flat_index(expr)?))),
+                    None if ident.and_then(|i| self.differential(i)).is_some() => self.rate(expr),
                     None => Some(self.graph.constant(ix.to_token_stream())),
                 }
             }
@@ -593,7 +632,7 @@ impl Reader<'_> {
                 };
                 let name = p.path.get_ident()?.to_string();
                 let arguments: Vec<&Expr> = call.args.iter().collect();
-                if name == "dot" {
+                if name == "dot" && !self.differentials {
                     let [arg] = arguments[..] else {
                         return None;
                     };
@@ -805,8 +844,9 @@ pub struct ClosedForm {
     pub hessian: Option<TokenStream>,
 }
 
-/// The closed forms of `L`, or `None` where the expression leaves the graph's language.
-pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<ClosedForm> {
+/// Each coordinate's name, flat offset and literal length; `None` where a length is not a
+/// literal or the lengths do not add up to `n`.
+fn layout(coordinates: &[Coordinate], n: usize) -> Option<Vec<(syn::Ident, usize, Option<usize>)>> {
     let mut offset = 0usize;
     let mut layout = Vec::new();
     for c in coordinates {
@@ -818,14 +858,17 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
         layout.push((c.name.clone(), offset, length));
         offset += length.unwrap_or(1);
     }
-    if offset != n {
-        return None;
-    }
+    (offset == n).then_some(layout)
+}
+
+/// The closed forms of `L`, or `None` where the expression leaves the graph's language.
+pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<ClosedForm> {
     let mut graph = Graph::new(n);
     let lagrangian = Reader {
         graph: &mut graph,
-        coordinates: layout,
+        coordinates: layout(coordinates, n)?,
         n,
+        differentials: false,
     }
     .read(expr)?;
     // Read before any derivative joins the graph: the property is the Lagrangian's own.
@@ -906,5 +949,63 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
         gradient,
         entire,
         hessian: Some(hessian),
+    })
+}
+
+/// The body of `one_form_with_derivative` for a one-form `Σ_i A_i(q) dq_i` written in
+/// differentials (in a scope where the parameters are bound by name, `__q` is the `f64` position
+/// and `__entry(i, j, x)` takes `∂A_i/∂q_j`): straight-line `f64` code handing over the entries
+/// that are not identically zero and returning the row `A(q)`, from one graph (a `sin` and a
+/// `cos` shared by the row and its derivative are one call). `None` where the form leaves the
+/// graph's language or is not linear in the differentials with coefficients of the positions
+/// alone.
+pub fn one_form_with_derivative(
+    form: &Expr,
+    coordinates: &[Coordinate],
+    n: usize,
+) -> Option<TokenStream> {
+    let mut graph = Graph::new(n);
+    let form = Reader {
+        graph: &mut graph,
+        coordinates: layout(coordinates, n)?,
+        n,
+        differentials: true,
+    }
+    .read(form)?;
+    let mut coefficients = Vec::new();
+    let mut entries = Vec::new();
+    for i in 0..n {
+        let coefficient = graph.derivative(form, n + i);
+        // Linear in the differentials: no coefficient moves with a rate.
+        for k in 0..n {
+            let moved = graph.derivative(coefficient, n + k);
+            if !graph.is(moved, 0.0) {
+                return None;
+            }
+        }
+        for j in 0..n {
+            let entry = graph.derivative(coefficient, j);
+            if !graph.is(entry, 0.0) {
+                entries.push((i, j, entry));
+            }
+        }
+        coefficients.push(coefficient);
+        if graph.nodes.len() > MAX_GRAPH {
+            return None;
+        }
+    }
+    let mut outputs = coefficients;
+    outputs.extend(entries.iter().map(|&(.., id)| id));
+    let code = graph.emit(&outputs);
+    let statements = &code.statements;
+    let row = &code.outputs[..n];
+    let calls = entries
+        .iter()
+        .zip(&code.outputs[n..])
+        .map(|(&(i, j, _), x)| quote!(__entry(#i, #j, #x);));
+    Some(quote! {
+        #statements
+        #(#calls)*
+        __dirac::nalgebra::SVector::<f64, #n>::from([#(#row),*])
     })
 }

@@ -384,6 +384,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     });
     let fields: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
     let mut constant_one_forms = Vec::new();
+    let mut one_form_derivatives = None;
     let one_form_names: Vec<String> = e
         .constraints
         .iter()
@@ -415,6 +416,18 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 })
             };
             let (positions_algebra, state_algebra) = (algebra(Some(NO_VELOCITIES)), algebra(None));
+            // Closed-form derivatives where every one-form has them (not on the Hamiltonian
+            // route, whose trait has no such method).
+            one_form_derivatives = literal_dimension(coordinates)
+                .filter(|_| !product && !hamiltonian)
+                .and_then(|n| {
+                    e.constraints
+                        .iter()
+                        .flatten()
+                        .map(|form| symbolic::one_form_with_derivative(form, coordinates, n))
+                        .collect::<Option<Vec<_>>>()
+                })
+                .filter(|forms| !forms.is_empty());
             constant_one_forms = match product {
                 true => Vec::new(),
                 false => e
@@ -486,6 +499,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 parameters,
                 one_forms,
                 constant_one_forms,
+                one_form_derivatives,
                 one_form_names,
                 holonomic,
                 forces,

@@ -12,6 +12,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::derivatives::{Seed, seeded_by_duals};
 use crate::error::DiracError;
+use crate::newton::exceeds;
 use crate::system::DiracSystem;
 
 /// `L` and its first derivatives at one `(q, v)`.
@@ -125,12 +126,15 @@ const TOLERANCE: f64 = 1e-8;
 
 /// Compares the model's closed forms, where it has them, with dual numbers at `(q, v)`: an
 /// `Err(InconsistentDerivatives)` naming the first derivative that differs by more than `1e-8`
-/// of the largest of its kind. Points where the Lagrangian is not finite are not judged.
+/// of the largest of its kind. Points where the Lagrangian is not finite are not judged. The
+/// one-forms' closed forms ([`DiracSystem::one_form_with_derivative`]) are compared at `q` the
+/// same way, the row and every entry of its derivative, those the model leaves out being zero.
 pub fn check<S: DiracSystem<N>, const N: usize>(
     system: &S,
     q: &SVector<f64, N>,
     v: &SVector<f64, N>,
 ) -> Result<(), DiracError> {
+    check_one_forms(system, q)?;
     let gradient = system.lagrangian_gradient(q, v);
     let hessian = system.lagrangian_hessian(q, v);
     if gradient.is_none() && hessian.is_none() {
@@ -188,6 +192,63 @@ pub fn check<S: DiracSystem<N>, const N: usize>(
     if let Some(h) = hessian {
         compare("gradient", first(&h.gradient), first(&reference.gradient))?;
         compare("Hessian", second(&h), second(&reference))?;
+    }
+    Ok(())
+}
+
+/// The one-forms' closed-form derivatives against dual numbers at `q` (see [`check`]).
+fn check_one_forms<S: DiracSystem<N>, const N: usize>(
+    system: &S,
+    q: &SVector<f64, N>,
+) -> Result<(), DiracError> {
+    if !S::ONE_FORM_DERIVATIVES {
+        return Ok(());
+    }
+    for a in 0..S::ONE_FORMS {
+        let mut closed = SMatrix::<f64, N, N>::zeros();
+        let mut outside = None;
+        let closed_row = system.one_form_with_derivative(q, a, |i, j, x| match (i < N, j < N) {
+            (true, true) => closed[(i, j)] += x,
+            _ => outside = Some((i, j)),
+        });
+        let name = system.one_form_name(a);
+        if let Some((i, j)) = outside {
+            return Err(DiracError::InconsistentDerivatives(format!(
+                "the closed-form derivative of {name} names entry ({i}, {j}), outside {N} × {N}"
+            )));
+        }
+        let row = system.one_form(&crate::derivatives::lift(q, 1.0), a);
+        let values = row.map(|x| x.re);
+        let duals = SMatrix::<f64, N, N>::from_fn(|i, j| crate::derivatives::gradient(&row[i])[j]);
+        if !(values.iter().all(|x| x.is_finite()) && duals.iter().all(|x| x.is_finite())) {
+            continue;
+        }
+        let bound = TOLERANCE * values.amax().max(f64::MIN_POSITIVE);
+        if let Some(i) = (0..N).find(|&i| exceeds((closed_row[i] - values[i]).abs(), bound)) {
+            return Err(DiracError::InconsistentDerivatives(format!(
+                "the closed-form row of {name} differs from `one_form` at q = {:?}: \
+                 A_{i} is {} against {}",
+                q.as_slice(),
+                closed_row[i],
+                values[i]
+            )));
+        }
+        let bound = TOLERANCE * duals.amax().max(f64::MIN_POSITIVE);
+        // A difference that is NaN (a closed form NaN where the duals are finite) disagrees.
+        let differs =
+            |(i, j): (usize, usize)| exceeds((closed[(i, j)] - duals[(i, j)]).abs(), bound);
+        if let Some((i, j)) = (0..N)
+            .flat_map(|i| (0..N).map(move |j| (i, j)))
+            .find(|&e| differs(e))
+        {
+            return Err(DiracError::InconsistentDerivatives(format!(
+                "the closed-form derivative of {name} differs from dual numbers at q = {:?}: \
+                 ∂A_{i}/∂q_{j} is {} against {}",
+                q.as_slice(),
+                closed[(i, j)],
+                duals[(i, j)]
+            )));
+        }
     }
     Ok(())
 }

@@ -208,12 +208,30 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         let mut impulse = SVector::<f64, N>::zeros();
         let mut scale = 0.0_f64;
         let xi_c = step * theta;
+        // On a translation chart a closed form is the chart's: the row and its derivative come
+        // from one piece of `f64` code, and a Jacobian touches only the entries given.
+        let closed = C::TRANSLATION && S::ONE_FORM_DERIVATIVES;
         for a in 0..S::ONE_FORMS {
             let col = layout.one_form(a);
             let mu = x[col];
-            let (row, derivative) = match jacobian {
-                Some(_) => one_form_in_chart(system, space, base, &xi_c, a),
-                None => (one_form_value_in_chart(system, space, base, &xi_c, a), None),
+            // Σ_i ξ_s,i ∂Ã_i/∂ξ_j over the closed form's entries.
+            let mut sum = SVector::<f64, N>::zeros();
+            let (row, derivative) = if closed {
+                let q_c = space.retract(base, &xi_c);
+                let weight = share * theta * mu;
+                // One call whether or not a Jacobian is asked for: in two branches the compiler
+                // would hoist the row's `sin` above them and part it from its `cos`.
+                let row = system.one_form_with_derivative(&q_c, a, |i, j, d| {
+                    if let Some(jacobian) = jacobian.as_deref_mut() {
+                        jacobian[(i, step_col + j)] += d * weight;
+                        sum[j] += d * step[i];
+                    }
+                });
+                (space.pull_back(base, &xi_c, &row), None)
+            } else if jacobian.is_some() {
+                one_form_in_chart(system, space, base, &xi_c, a)
+            } else {
+                (one_form_value_in_chart(system, space, base, &xi_c, a), None)
             };
             impulse += row * mu;
             for i in 0..N {
@@ -228,6 +246,8 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             let mut force = jacobian.fixed_view_mut::<N, 1>(0, col);
             force += row * share;
             let turning = match derivative {
+                // `∂(Ã ξ_s)/∂ξ_s = Ã + θ ξ_sᵀ ∂Ã`, over the closed form's entries.
+                None if closed => row + sum * theta,
                 None => row,
                 Some(derivative) => {
                     let mut block = jacobian.fixed_view_mut::<N, N>(0, step_col);

@@ -78,6 +78,10 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// ```
     const LAGRANGIAN_ENTIRE: bool = false;
 
+    /// Whether [`one_form_with_derivative`](Self::one_form_with_derivative) gives the one-forms'
+    /// derivatives in closed form (`false` by default: dual numbers take them).
+    const ONE_FORM_DERIVATIVES: bool = false;
+
     /// The continuous Lagrangian `L(q, v)` at position `q` and velocity `v`.
     fn lagrangian<D: Scalar>(&self, q: &M::Point<D>, v: &M::Tangent<D>) -> D;
 
@@ -111,6 +115,59 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     fn one_form<D: Scalar>(&self, q: &M::Point<D>, a: usize) -> M::Tangent<D> {
         let _ = (q, a);
         M::zero()
+    }
+
+    /// One-form `a` at `q` with its derivative, in closed form where a model on `Rᴺ` has it
+    /// (`ONE_FORM_DERIVATIVES = true`): hands each entry `∂A_a,i/∂q_j` that is not identically
+    /// zero to `entry(i, j, value)` and returns the row `A_a(q)`. By default the row of
+    /// [`one_form`](Self::one_form) without entries, and the runtime takes the derivative by
+    /// dual numbers. `#[dirac_system]` derives it at compile time from one-forms written in
+    /// differentials: a degree-1 step then reads the row and its derivative from one piece of
+    /// straight-line code, and its Jacobian touches only the entries given. It must agree with
+    /// [`one_form`](Self::one_form): a stepper compares the two at the start of every run
+    /// ([`closed_form::check`](crate::closed_form::check)).
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    ///
+    /// /// A knife edge in the plane: sin φ ẋ − cos φ ẏ = 0.
+    /// struct KnifeEdge;
+    /// impl DiracSystem<3> for KnifeEdge {
+    ///     const ONE_FORMS: usize = 1;
+    ///     const ONE_FORM_DERIVATIVES: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * 0.5
+    ///     }
+    ///     fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, _a: usize) -> SVector<D, 3> {
+    ///         SVector::from([q[2].sin(), -q[2].cos(), D::from(0.0)])
+    ///     }
+    ///     fn one_form_with_derivative(
+    ///         &self,
+    ///         q: &SVector<f64, 3>,
+    ///         _a: usize,
+    ///         mut entry: impl FnMut(usize, usize, f64),
+    ///     ) -> SVector<f64, 3> {
+    ///         let (sin, cos) = q[2].sin_cos();
+    ///         entry(0, 2, cos);
+    ///         entry(1, 2, sin);
+    ///         vector![sin, -cos, 0.0]
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(KnifeEdge, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![0.0, 0.0, 0.0], vector![1.0, 0.0, 1.0])?;
+    /// stepper.run(10)?;
+    /// assert!(stepper.constraint_violation() < 1e-12);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    fn one_form_with_derivative(
+        &self,
+        q: &M::Point<f64>,
+        a: usize,
+        entry: impl FnMut(usize, usize, f64),
+    ) -> M::Tangent<f64> {
+        let _ = entry;
+        self.one_form(q, a)
     }
 
     /// The name of one-form `a`, for error messages (by default `one-form a`; the attribute
