@@ -5,7 +5,7 @@
 
 use dirac::nalgebra::{SMatrix, SVector};
 use dirac::prelude::*;
-use dirac::{LagrangianGradient, LagrangianHessian, closed_form};
+use dirac::{HessianZeros, LagrangianGradient, LagrangianHessian, closed_form};
 
 /// Every trigonometric and hyperbolic function, a product with a velocity-dependent mass, a
 /// quotient and unary minus.
@@ -164,6 +164,38 @@ fn every_function_is_differentiated_exactly() {
     constraints(potential(x) * dx - dy),
 )]
 struct FormCallsUser;
+
+/// The Hessian blocks that vanish identically are read off the expression, and a claim that a
+/// block vanishes where it does not is refused at the start of a run.
+#[test]
+fn vanishing_hessian_blocks_are_known_and_checked() {
+    const {
+        // L = T(v) on a flat plane with a potential linear in x: only ∂²L/∂v² is left.
+        let blade = <KnifeEdgeScene as DiracSystem<3>>::LAGRANGIAN_HESSIAN_ZEROS;
+        assert!(blade.qq && blade.qv && !blade.vv);
+        // A mass that depends on the position couples them.
+        let coupled = <Trigonometric as DiracSystem<2>>::LAGRANGIAN_HESSIAN_ZEROS;
+        assert!(!coupled.qq && !coupled.qv && !coupled.vv);
+    };
+    struct Claims;
+    impl DiracSystem<1> for Claims {
+        const LAGRANGIAN_HESSIAN_ZEROS: HessianZeros = HessianZeros {
+            qq: false,
+            qv: true,
+            vv: false,
+        };
+        fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+            // ∂²L/∂q∂v = 2 q v: not zero.
+            v[0] * v[0] * (q[0] * q[0] + 1.0) * 0.5
+        }
+    }
+    let mut stepper = Stepper::new(Claims, Quadrature::midpoint(), 0.1).expect("stepper");
+    let refused = stepper.start_from_velocity(vector![0.5], vector![0.3]);
+    assert!(
+        matches!(refused, Err(DiracError::InconsistentDerivatives(ref m)) if m.contains("∂²L/∂q∂v")),
+        "{refused:?}"
+    );
+}
 
 #[test]
 fn only_expressions_in_the_language_get_closed_forms() {

@@ -318,9 +318,19 @@ fn the_assembly_writes_every_row_of_the_residual() {
 #[derive(Debug, Clone, Copy)]
 struct Blade;
 
+/// A separable Lagrangian (`∂²L/∂q∂v = 0`, its potential curved): the step skips the mixed
+/// blocks' products.
+#[dirac_system(
+    coordinates(x, y, z),
+    lagrangian = 0.5 * (dot(x).powi(2) + 2.0 * dot(y).powi(2) + dot(z).powi(2)) + cos(x) - y * y * z,
+)]
+#[derive(Debug, Clone, Copy)]
+struct Separable;
+
 /// The Jacobian the assembly adds is the derivative of its residual: against central
 /// differences, off the solution with multipliers that are not zero, at each constraint point,
-/// for a one-form in closed form and for one beside a holonomic constraint.
+/// for a one-form in closed form (with a Lagrangian whose `∂²L/∂q²` and `∂²L/∂q∂v` vanish), for
+/// one beside a holonomic constraint, and for a separable Lagrangian.
 #[test]
 fn the_jacobian_is_the_residuals_derivative() {
     use dirac::euler_lagrange::EulerLagrange;
@@ -372,4 +382,9 @@ fn the_jacobian_is_the_residuals_derivative() {
         vector![0.6, 0.0, -0.8],
         vector![0.0, 1.0, 0.0],
     );
+    check(Separable, vector![0.6, -0.3, 0.8], vector![0.2, 1.0, -0.4]);
+    const {
+        assert!(Blade::LAGRANGIAN_HESSIAN_ZEROS.qq && Blade::LAGRANGIAN_HESSIAN_ZEROS.qv);
+        assert!(!Separable::LAGRANGIAN_HESSIAN_ZEROS.qq && Separable::LAGRANGIAN_HESSIAN_ZEROS.qv);
+    };
 }

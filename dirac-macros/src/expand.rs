@@ -380,8 +380,16 @@ fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
             const LAGRANGIAN_ENTIRE: bool = true;
         )
     });
+    let zeros = (closed.hessian.is_some() && closed.zeros.contains(&true)).then(|| {
+        let [qq, qv, vv] = closed.zeros;
+        quote!(
+            const LAGRANGIAN_HESSIAN_ZEROS: __dirac::HessianZeros =
+                __dirac::HessianZeros { qq: #qq, qv: #qv, vv: #vv };
+        )
+    });
     quote! {
         #entire
+        #zeros
         #one_forms
 
         #[inline]

@@ -842,6 +842,8 @@ pub struct ClosedForm {
     pub entire: bool,
     /// `None` when the second derivatives exceed the size bound.
     pub hessian: Option<TokenStream>,
+    /// Whether `∂²L/∂q²`, `∂²L/∂q∂v`, `∂²L/∂v²` vanish identically (known with the Hessian).
+    pub zeros: [bool; 3],
 }
 
 /// Each coordinate's name, flat offset and literal length; `None` where a length is not a
@@ -901,6 +903,7 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
                     gradient,
                     entire,
                     hessian: None,
+                    zeros: [false; 3],
                 });
             }
         }
@@ -931,6 +934,15 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
                 false => quote!(#block[(#i, #j)] = #x;),
             }
         });
+    let mut zeros = [true; 3];
+    for &(i, j, id) in &second {
+        let block = match (i < n, j < n) {
+            (true, true) => 0,
+            (true, false) => 1,
+            _ => 2,
+        };
+        zeros[block] &= graph.is(id, 0.0);
+    }
     let zero = quote!(__dirac::nalgebra::SMatrix::<f64, #n, #n>::zeros());
     let hessian = quote! {
         #statements
@@ -949,6 +961,7 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
         gradient,
         entire,
         hessian: Some(hessian),
+        zeros,
     })
 }
 

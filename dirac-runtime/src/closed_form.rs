@@ -121,6 +121,36 @@ impl<const N: usize> LagrangianHessian<N> {
     }
 }
 
+/// Which blocks of the Lagrangian's Hessian vanish identically: `#[dirac_system]` reads them off
+/// the expression (`∂²L/∂q∂v = 0` for `L = T(v) − V(q)`, `∂²L/∂q² = 0` for a potential linear
+/// in `q`), and a step skips their products. A stepper checks the claim at the start of every
+/// run ([`check`]).
+///
+/// ```
+/// use dirac_runtime::HessianZeros;
+///
+/// let separable = HessianZeros { qv: true, ..HessianZeros::NONE };
+/// assert!(!separable.qq && separable.qv && !separable.vv);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HessianZeros {
+    /// `∂²L/∂q² = 0` everywhere.
+    pub qq: bool,
+    /// `∂²L/∂q∂v = 0` everywhere.
+    pub qv: bool,
+    /// `∂²L/∂v² = 0` everywhere.
+    pub vv: bool,
+}
+
+impl HessianZeros {
+    /// No block known to vanish.
+    pub const NONE: Self = Self {
+        qq: false,
+        qv: false,
+        vv: false,
+    };
+}
+
 /// Relative disagreement with dual numbers beyond which closed forms are refused.
 const TOLERANCE: f64 = 1e-8;
 
@@ -129,6 +159,8 @@ const TOLERANCE: f64 = 1e-8;
 /// of the largest of its kind. Points where the Lagrangian is not finite are not judged. The
 /// one-forms' closed forms ([`DiracSystem::one_form_with_derivative`]) are compared at `q` the
 /// same way, the row and every entry of its derivative, those the model leaves out being zero.
+/// A Hessian block claimed to vanish ([`DiracSystem::LAGRANGIAN_HESSIAN_ZEROS`]) must vanish
+/// under dual numbers at `(q, v)`.
 pub fn check<S: DiracSystem<N>, const N: usize>(
     system: &S,
     q: &SVector<f64, N>,
@@ -137,7 +169,8 @@ pub fn check<S: DiracSystem<N>, const N: usize>(
     check_one_forms(system, q)?;
     let gradient = system.lagrangian_gradient(q, v);
     let hessian = system.lagrangian_hessian(q, v);
-    if gradient.is_none() && hessian.is_none() {
+    let zeros = S::LAGRANGIAN_HESSIAN_ZEROS;
+    if gradient.is_none() && hessian.is_none() && zeros == HessianZeros::NONE {
         return Ok(());
     }
     let qv = seeded_by_duals(system, q, v, Seed::POSITION, Seed::VELOCITY);
@@ -186,6 +219,20 @@ pub fn check<S: DiracSystem<N>, const N: usize>(
             ))),
         }
     };
+    for (claimed, block, name) in [
+        (zeros.qq, &reference.qq, "∂²L/∂q²"),
+        (zeros.qv, &reference.qv, "∂²L/∂q∂v"),
+        (zeros.vv, &reference.vv, "∂²L/∂v²"),
+    ] {
+        if claimed && block.iter().any(|x| *x != 0.0) {
+            return Err(DiracError::InconsistentDerivatives(format!(
+                "{name} is said to vanish (LAGRANGIAN_HESSIAN_ZEROS), but dual numbers give {block} \
+                 at q = {:?}, v = {:?}",
+                q.as_slice(),
+                v.as_slice()
+            )));
+        }
+    }
     if let Some(g) = gradient {
         compare("gradient", first(&g), first(&reference.gradient))?;
     }

@@ -286,9 +286,15 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             holonomic_forms,
             ..
         } = *self;
+        let share = point.share();
+        if S::HOLONOMIC == 0 && layout.points() == 1 {
+            // One-forms alone on a degree-1 step.
+            let (impulse, scale) = self.add_one_forms(x, residual, jacobian);
+            let end = impulse * (1.0 - share);
+            return (StepCovectors { impulse, end }, scale);
+        }
         let step_col = layout.end_point();
         let step = x.fixed_rows::<N>(step_col).into_owned();
-        let share = point.share();
         let (mut impulse, mut scale) = if layout.points() == 1 {
             self.add_one_forms(x, residual, jacobian.as_deref_mut())
         } else {

@@ -9,7 +9,7 @@
 use nalgebra::{Const, SMatrix, SVector, U1};
 use num_dual::{Derivative, DualSVec64, HyperDualSVec64, HyperHyperDual64};
 
-use crate::closed_form::{LagrangianGradient, LagrangianHessian};
+use crate::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};
 use crate::configuration_space::{ConfigurationSpace, Point};
 use crate::hamiltonian_system::HamiltonianSystem;
 use crate::quadrature::Quadrature;
@@ -315,7 +315,7 @@ pub(crate) fn seeded<F: PhaseFunction<N>, const N: usize>(
         };
     }
     match lagrangian.closed_hessian(q, v) {
-        Some(h) => seeded_from_hessian(&h, x, y),
+        Some(h) => seeded_from_hessian(&h, x, y, HessianZeros::NONE),
         None => seeded_by_duals(lagrangian, q, v, x, y),
     }
 }
@@ -328,20 +328,28 @@ pub(crate) fn seeded_from_hessian<const N: usize>(
     h: &LagrangianHessian<N>,
     x: Seed,
     y: Seed,
+    zeros: HessianZeros,
 ) -> Seeded<N> {
     let g = &h.gradient;
     if ![x.position, x.velocity, y.position, y.velocity].contains(&0.0) {
-        return seeded_without_zero_weights(h, x, y);
+        return seeded_without_zero_weights(h, x, y, zeros);
     }
     let along = |s: Seed| weighted(&g.q, s.position) + weighted(&g.v, s.velocity);
     Seeded {
         value: g.value,
         first: along(x),
         second: along(y),
-        mixed: weighted(&h.qq, x.position * y.position)
-            + weighted(&h.qv, x.position * y.velocity)
-            + weighted(&h.qv.transpose(), x.velocity * y.position)
-            + weighted(&h.vv, x.velocity * y.velocity),
+        mixed: blocks(
+            h,
+            zeros,
+            [
+                x.position * y.position,
+                x.position * y.velocity,
+                x.velocity * y.position,
+                x.velocity * y.velocity,
+            ],
+            weighted,
+        ),
     }
 }
 
@@ -351,17 +359,57 @@ pub(crate) fn seeded_without_zero_weights<const N: usize>(
     h: &LagrangianHessian<N>,
     x: Seed,
     y: Seed,
+    zeros: HessianZeros,
 ) -> Seeded<N> {
     let g = &h.gradient;
     Seeded {
         value: g.value,
         first: g.q * x.position + g.v * x.velocity,
         second: g.q * y.position + g.v * y.velocity,
-        mixed: h.qq * (x.position * y.position)
-            + h.qv * (x.position * y.velocity)
-            + h.qv.transpose() * (x.velocity * y.position)
-            + h.vv * (x.velocity * y.velocity),
+        mixed: blocks(
+            h,
+            zeros,
+            [
+                x.position * y.position,
+                x.position * y.velocity,
+                x.velocity * y.position,
+                x.velocity * y.velocity,
+            ],
+            |m, w| m * w,
+        ),
     }
+}
+
+/// `∂²L/∂q² w_0 + ∂²L/∂q∂v w_1 + (∂²L/∂q∂v)ᵀ w_2 + ∂²L/∂v² w_3`, each product by `times`, in
+/// that order, without the blocks `zeros` says vanish.
+#[inline(always)]
+fn blocks<const N: usize>(
+    h: &LagrangianHessian<N>,
+    zeros: HessianZeros,
+    w: [f64; 4],
+    times: impl Fn(&SMatrix<f64, N, N>, f64) -> SMatrix<f64, N, N>,
+) -> SMatrix<f64, N, N> {
+    if zeros == HessianZeros::NONE {
+        // The plain sum (the flags are constants: the other branch is not compiled in).
+        return times(&h.qq, w[0])
+            + times(&h.qv, w[1])
+            + times(&h.qv.transpose(), w[2])
+            + times(&h.vv, w[3]);
+    }
+    let terms = [
+        (zeros.qq, h.qq, w[0]),
+        (zeros.qv, h.qv, w[1]),
+        (zeros.qv, h.qv.transpose(), w[2]),
+        (zeros.vv, h.vv, w[3]),
+    ];
+    let mut sum: Option<SMatrix<f64, N, N>> = None;
+    for (zero, block, weight) in terms {
+        if !zero {
+            let term = times(&block, weight);
+            sum = Some(sum.map_or(term, |s| s + term));
+        }
+    }
+    sum.unwrap_or_else(SMatrix::zeros)
 }
 
 /// `w · m`, or zeros when `w` is zero (whatever `m` holds).

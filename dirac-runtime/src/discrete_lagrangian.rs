@@ -15,7 +15,7 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
-use crate::closed_form::LagrangianHessian;
+use crate::closed_form::{HessianZeros, LagrangianHessian};
 use crate::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors, Tangent};
 use crate::derivatives::{
     InChart, PhaseFunction, Seed, directional_gradient, gradients, hessian, moving_row, seeded,
@@ -495,6 +495,11 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         // the Hessian share (a `sin`) above the branch and leaves its partner (the `cos`) below,
         // where the two can no longer be one `sincos` call.
         if jacobian.is_some() {
+            // On a translation chart the chart's Hessian is the model's, its zero blocks too.
+            let zeros = match C::TRANSLATION {
+                true => S::LAGRANGIAN_HESSIAN_ZEROS,
+                false => HessianZeros::NONE,
+            };
             for node in &self.nodes {
                 let (w, [a0, a1], [d0, d1]) = node.pair();
                 let plain = node.pair_without_zeros;
@@ -512,9 +517,9 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                 );
                 let hessian = chart.closed_hessian(&node, &rate)?;
                 let l = if plain {
-                    seeded_without_zero_weights(&hessian, x, y)
+                    seeded_without_zero_weights(&hessian, x, y, zeros)
                 } else {
-                    seeded_from_hessian(&hessian, x, y)
+                    seeded_from_hessian(&hessian, x, y, zeros)
                 };
                 block += l.mixed * w;
                 row += l.first * w;

@@ -60,7 +60,7 @@ pub mod system;
 pub mod trajectory;
 pub mod work_precision;
 
-pub use closed_form::{LagrangianGradient, LagrangianHessian};
+pub use closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};
 pub use configuration_space::{ConfigurationSpace, Euclidean, Positive};
 pub use constraint::ConstraintPoint;
 pub use dense_output::Sample;
