@@ -863,16 +863,28 @@ fn layout(coordinates: &[Coordinate], n: usize) -> Option<Vec<(syn::Ident, usize
     (offset == n).then_some(layout)
 }
 
-/// The closed forms of `L`, or `None` where the expression leaves the graph's language.
-pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<ClosedForm> {
+/// `expr` read into a new graph over `n` coordinates (differentials as rates where
+/// `differentials`), with its node; `None` where it leaves the graph's language.
+fn graph_of(
+    expr: &Expr,
+    coordinates: &[Coordinate],
+    n: usize,
+    differentials: bool,
+) -> Option<(Graph, Id)> {
     let mut graph = Graph::new(n);
-    let lagrangian = Reader {
+    let id = Reader {
         graph: &mut graph,
         coordinates: layout(coordinates, n)?,
         n,
-        differentials: false,
+        differentials,
     }
     .read(expr)?;
+    Some((graph, id))
+}
+
+/// The closed forms of `L`, or `None` where the expression leaves the graph's language.
+pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<ClosedForm> {
+    let (mut graph, lagrangian) = graph_of(expr, coordinates, n, false)?;
     // Read before any derivative joins the graph: the property is the Lagrangian's own.
     let entire = graph.entire();
     let first: Vec<Id> = (0..2 * n)
@@ -977,14 +989,7 @@ pub fn one_form_with_derivative(
     coordinates: &[Coordinate],
     n: usize,
 ) -> Option<TokenStream> {
-    let mut graph = Graph::new(n);
-    let form = Reader {
-        graph: &mut graph,
-        coordinates: layout(coordinates, n)?,
-        n,
-        differentials: true,
-    }
-    .read(form)?;
+    let (mut graph, form) = graph_of(form, coordinates, n, true)?;
     let mut coefficients = Vec::new();
     let mut entries = Vec::new();
     for i in 0..n {

@@ -339,17 +339,7 @@ pub(crate) fn seeded_from_hessian<const N: usize>(
         value: g.value,
         first: along(x),
         second: along(y),
-        mixed: blocks(
-            h,
-            zeros,
-            [
-                x.position * y.position,
-                x.position * y.velocity,
-                x.velocity * y.position,
-                x.velocity * y.velocity,
-            ],
-            weighted,
-        ),
+        mixed: blocks(h, zeros, x, y, weighted),
     }
 }
 
@@ -366,29 +356,26 @@ pub(crate) fn seeded_without_zero_weights<const N: usize>(
         value: g.value,
         first: g.q * x.position + g.v * x.velocity,
         second: g.q * y.position + g.v * y.velocity,
-        mixed: blocks(
-            h,
-            zeros,
-            [
-                x.position * y.position,
-                x.position * y.velocity,
-                x.velocity * y.position,
-                x.velocity * y.velocity,
-            ],
-            |m, w| m * w,
-        ),
+        mixed: blocks(h, zeros, x, y, |m, w| m * w),
     }
 }
 
-/// `∂²L/∂q² w_0 + ∂²L/∂q∂v w_1 + (∂²L/∂q∂v)ᵀ w_2 + ∂²L/∂v² w_3`, each product by `times`, in
-/// that order, without the blocks `zeros` says vanish.
+/// `∂²L/∂q² x_q y_q + ∂²L/∂q∂v x_q y_v + (∂²L/∂q∂v)ᵀ x_v y_q + ∂²L/∂v² x_v y_v`, each product
+/// by `times`, in that order, without the blocks `zeros` says vanish.
 #[inline(always)]
 fn blocks<const N: usize>(
     h: &LagrangianHessian<N>,
     zeros: HessianZeros,
-    w: [f64; 4],
+    x: Seed,
+    y: Seed,
     times: impl Fn(&SMatrix<f64, N, N>, f64) -> SMatrix<f64, N, N>,
 ) -> SMatrix<f64, N, N> {
+    let w = [
+        x.position * y.position,
+        x.position * y.velocity,
+        x.velocity * y.position,
+        x.velocity * y.velocity,
+    ];
     if zeros == HessianZeros::NONE {
         // The plain sum (the flags are constants: the other branch is not compiled in).
         return times(&h.qq, w[0])
