@@ -320,6 +320,15 @@ fn one_forms_get_their_rows_and_derivatives_in_closed_form() {
             assert_eq!(unique, expected, "form {a}");
         }
     }
+    // Beside a coordinate named `dx`, `dx` in a form is `x`'s differential (as `one_form` reads
+    // it), and `ddx` that coordinate's.
+    for q in [vector![0.7, 0.2], vector![-1.3, 2.0]] {
+        let (row, derivative, given) = closed_form_of(&Shadowed, &q, 0);
+        let (reference_row, reference) = differenced_form(&Shadowed, &q, 0);
+        assert_eq!(row, reference_row);
+        close(&derivative, &reference, "derivative");
+        assert_eq!(given, [(0, 0)]);
+    }
     // The scene's knife edge: two entries, the blade's angle moving the row.
     let q = vector![0.1, 0.2, 0.5];
     let (row, derivative, given) = closed_form_of(&KnifeEdgeScene, &q, 0);
@@ -337,6 +346,14 @@ fn one_forms_get_their_rows_and_derivatives_in_closed_form() {
     constraints(sin(phi) * dx - cos(phi) * dy),
 )]
 struct KnifeEdgeScene;
+
+/// A coordinate whose name is another's differential.
+#[dirac_system(
+    coordinates(x, dx),
+    lagrangian = 0.5 * (dot(x).powi(2) + dot(dx).powi(2)),
+    constraints(x * x * dx + ddx),
+)]
+struct Shadowed;
 
 /// A model whose one-forms the runtime differentiates by dual numbers: the knife edge's, with
 /// `one_form` alone.

@@ -354,6 +354,10 @@ fn the_jacobian_is_the_residuals_derivative() {
             let mut residual = DVector::zeros(n);
             let mut jacobian = DMatrix::zeros(n, n);
             equations.assemble(&state, &x, &mut residual, Some(&mut jacobian));
+            // The residual is the same function with a Jacobian and without, bit for bit.
+            let mut plain = DVector::zeros(n);
+            equations.assemble(&state, &x, &mut plain, None);
+            assert_eq!(residual, plain, "{point:?}");
             let delta = 1e-6;
             let mut differenced = DMatrix::zeros(n, n);
             for j in 0..n {

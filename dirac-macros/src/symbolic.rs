@@ -581,16 +581,18 @@ impl Reader<'_> {
                 let x: f64 = digits.parse().ok()?;
                 x.is_finite().then(|| self.graph.number(x))
             }
-            Expr::Path(p) => match p.path.get_ident().and_then(|i| self.coordinate(i)) {
-                Some(_) => Some(self.graph.intern(Node::Variable(self.flat_index(expr)?))),
-                None if p
-                    .path
+            // In a one-form a differential comes first, as the form's splitter reads it: `dx`
+            // is `x`'s differential even beside a coordinate named `dx`.
+            Expr::Path(p)
+                if p.path
                     .get_ident()
                     .and_then(|i| self.differential(i))
                     .is_some() =>
-                {
-                    self.rate(expr)
-                }
+            {
+                self.rate(expr)
+            }
+            Expr::Path(p) => match p.path.get_ident().and_then(|i| self.coordinate(i)) {
+                Some(_) => Some(self.graph.intern(Node::Variable(self.flat_index(expr)?))),
                 None => Some(self.graph.constant(p.to_token_stream())),
             },
             Expr::Index(ix) => {
@@ -598,9 +600,11 @@ impl Reader<'_> {
                     return None;
                 };
                 let ident = p.path.get_ident();
+                if ident.and_then(|i| self.differential(i)).is_some() {
+                    return self.rate(expr);
+                }
                 match ident.and_then(|i| self.coordinate(i)) {
                     Some(_) => Some(self.graph.intern(Node::Variable(self.flat_index(expr)?))),
-                    None if ident.and_then(|i| self.differential(i)).is_some() => self.rate(expr),
                     None => Some(self.graph.constant(ix.to_token_stream())),
                 }
             }

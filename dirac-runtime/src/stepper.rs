@@ -1032,6 +1032,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         // this stepper (or another) produced is always accepted.
         let tolerance = START_TOLERANCE.max(100.0 * self.newton.options().residual_tolerance);
         self.equations.check_start(&state, tolerance)?;
+        // A refused start keeps the last step's violation, which the trial below may no longer
+        // be able to measure (`begin` may clear the predictor's solutions).
+        self.settle_violation();
         self.begin(&state)?;
         // A rule that does not determine the model's motion (the first step's Jacobian is
         // singular) is refused here, before the first step, naming the undetermined unknowns.
