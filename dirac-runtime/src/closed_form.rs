@@ -186,7 +186,6 @@ pub fn check<S: DiracSystem<N>, const N: usize>(
         qv: qv.mixed,
         vv,
     };
-    let finite = |x: &[f64]| x.iter().all(|x| x.is_finite());
     let first = |g: &LagrangianGradient<N>| {
         let mut all = vec![g.value];
         all.extend(g.q.iter().chain(g.v.iter()));
@@ -199,26 +198,18 @@ pub fn check<S: DiracSystem<N>, const N: usize>(
             .copied()
             .collect::<Vec<_>>()
     };
-    let compare = |what: &str, closed: Vec<f64>, duals: Vec<f64>| {
-        if !finite(&duals) {
-            return Ok(());
-        }
-        let scale = duals.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-        // A difference that is NaN (a closed form NaN where the duals are finite) disagrees.
-        let bound = TOLERANCE * scale.max(f64::MIN_POSITIVE);
-        let agrees = |a: f64, b: f64| (a - b).abs() <= bound;
-        match closed.iter().zip(&duals).position(|(a, b)| !agrees(*a, *b)) {
+    let compare =
+        |what: &str, closed: Vec<f64>, duals: Vec<f64>| match disagreement(&closed, &duals) {
             None => Ok(()),
             Some(k) => Err(DiracError::InconsistentDerivatives(format!(
                 "the closed-form {what} of the Lagrangian differs from dual numbers at \
-                 q = {:?}, v = {:?}: entry {k} is {} against {}",
+             q = {:?}, v = {:?}: entry {k} is {} against {}",
                 q.as_slice(),
                 v.as_slice(),
                 closed[k],
                 duals[k]
             ))),
-        }
-    };
+        };
     for (claimed, block, name) in [
         (zeros.qq, &reference.qq, "∂²L/∂q²"),
         (zeros.qv, &reference.qv, "∂²L/∂q∂v"),
@@ -268,12 +259,7 @@ fn check_one_forms<S: DiracSystem<N>, const N: usize>(
         }
         let row = system.one_form(&crate::derivatives::lift(q, 1.0), a);
         let values = row.map(|x| x.re);
-        let duals = SMatrix::<f64, N, N>::from_fn(|i, j| crate::derivatives::gradient(&row[i])[j]);
-        if !(values.iter().all(|x| x.is_finite()) && duals.iter().all(|x| x.is_finite())) {
-            continue;
-        }
-        let bound = TOLERANCE * values.amax().max(f64::MIN_POSITIVE);
-        if let Some(i) = (0..N).find(|&i| exceeds((closed_row[i] - values[i]).abs(), bound)) {
+        if let Some(i) = disagreement(closed_row.as_slice(), values.as_slice()) {
             return Err(DiracError::InconsistentDerivatives(format!(
                 "the closed-form row of {name} differs from `one_form` at q = {:?}: \
                  A_{i} is {} against {}",
@@ -282,14 +268,10 @@ fn check_one_forms<S: DiracSystem<N>, const N: usize>(
                 values[i]
             )));
         }
-        let bound = TOLERANCE * duals.amax().max(f64::MIN_POSITIVE);
-        // A difference that is NaN (a closed form NaN where the duals are finite) disagrees.
-        let differs =
-            |(i, j): (usize, usize)| exceeds((closed[(i, j)] - duals[(i, j)]).abs(), bound);
-        if let Some((i, j)) = (0..N)
-            .flat_map(|i| (0..N).map(move |j| (i, j)))
-            .find(|&e| differs(e))
-        {
+        let duals = SMatrix::<f64, N, N>::from_fn(|i, j| crate::derivatives::gradient(&row[i])[j]);
+        if let Some(k) = disagreement(closed.as_slice(), duals.as_slice()) {
+            // Column-major: entry k is (k mod N, k div N).
+            let (i, j) = (k % N, k / N);
             return Err(DiracError::InconsistentDerivatives(format!(
                 "the closed-form derivative of {name} differs from dual numbers at q = {:?}: \
                  ∂A_{i}/∂q_{j} is {} against {}",
@@ -300,4 +282,19 @@ fn check_one_forms<S: DiracSystem<N>, const N: usize>(
         }
     }
     Ok(())
+}
+
+/// The first entry where `closed` differs from `duals` by more than `1e-8` of the largest of
+/// `duals`, or `None` (also where `duals` are not finite: such a point is not judged). A
+/// difference that is NaN (a closed form NaN where the duals are finite) disagrees.
+fn disagreement(closed: &[f64], duals: &[f64]) -> Option<usize> {
+    if !duals.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let scale = duals.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let bound = TOLERANCE * scale.max(f64::MIN_POSITIVE);
+    closed
+        .iter()
+        .zip(duals)
+        .position(|(a, b)| exceeds((a - b).abs(), bound))
 }
