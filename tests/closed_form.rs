@@ -165,24 +165,28 @@ fn every_function_is_differentiated_exactly() {
 )]
 struct FormCallsUser;
 
-/// The Hessian blocks that vanish identically are read off the expression, and a claim that a
-/// block vanishes where it does not is refused at the start of a run.
+/// The Hessian entries that vanish identically are read off the expression, and a claim that an
+/// entry vanishes where it does not is refused at the start of a run.
 #[test]
-fn vanishing_hessian_blocks_are_known_and_checked() {
-    const {
-        // L = T(v) on a flat plane with a potential linear in x: only ∂²L/∂v² is left.
-        let blade = <KnifeEdgeScene as DiracSystem<3>>::LAGRANGIAN_HESSIAN_ZEROS;
-        assert!(blade.qq && blade.qv && !blade.vv);
-        // A mass that depends on the position couples them.
-        let coupled = <Trigonometric as DiracSystem<2>>::LAGRANGIAN_HESSIAN_ZEROS;
-        assert!(!coupled.qq && !coupled.qv && !coupled.vv);
-    };
+fn vanishing_hessian_entries_are_known_and_checked() {
+    let all = [[true; 3]; 3];
+    let diagonal = [
+        [false, true, true],
+        [true, false, true],
+        [true, true, false],
+    ];
+    // L = T(v) on a flat plane: only the diagonal of ∂²L/∂v² is left.
+    let blade = <KnifeEdgeScene as DiracSystem<3>>::LAGRANGIAN_HESSIAN_ZEROS;
+    assert_eq!((blade.qq, blade.qv, blade.vv), (all, all, diagonal));
+    assert!(blade.vanishes(0, 1) && !blade.vanishes(2, 2));
+    // A mass that depends on the position couples every entry.
+    let coupled = <Trigonometric as DiracSystem<2>>::LAGRANGIAN_HESSIAN_ZEROS;
+    assert_eq!(coupled, HessianZeros::NONE);
     struct Claims;
     impl DiracSystem<1> for Claims {
-        const LAGRANGIAN_HESSIAN_ZEROS: HessianZeros = HessianZeros {
-            qq: false,
-            qv: true,
-            vv: false,
+        const LAGRANGIAN_HESSIAN_ZEROS: HessianZeros<1> = HessianZeros {
+            qv: [[true]],
+            ..HessianZeros::NONE
         };
         fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
             // ∂²L/∂q∂v = 2 q v: not zero.
@@ -192,7 +196,26 @@ fn vanishing_hessian_blocks_are_known_and_checked() {
     let mut stepper = Stepper::new(Claims, Quadrature::midpoint(), 0.1).expect("stepper");
     let refused = stepper.start_from_velocity(vector![0.5], vector![0.3]);
     assert!(
-        matches!(refused, Err(DiracError::InconsistentDerivatives(ref m)) if m.contains("∂²L/∂q∂v")),
+        matches!(refused, Err(DiracError::InconsistentDerivatives(ref m)) if m.contains("∂²L/∂q_0∂v_0")),
+        "{refused:?}"
+    );
+    // One entry off the diagonal claimed in a block whose others do vanish.
+    struct OffDiagonal;
+    impl DiracSystem<2> for OffDiagonal {
+        const LAGRANGIAN_HESSIAN_ZEROS: HessianZeros<2> = HessianZeros {
+            qq: [[true; 2]; 2],
+            qv: [[true; 2]; 2],
+            vv: [[false, true], [true, false]],
+        };
+        fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+            // ∂²L/∂v₀∂v₁ = 0.1.
+            (v[0] * v[0] + v[1] * v[1]) * 0.5 + v[0] * v[1] * 0.1
+        }
+    }
+    let mut stepper = Stepper::new(OffDiagonal, Quadrature::midpoint(), 0.1).expect("stepper");
+    let refused = stepper.start_from_velocity(vector![0.5, 0.1], vector![0.3, 0.2]);
+    assert!(
+        matches!(refused, Err(DiracError::InconsistentDerivatives(ref m)) if m.contains("∂²L/∂v_0∂v_1")),
         "{refused:?}"
     );
 }

@@ -327,10 +327,21 @@ struct Blade;
 #[derive(Debug, Clone, Copy)]
 struct Separable;
 
+/// `∂²L/∂q∂v` with a single entry, off its diagonal (`∂²L/∂y∂ẋ`), and `∂²L/∂q²` diagonal: the
+/// step combines the entries that do not vanish of a block and of its transpose.
+#[dirac_system(
+    coordinates(x, y, z),
+    lagrangian = 0.5 * (dot(x).powi(2) + dot(y).powi(2) + dot(z).powi(2)) + y * dot(x)
+        - cos(x) - y.powi(2) - z.powi(3),
+)]
+#[derive(Debug, Clone, Copy)]
+struct Skew;
+
 /// The Jacobian the assembly adds is the derivative of its residual: against central
 /// differences, off the solution with multipliers that are not zero, at each constraint point,
 /// for a one-form in closed form (with a Lagrangian whose `∂²L/∂q²` and `∂²L/∂q∂v` vanish), for
-/// one beside a holonomic constraint, and for a separable Lagrangian.
+/// one beside a holonomic constraint, for a separable Lagrangian and for one whose `∂²L/∂q∂v`
+/// has a single entry off its diagonal.
 #[test]
 fn the_jacobian_is_the_residuals_derivative() {
     use dirac::euler_lagrange::EulerLagrange;
@@ -387,8 +398,20 @@ fn the_jacobian_is_the_residuals_derivative() {
         vector![0.0, 1.0, 0.0],
     );
     check(Separable, vector![0.6, -0.3, 0.8], vector![0.2, 1.0, -0.4]);
-    const {
-        assert!(Blade::LAGRANGIAN_HESSIAN_ZEROS.qq && Blade::LAGRANGIAN_HESSIAN_ZEROS.qv);
-        assert!(!Separable::LAGRANGIAN_HESSIAN_ZEROS.qq && Separable::LAGRANGIAN_HESSIAN_ZEROS.qv);
-    };
+    check(Skew, vector![0.6, -0.3, 0.8], vector![0.2, 1.0, -0.4]);
+    // The step skipped the Hessian's products it was told vanish: they did.
+    let (blade, separable) = (
+        Blade::LAGRANGIAN_HESSIAN_ZEROS,
+        Separable::LAGRANGIAN_HESSIAN_ZEROS,
+    );
+    assert!((0..3).all(|i| (0..3).all(|j| blade.qq[i][j] && blade.qv[i][j])));
+    assert!(blade.vanishes(0, 1) && !blade.vanishes(1, 1));
+    assert!(!separable.qq[0][0] && separable.qq[0][1] && separable.qv == [[true; 3]; 3]);
+    assert!(separable.vanishes(0, 1) && !separable.vanishes(1, 2));
+    let skew = Skew::LAGRANGIAN_HESSIAN_ZEROS;
+    let off_diagonal = |i: usize, j: usize| i != j;
+    assert!((0..3).all(|i| (0..3).all(|j| skew.qq[i][j] == off_diagonal(i, j))));
+    assert!((0..3).all(|i| (0..3).all(|j| skew.qv[i][j] == ((i, j) != (1, 0)))));
+    assert!((0..3).all(|i| (0..3).all(|j| skew.vv[i][j] == off_diagonal(i, j))));
+    assert!(!skew.vanishes(0, 1) && !skew.vanishes(1, 0) && skew.vanishes(0, 2));
 }

@@ -380,10 +380,14 @@ fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
             const LAGRANGIAN_ENTIRE: bool = true;
         )
     });
-    let zeros = (closed.hessian.is_some() && closed.zeros.contains(&true)).then(|| {
-        let [qq, qv, vv] = closed.zeros;
+    let any = closed.zeros.iter().flatten().flatten().any(|&zero| zero);
+    let zeros = (closed.hessian.is_some() && any).then(|| {
+        let [qq, qv, vv] = closed.zeros.clone().map(|block| {
+            let rows = block.into_iter().map(|row| quote!([#(#row),*]));
+            quote!([#(#rows),*])
+        });
         quote!(
-            const LAGRANGIAN_HESSIAN_ZEROS: __dirac::HessianZeros =
+            const LAGRANGIAN_HESSIAN_ZEROS: __dirac::HessianZeros<#n> =
                 __dirac::HessianZeros { qq: #qq, qv: #qv, vv: #vv };
         )
     });

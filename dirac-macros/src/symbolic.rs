@@ -846,8 +846,9 @@ pub struct ClosedForm {
     pub entire: bool,
     /// `None` when the second derivatives exceed the size bound.
     pub hessian: Option<TokenStream>,
-    /// Whether `∂²L/∂q²`, `∂²L/∂q∂v`, `∂²L/∂v²` vanish identically (known with the Hessian).
-    pub zeros: [bool; 3],
+    /// Which entries of `∂²L/∂q²`, `∂²L/∂q∂v`, `∂²L/∂v²` vanish identically, each block by
+    /// `[i][j]` (known with the Hessian; none otherwise).
+    pub zeros: [Vec<Vec<bool>>; 3],
 }
 
 /// Each coordinate's name, flat offset and literal length; `None` where a length is not a
@@ -919,7 +920,7 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
                     gradient,
                     entire,
                     hessian: None,
-                    zeros: [false; 3],
+                    zeros: Default::default(),
                 });
             }
         }
@@ -950,14 +951,14 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
                 false => quote!(#block[(#i, #j)] = #x;),
             }
         });
-    let mut zeros = [true; 3];
+    let mut zeros: [Vec<Vec<bool>>; 3] = std::array::from_fn(|_| vec![vec![false; n]; n]);
     for &(i, j, id) in &second {
-        let block = match (i < n, j < n) {
-            (true, true) => 0,
-            (true, false) => 1,
-            _ => 2,
-        };
-        zeros[block] &= graph.is(id, 0.0);
+        let zero = graph.is(id, 0.0);
+        match (i < n, j < n) {
+            (true, true) => (zeros[0][i][j], zeros[0][j][i]) = (zero, zero),
+            (true, false) => zeros[1][i][j - n] = zero,
+            _ => (zeros[2][i - n][j - n], zeros[2][j - n][i - n]) = (zero, zero),
+        }
     }
     let zero = quote!(__dirac::nalgebra::SMatrix::<f64, #n, #n>::zeros());
     let hessian = quote! {

@@ -121,34 +121,58 @@ impl<const N: usize> LagrangianHessian<N> {
     }
 }
 
-/// Which blocks of the Lagrangian's Hessian vanish identically: `#[dirac_system]` reads them off
-/// the expression (`∂²L/∂q∂v = 0` for `L = T(v) − V(q)`, `∂²L/∂q² = 0` for a potential linear
-/// in `q`), and a step skips their products. A stepper checks the claim at the start of every
-/// run ([`check`]).
+/// Which entries of the Lagrangian's Hessian vanish identically: `#[dirac_system]` reads them off
+/// the expression (`∂²L/∂q∂v = 0` for `L = T(v) − V(q)`, `∂²L/∂q² = 0` for a potential linear in
+/// `q`, `∂²L/∂v_i∂v_j = 0` off the diagonal of a diagonal mass matrix), and a step skips their
+/// products. A stepper checks the claim at the start of every run ([`check`]).
 ///
 /// ```
 /// use dirac_runtime::HessianZeros;
 ///
-/// let separable = HessianZeros { qv: true, ..HessianZeros::NONE };
-/// assert!(!separable.qq && separable.qv && !separable.vv);
+/// // L = ½ (v₀² + v₁²) − V(q): no mixed block, and a diagonal ∂²L/∂v².
+/// let zeros = HessianZeros::<2> {
+///     qv: [[true; 2]; 2],
+///     vv: [[false, true], [true, false]],
+///     ..HessianZeros::NONE
+/// };
+/// assert!(zeros.vanishes(0, 1) && !zeros.vanishes(0, 0));
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct HessianZeros {
-    /// `∂²L/∂q² = 0` everywhere.
-    pub qq: bool,
-    /// `∂²L/∂q∂v = 0` everywhere.
-    pub qv: bool,
-    /// `∂²L/∂v² = 0` everywhere.
-    pub vv: bool,
+pub struct HessianZeros<const N: usize> {
+    /// `qq[i][j]`: `∂²L/∂q_i∂q_j = 0` everywhere.
+    pub qq: [[bool; N]; N],
+    /// `qv[i][j]`: `∂²L/∂q_i∂v_j = 0` everywhere.
+    pub qv: [[bool; N]; N],
+    /// `vv[i][j]`: `∂²L/∂v_i∂v_j = 0` everywhere.
+    pub vv: [[bool; N]; N],
 }
 
-impl HessianZeros {
-    /// No block known to vanish.
+impl<const N: usize> HessianZeros<N> {
+    /// No entry known to vanish.
     pub const NONE: Self = Self {
-        qq: false,
-        qv: false,
-        vv: false,
+        qq: [[false; N]; N],
+        qv: [[false; N]; N],
+        vv: [[false; N]; N],
     };
+
+    /// Whether entry `(i, j)` of every block a step combines vanishes: `∂²L/∂q_i∂q_j`,
+    /// `∂²L/∂q_i∂v_j`, `∂²L/∂q_j∂v_i` and `∂²L/∂v_i∂v_j`, so that any weighted sum of the
+    /// blocks (`∂²L/∂q∂v` and its transpose among them) is zero there.
+    pub const fn vanishes(&self, i: usize, j: usize) -> bool {
+        self.qq[i][j] && self.qv[i][j] && self.qv[j][i] && self.vv[i][j]
+    }
+
+    /// `f(i, j)` at each entry that does not [vanish](Self::vanishes), row by row.
+    #[inline(always)]
+    pub(crate) fn for_each_live(&self, mut f: impl FnMut(usize, usize)) {
+        for i in 0..N {
+            for j in 0..N {
+                if !self.vanishes(i, j) {
+                    f(i, j);
+                }
+            }
+        }
+    }
 }
 
 /// Relative disagreement with dual numbers beyond which closed forms are refused.
@@ -159,7 +183,7 @@ const TOLERANCE: f64 = 1e-8;
 /// of the largest of its kind. Points where the Lagrangian is not finite are not judged. The
 /// one-forms' closed forms ([`DiracSystem::one_form_with_derivative`]) are compared at `q` the
 /// same way, the row and every entry of its derivative, those the model leaves out being zero.
-/// A Hessian block claimed to vanish ([`DiracSystem::LAGRANGIAN_HESSIAN_ZEROS`]) must vanish
+/// A Hessian entry claimed to vanish ([`DiracSystem::LAGRANGIAN_HESSIAN_ZEROS`]) must vanish
 /// under dual numbers at `(q, v)`.
 pub fn check<S: DiracSystem<N>, const N: usize>(
     system: &S,
@@ -211,19 +235,25 @@ pub fn check<S: DiracSystem<N>, const N: usize>(
             ))),
         };
     for (claimed, block, name) in [
-        (zeros.qq, &reference.qq, "∂²L/∂q²"),
-        (zeros.qv, &reference.qv, "∂²L/∂q∂v"),
-        (zeros.vv, &reference.vv, "∂²L/∂v²"),
+        (&zeros.qq, &reference.qq, ["q", "q"]),
+        (&zeros.qv, &reference.qv, ["q", "v"]),
+        (&zeros.vv, &reference.vv, ["v", "v"]),
     ] {
         // Not judged where the dual numbers are not finite (as the comparisons below).
-        let finite = block.iter().all(|x| x.is_finite());
-        if claimed && finite && block.iter().any(|x| *x != 0.0) {
-            return Err(DiracError::InconsistentDerivatives(format!(
-                "{name} is said to vanish (LAGRANGIAN_HESSIAN_ZEROS), but dual numbers give {block} \
-                 at q = {:?}, v = {:?}",
-                q.as_slice(),
-                v.as_slice()
-            )));
+        if !block.iter().all(|x| x.is_finite()) {
+            continue;
+        }
+        for (i, j) in (0..N).flat_map(|i| (0..N).map(move |j| (i, j))) {
+            if claimed[i][j] && block[(i, j)] != 0.0 {
+                let [x, y] = name;
+                return Err(DiracError::InconsistentDerivatives(format!(
+                    "∂²L/∂{x}_{i}∂{y}_{j} is said to vanish (LAGRANGIAN_HESSIAN_ZEROS), but dual \
+                     numbers give {} at q = {:?}, v = {:?}",
+                    block[(i, j)],
+                    q.as_slice(),
+                    v.as_slice()
+                )));
+            }
         }
     }
     if let Some(g) = gradient {

@@ -328,7 +328,7 @@ pub(crate) fn seeded_from_hessian<const N: usize>(
     h: &LagrangianHessian<N>,
     x: Seed,
     y: Seed,
-    zeros: HessianZeros,
+    zeros: HessianZeros<N>,
 ) -> Seeded<N> {
     let g = &h.gradient;
     if ![x.position, x.velocity, y.position, y.velocity].contains(&0.0) {
@@ -339,7 +339,7 @@ pub(crate) fn seeded_from_hessian<const N: usize>(
         value: g.value,
         first: along(x),
         second: along(y),
-        mixed: blocks(h, zeros, x, y, weighted),
+        mixed: blocks(h, zeros, x, y, |e, w| if w == 0.0 { 0.0 } else { e * w }),
     }
 }
 
@@ -349,26 +349,26 @@ pub(crate) fn seeded_without_zero_weights<const N: usize>(
     h: &LagrangianHessian<N>,
     x: Seed,
     y: Seed,
-    zeros: HessianZeros,
+    zeros: HessianZeros<N>,
 ) -> Seeded<N> {
     let g = &h.gradient;
     Seeded {
         value: g.value,
         first: g.q * x.position + g.v * x.velocity,
         second: g.q * y.position + g.v * y.velocity,
-        mixed: blocks(h, zeros, x, y, |m, w| m * w),
+        mixed: blocks(h, zeros, x, y, |e, w| e * w),
     }
 }
 
 /// `∂²L/∂q² x_q y_q + ∂²L/∂q∂v x_q y_v + (∂²L/∂q∂v)ᵀ x_v y_q + ∂²L/∂v² x_v y_v`, each product
-/// by `times`, in that order, without the blocks `zeros` says vanish.
+/// by `times`, in that order, without the entries `zeros` says vanish.
 #[inline(always)]
 fn blocks<const N: usize>(
     h: &LagrangianHessian<N>,
-    zeros: HessianZeros,
+    zeros: HessianZeros<N>,
     x: Seed,
     y: Seed,
-    times: impl Fn(&SMatrix<f64, N, N>, f64) -> SMatrix<f64, N, N>,
+    times: impl Fn(f64, f64) -> f64,
 ) -> SMatrix<f64, N, N> {
     let w = [
         x.position * y.position,
@@ -376,27 +376,36 @@ fn blocks<const N: usize>(
         x.velocity * y.position,
         x.velocity * y.velocity,
     ];
+    let mixed = h.qv.transpose();
     if zeros == HessianZeros::NONE {
         // The plain sum (the flags are constants: the other branch is not compiled in).
-        return times(&h.qq, w[0])
-            + times(&h.qv, w[1])
-            + times(&h.qv.transpose(), w[2])
-            + times(&h.vv, w[3]);
+        return h.qq.map(|e| times(e, w[0]))
+            + h.qv.map(|e| times(e, w[1]))
+            + mixed.map(|e| times(e, w[2]))
+            + h.vv.map(|e| times(e, w[3]));
     }
-    let terms = [
-        (zeros.qq, h.qq, w[0]),
-        (zeros.qv, h.qv, w[1]),
-        (zeros.qv, h.qv.transpose(), w[2]),
-        (zeros.vv, h.vv, w[3]),
-    ];
-    let mut sum: Option<SMatrix<f64, N, N>> = None;
-    for (zero, block, weight) in terms {
-        if !zero {
-            let term = times(&block, weight);
-            sum = Some(sum.map_or(term, |s| s + term));
+    let mut sum = SMatrix::zeros();
+    for i in 0..N {
+        for j in 0..N {
+            let terms = [
+                (zeros.qq[i][j], h.qq[(i, j)], w[0]),
+                (zeros.qv[i][j], h.qv[(i, j)], w[1]),
+                (zeros.qv[j][i], mixed[(i, j)], w[2]),
+                (zeros.vv[i][j], h.vv[(i, j)], w[3]),
+            ];
+            let mut entry: Option<f64> = None;
+            for (zero, x, weight) in terms {
+                if !zero {
+                    let term = times(x, weight);
+                    entry = Some(entry.map_or(term, |s| s + term));
+                }
+            }
+            if let Some(entry) = entry {
+                sum[(i, j)] = entry;
+            }
         }
     }
-    sum.unwrap_or_else(SMatrix::zeros)
+    sum
 }
 
 /// `w · m`, or zeros when `w` is zero (whatever `m` holds).

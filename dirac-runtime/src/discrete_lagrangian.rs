@@ -491,15 +491,15 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         let mut impulse = SVector::zeros();
         let mut end = SVector::zeros();
         let mut block = SMatrix::<f64, N, N>::zeros();
+        // On a translation chart the chart's Hessian is the model's, its zero entries too.
+        let zeros = match C::TRANSLATION {
+            true => S::LAGRANGIAN_HESSIAN_ZEROS,
+            false => HessianZeros::NONE,
+        };
         // One loop for each case: within one loop body the compiler hoists what the gradient and
         // the Hessian share (a `sin`) above the branch and leaves its partner (the `cos`) below,
         // where the two can no longer be one `sincos` call.
         if jacobian.is_some() {
-            // On a translation chart the chart's Hessian is the model's, its zero blocks too.
-            let zeros = match C::TRANSLATION {
-                true => S::LAGRANGIAN_HESSIAN_ZEROS,
-                false => HessianZeros::NONE,
-            };
             for node in &self.nodes {
                 let (w, [a0, a1], [d0, d1]) = node.pair();
                 let plain = node.pair_without_zeros;
@@ -521,7 +521,11 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                 } else {
                     seeded_from_hessian(&hessian, x, y, zeros)
                 };
-                block += l.mixed * w;
+                if zeros == HessianZeros::NONE {
+                    block += l.mixed * w;
+                } else {
+                    zeros.for_each_live(|i, j| block[(i, j)] += l.mixed[(i, j)] * w);
+                }
                 row += l.first * w;
                 impulse += (l.first + l.second) * w;
                 end += l.second * w;
@@ -542,7 +546,11 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         residual.fixed_rows_mut::<N>(0).copy_from(&row);
         if let Some(jacobian) = jacobian.as_deref_mut() {
             let mut target = jacobian.fixed_view_mut::<N, N>(0, 0);
-            target += block;
+            if zeros == HessianZeros::NONE {
+                target += block;
+            } else {
+                zeros.for_each_live(|i, j| target[(i, j)] += block[(i, j)]);
+            }
         }
         Some((StepCovectors { impulse, end }, magnitude.amax()))
     }

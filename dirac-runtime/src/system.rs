@@ -78,12 +78,12 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// ```
     const LAGRANGIAN_ENTIRE: bool = false;
 
-    /// The blocks of the Lagrangian's Hessian that vanish identically ([`HessianZeros`]; none by
+    /// The entries of the Lagrangian's Hessian that vanish identically ([`HessianZeros`]; none by
     /// default): a degree-1 step with closed-form derivatives skips their products.
     /// `#[dirac_system]` reads them off the expression.
     ///
     /// [`HessianZeros`]: crate::HessianZeros
-    const LAGRANGIAN_HESSIAN_ZEROS: crate::HessianZeros = crate::HessianZeros::NONE;
+    const LAGRANGIAN_HESSIAN_ZEROS: crate::HessianZeros<N> = crate::HessianZeros::NONE;
 
     /// Whether [`one_form_with_derivative`](Self::one_form_with_derivative) gives the one-forms'
     /// derivatives in closed form (`false` by default: dual numbers take them).
