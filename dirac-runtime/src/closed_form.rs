@@ -129,12 +129,9 @@ impl<const N: usize> LagrangianHessian<N> {
 /// ```
 /// use dirac_runtime::HessianZeros;
 ///
-/// // L = ½ (v₀² + v₁²) − V(q): no mixed block, and a diagonal ∂²L/∂v².
-/// let zeros = HessianZeros::<2> {
-///     qv: [[true; 2]; 2],
-///     vv: [[false, true], [true, false]],
-///     ..HessianZeros::NONE
-/// };
+/// // L = ½ (v₀² + v₁²) − V(q₀) − W(q₁): ∂²L/∂q∂v vanishes, ∂²L/∂q² and ∂²L/∂v² are diagonal.
+/// let diagonal = [[false, true], [true, false]];
+/// let zeros = HessianZeros::<2> { qq: diagonal, qv: [[true; 2]; 2], vv: diagonal };
 /// assert!(zeros.vanishes(0, 1) && !zeros.vanishes(0, 0));
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -160,18 +157,6 @@ impl<const N: usize> HessianZeros<N> {
     /// blocks (`∂²L/∂q∂v` and its transpose among them) is zero there.
     pub const fn vanishes(&self, i: usize, j: usize) -> bool {
         self.qq[i][j] && self.qv[i][j] && self.qv[j][i] && self.vv[i][j]
-    }
-
-    /// `f(i, j)` at each entry that does not [vanish](Self::vanishes), row by row.
-    #[inline(always)]
-    pub(crate) fn for_each_live(&self, mut f: impl FnMut(usize, usize)) {
-        for i in 0..N {
-            for j in 0..N {
-                if !self.vanishes(i, j) {
-                    f(i, j);
-                }
-            }
-        }
     }
 }
 

@@ -202,33 +202,31 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             layout,
             ..
         } = *self;
+        if C::TRANSLATION && S::ONE_FORM_DERIVATIVES {
+            // On a translation chart a closed form is the chart's.
+            // A degree-1 step: the end point's increment leads the unknowns, the multipliers
+            // follow it.
+            debug_assert!(layout.end_point() == 0 && layout.one_form(0) == N);
+            return closed_one_forms(
+                system,
+                space,
+                base,
+                point,
+                x.as_slice(),
+                residual.as_mut_slice(),
+                jacobian.map(|j| j.as_mut_slice()),
+            );
+        }
         let step_col = layout.end_point();
         let step = x.fixed_rows::<N>(step_col).into_owned();
         let (theta, share) = (point.theta(), point.share());
         let mut impulse = SVector::<f64, N>::zeros();
         let mut scale = 0.0_f64;
         let xi_c = step * theta;
-        // On a translation chart a closed form is the chart's: the row and its derivative come
-        // from one piece of `f64` code, and a Jacobian touches only the entries given.
-        let closed = C::TRANSLATION && S::ONE_FORM_DERIVATIVES;
         for a in 0..S::ONE_FORMS {
             let col = layout.one_form(a);
             let mu = x[col];
-            // Σ_i ξ_s,i ∂Ã_i/∂ξ_j over the closed form's entries.
-            let mut sum = SVector::<f64, N>::zeros();
-            let (row, derivative) = if closed {
-                let q_c = space.retract(base, &xi_c);
-                let weight = share * theta * mu;
-                // One call whether or not a Jacobian is asked for: in two branches the compiler
-                // would hoist the row's `sin` above them and part it from its `cos`.
-                let row = system.one_form_with_derivative(&q_c, a, |i, j, d| {
-                    if let Some(jacobian) = jacobian.as_deref_mut() {
-                        jacobian[(i, step_col + j)] += d * weight;
-                        sum[j] += d * step[i];
-                    }
-                });
-                (space.pull_back(base, &xi_c, &row), None)
-            } else if jacobian.is_some() {
+            let (row, derivative) = if jacobian.is_some() {
                 one_form_in_chart(system, space, base, &xi_c, a)
             } else {
                 (one_form_value_in_chart(system, space, base, &xi_c, a), None)
@@ -246,8 +244,6 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             let mut force = jacobian.fixed_view_mut::<N, 1>(0, col);
             force += row * share;
             let turning = match derivative {
-                // `∂(Ã ξ_s)/∂ξ_s = Ã + θ ξ_sᵀ ∂Ã`, over the closed form's entries.
-                None if closed => row + sum * theta,
                 None => row,
                 Some(derivative) => {
                     let mut block = jacobian.fixed_view_mut::<N, N>(0, step_col);
@@ -261,6 +257,71 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         }
         (impulse, scale)
     }
+}
+
+/// The one-forms of a degree-1 step on a translation chart (`Rⁿ`) from their closed forms
+/// ([`DiracSystem::one_form_with_derivative`]), held at `q_c = q_k + θ ξ_s`: adds `σ A(q_c)ᵀμ`
+/// to the rows `0..N`, writes the rows `A(q_c) ξ_s`, and where a Jacobian is asked for (`n × n`
+/// by columns, `n = x.len()`) adds `σ θ Σ_a μ_a ∂A_a/∂q` to the block of `ξ_s` over the entries
+/// the closed form gives, `σ A_aᵀ` to the column of `μ_a` and writes the row of `μ_a`'s
+/// constraint, `A_a + θ ξ_sᵀ ∂A_a/∂q`. The unknowns are a degree-1 step's: `ξ_s` in `0..N`, then
+/// `μ`. Returns the impulse `A(q_c)ᵀμ` with the size of the rows' terms. On slices: their own
+/// indices, without a check each.
+#[inline(always)]
+pub(crate) fn closed_one_forms<
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+    const N: usize,
+>(
+    system: &S,
+    space: &C,
+    base: &Point<C, N, f64>,
+    point: ConstraintPoint,
+    x: &[f64],
+    residual: &mut [f64],
+    mut jacobian: Option<&mut [f64]>,
+) -> (SVector<f64, N>, f64) {
+    let n = x.len();
+    let step = SVector::<f64, N>::from_fn(|i, _| x[i]);
+    let (theta, share) = (point.theta(), point.share());
+    debug_assert!(C::TRANSLATION && S::ONE_FORM_DERIVATIVES);
+    let xi_c = step * theta;
+    let q_c = space.retract(base, &xi_c);
+    let mut impulse = SVector::<f64, N>::zeros();
+    let mut scale = 0.0_f64;
+    for a in 0..S::ONE_FORMS {
+        let col = N + a;
+        let mu = x[col];
+        let weight = share * theta * mu;
+        // Σ_i ξ_s,i ∂A_i/∂q_j over the closed form's entries.
+        let mut sum = SVector::<f64, N>::zeros();
+        // One call whether or not a Jacobian is asked for: in two branches the compiler would
+        // hoist the row's `sin` above them and part it from its `cos`.
+        let row = system.one_form_with_derivative(&q_c, a, |i, j, d| {
+            if let Some(jacobian) = jacobian.as_deref_mut() {
+                jacobian[j * n + i] += d * weight;
+                sum[j] += d * step[i];
+            }
+        });
+        // The chart's row (the model's, on a translation chart).
+        let row = space.pull_back(base, &xi_c, &row);
+        let (mut value, mut size) = (0.0, 0.0);
+        for i in 0..N {
+            impulse[i] += row[i] * mu;
+            residual[i] += share * mu * row[i];
+            value += row[i] * step[i];
+            size += row[i].abs() * step[i].abs();
+        }
+        residual[col] = value;
+        scale = scale.max(size);
+        if let Some(jacobian) = jacobian.as_deref_mut() {
+            for i in 0..N {
+                jacobian[col * n + i] += row[i] * share;
+                jacobian[i * n + col] = row[i] + sum[i] * theta;
+            }
+        }
+    }
+    (impulse, scale)
 }
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>

@@ -9,7 +9,7 @@
 use nalgebra::{Const, SMatrix, SVector, U1};
 use num_dual::{Derivative, DualSVec64, HyperDualSVec64, HyperHyperDual64};
 
-use crate::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};
+use crate::closed_form::{LagrangianGradient, LagrangianHessian};
 use crate::configuration_space::{ConfigurationSpace, Point};
 use crate::hamiltonian_system::HamiltonianSystem;
 use crate::quadrature::Quadrature;
@@ -315,7 +315,7 @@ pub(crate) fn seeded<F: PhaseFunction<N>, const N: usize>(
         };
     }
     match lagrangian.closed_hessian(q, v) {
-        Some(h) => seeded_from_hessian(&h, x, y, HessianZeros::NONE),
+        Some(h) => seeded_from_hessian(&h, x, y),
         None => seeded_by_duals(lagrangian, q, v, x, y),
     }
 }
@@ -328,84 +328,40 @@ pub(crate) fn seeded_from_hessian<const N: usize>(
     h: &LagrangianHessian<N>,
     x: Seed,
     y: Seed,
-    zeros: HessianZeros<N>,
 ) -> Seeded<N> {
     let g = &h.gradient;
     if ![x.position, x.velocity, y.position, y.velocity].contains(&0.0) {
-        return seeded_without_zero_weights(h, x, y, zeros);
+        return seeded_without_zero_weights(h, x, y);
     }
     let along = |s: Seed| weighted(&g.q, s.position) + weighted(&g.v, s.velocity);
     Seeded {
         value: g.value,
         first: along(x),
         second: along(y),
-        mixed: blocks(h, zeros, x, y, |e, w| if w == 0.0 { 0.0 } else { e * w }),
+        mixed: weighted(&h.qq, x.position * y.position)
+            + weighted(&h.qv, x.position * y.velocity)
+            + weighted(&h.qv.transpose(), x.velocity * y.position)
+            + weighted(&h.vv, x.velocity * y.velocity),
     }
 }
 
 /// [`seeded_from_hessian`] where no weight of `x` and `y` is zero: the plain products.
 #[inline(always)]
-pub(crate) fn seeded_without_zero_weights<const N: usize>(
+fn seeded_without_zero_weights<const N: usize>(
     h: &LagrangianHessian<N>,
     x: Seed,
     y: Seed,
-    zeros: HessianZeros<N>,
 ) -> Seeded<N> {
     let g = &h.gradient;
     Seeded {
         value: g.value,
         first: g.q * x.position + g.v * x.velocity,
         second: g.q * y.position + g.v * y.velocity,
-        mixed: blocks(h, zeros, x, y, |e, w| e * w),
+        mixed: h.qq * (x.position * y.position)
+            + h.qv * (x.position * y.velocity)
+            + h.qv.transpose() * (x.velocity * y.position)
+            + h.vv * (x.velocity * y.velocity),
     }
-}
-
-/// `∂²L/∂q² x_q y_q + ∂²L/∂q∂v x_q y_v + (∂²L/∂q∂v)ᵀ x_v y_q + ∂²L/∂v² x_v y_v`, each product
-/// by `times`, in that order, without the entries `zeros` says vanish.
-#[inline(always)]
-fn blocks<const N: usize>(
-    h: &LagrangianHessian<N>,
-    zeros: HessianZeros<N>,
-    x: Seed,
-    y: Seed,
-    times: impl Fn(f64, f64) -> f64,
-) -> SMatrix<f64, N, N> {
-    let w = [
-        x.position * y.position,
-        x.position * y.velocity,
-        x.velocity * y.position,
-        x.velocity * y.velocity,
-    ];
-    let mixed = h.qv.transpose();
-    if zeros == HessianZeros::NONE {
-        // The plain sum (the flags are constants: the other branch is not compiled in).
-        return h.qq.map(|e| times(e, w[0]))
-            + h.qv.map(|e| times(e, w[1]))
-            + mixed.map(|e| times(e, w[2]))
-            + h.vv.map(|e| times(e, w[3]));
-    }
-    let mut sum = SMatrix::zeros();
-    for i in 0..N {
-        for j in 0..N {
-            let terms = [
-                (zeros.qq[i][j], h.qq[(i, j)], w[0]),
-                (zeros.qv[i][j], h.qv[(i, j)], w[1]),
-                (zeros.qv[j][i], mixed[(i, j)], w[2]),
-                (zeros.vv[i][j], h.vv[(i, j)], w[3]),
-            ];
-            let mut entry: Option<f64> = None;
-            for (zero, x, weight) in terms {
-                if !zero {
-                    let term = times(x, weight);
-                    entry = Some(entry.map_or(term, |s| s + term));
-                }
-            }
-            if let Some(entry) = entry {
-                sum[(i, j)] = entry;
-            }
-        }
-    }
-    sum
 }
 
 /// `w · m`, or zeros when `w` is zero (whatever `m` holds).

@@ -15,11 +15,11 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
-use crate::closed_form::{HessianZeros, LagrangianHessian};
+use crate::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};
 use crate::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors, Tangent};
 use crate::derivatives::{
     InChart, PhaseFunction, Seed, directional_gradient, gradients, hessian, moving_row, seeded,
-    seeded_from_hessian, seeded_without_zero_weights, third_derivative,
+    third_derivative,
 };
 use crate::error::DiracError;
 use crate::manifold::Vectors;
@@ -97,6 +97,83 @@ struct NodeSums<const N: usize> {
     end: SVector<f64, N>,
     magnitude: SVector<f64, N>,
     closed_gradient: bool,
+}
+
+/// The sums of a degree-1 step assembled from the Lagrangian's closed forms (see
+/// [`DiscreteLagrangian::pair_in_closed_form`]), node by node: rows `0..N` of the residual, the
+/// slot covectors and the size of the terms (the Jacobian's block, where one is asked for, is
+/// added with them).
+struct PairSums<'a, const N: usize> {
+    residual: &'a mut [f64],
+    impulse: &'a mut SVector<f64, N>,
+    end: &'a mut SVector<f64, N>,
+    magnitude: &'a mut SVector<f64, N>,
+}
+
+impl<const N: usize> PairSums<'_, N> {
+    /// Adds the node of weight `w`, basis `a` and rates `d` from `L`'s closed-form gradient
+    /// there (no Jacobian).
+    #[inline(always)]
+    fn add_gradient(
+        &mut self,
+        g: &LagrangianGradient<N>,
+        (w, [a0, a1], [d0, d1]): (f64, [f64; 2], [f64; 2]),
+    ) {
+        for i in 0..N {
+            let first = g.q[i] * a0 + g.v[i] * d0;
+            self.residual[i] += first * w;
+            self.impulse[i] += g.q[i] * w;
+            self.end[i] += (g.q[i] * a1 + g.v[i] * d1) * w;
+            self.magnitude[i] += first.abs() * w;
+        }
+    }
+
+    /// Adds the node from `L`'s closed-form Hessian there, each product by `times`, and its
+    /// part of the block of `ξ` to `jacobian` (`n × n` by columns, `n` the residual's length):
+    /// `Σ` of the Hessian's blocks' entries by the products of the seeds `(a_0, d_0)` and
+    /// `(a_1, d_1)`, the entries `zeros` says vanish left out.
+    #[inline(always)]
+    fn add_hessian(
+        &mut self,
+        hessian: &LagrangianHessian<N>,
+        zeros: HessianZeros<N>,
+        (w, [a0, a1], [d0, d1]): (f64, [f64; 2], [f64; 2]),
+        jacobian: &mut [f64],
+        times: impl Fn(f64, f64) -> f64,
+    ) {
+        let n = self.residual.len();
+        let g = &hessian.gradient;
+        let c = [a0 * a1, a0 * d1, d0 * a1, d0 * d1];
+        for j in 0..N {
+            for i in 0..N {
+                if zeros != HessianZeros::NONE && zeros.vanishes(i, j) {
+                    continue;
+                }
+                let terms = [
+                    (zeros.qq[i][j], hessian.qq[(i, j)], c[0]),
+                    (zeros.qv[i][j], hessian.qv[(i, j)], c[1]),
+                    (zeros.qv[j][i], hessian.qv[(j, i)], c[2]),
+                    (zeros.vv[i][j], hessian.vv[(i, j)], c[3]),
+                ];
+                let mut entry: Option<f64> = None;
+                for (zero, x, c) in terms {
+                    if !zero {
+                        let term = times(x, c);
+                        entry = Some(entry.map_or(term, |e| e + term));
+                    }
+                }
+                jacobian[j * n + i] += entry.unwrap_or(0.0) * w;
+            }
+        }
+        for i in 0..N {
+            let first = times(g.q[i], a0) + times(g.v[i], d0);
+            let second = times(g.q[i], a1) + times(g.v[i], d1);
+            self.residual[i] += first * w;
+            self.impulse[i] += (first + second) * w;
+            self.end[i] += second * w;
+            self.magnitude[i] += first.abs() * w;
+        }
+    }
 }
 
 impl<S: DiracSystem<N>, const N: usize> DiscreteLagrangian<S, N> {
@@ -321,8 +398,14 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         }
         let s = self.quadrature.degree();
         if s == 1
-            && let Some((covectors, magnitude)) =
-                self.pair_in_closed_form(base, &increments[0], momentum, residual, &mut jacobian)
+            && let Some((covectors, magnitude)) = self.pair_in_closed_form(
+                base,
+                &increments[0],
+                momentum,
+                residual.as_mut_slice(),
+                jacobian.as_deref_mut().map(|j| j.as_mut_slice()),
+                false,
+            )
         {
             residual.as_mut_slice()[N..].fill(0.0);
             return (Some(covectors), magnitude);
@@ -465,91 +548,78 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         }
     }
 
+    /// Whether the rule has a single node (the midpoint rule among the degree-1 rules).
+    pub(crate) fn one_node(&self) -> bool {
+        self.nodes.len() == 1
+    }
+
     /// [`euler_lagrange`](Self::euler_lagrange) of a degree-1 step (one pair of slots, `ξ` the
     /// end point's increment) from the Lagrangian's closed-form derivatives: the same sums in
     /// the same order as the general path, without its loops over the step's points: the slot
-    /// covectors and the size of the residual's terms. Writes rows `0..N` alone: the rows after
-    /// them are the caller's to write. `None`, with nothing written, where the model has no
-    /// closed forms.
+    /// covectors and the size of the residual's terms. Writes rows `0..N` of `residual` alone
+    /// (the rows after them are the caller's to write) and, where a Jacobian is asked for (by
+    /// columns, `n × n` for `n = residual.len()`), adds the block of `ξ` over the entries of the
+    /// Hessian that do not vanish. On slices: their own indices, without a check each. With
+    /// `one_node` (the rule has one node) the node's code is seen whole. `None`, with nothing
+    /// written, where the model has no closed forms.
     #[inline(always)]
     pub(crate) fn pair_in_closed_form(
         &self,
         base: &Point<C, N, f64>,
         xi: &SVector<f64, N>,
         momentum: &SVector<f64, N>,
-        residual: &mut DVector<f64>,
-        jacobian: &mut Option<&mut DMatrix<f64>>,
+        residual: &mut [f64],
+        jacobian: Option<&mut [f64]>,
+        one_node: bool,
     ) -> Option<(StepCovectors<N>, f64)> {
         debug_assert_eq!(
             self.quadrature.degree(),
             1,
             "a pair of slots is a degree-1 step"
         );
+        // Cut to one node, the loop over the nodes has a known length, and the compiler sees
+        // the node's code whole.
+        let nodes = match one_node {
+            true => self.nodes.get(..1)?,
+            false => self.nodes.as_slice(),
+        };
         let chart = self.in_chart(base);
-        let mut row = *momentum;
-        let mut magnitude = momentum.abs();
-        let mut impulse = SVector::zeros();
-        let mut end = SVector::zeros();
-        let mut block = SMatrix::<f64, N, N>::zeros();
         // On a translation chart the chart's Hessian is the model's, its zero entries too.
         let zeros = match C::TRANSLATION {
             true => S::LAGRANGIAN_HESSIAN_ZEROS,
             false => HessianZeros::NONE,
         };
+        residual[..N].copy_from_slice(momentum.as_slice());
+        let (mut magnitude, mut impulse, mut end) =
+            (momentum.abs(), SVector::zeros(), SVector::zeros());
+        let mut sums = PairSums {
+            residual,
+            impulse: &mut impulse,
+            end: &mut end,
+            magnitude: &mut magnitude,
+        };
         // One loop for each case: within one loop body the compiler hoists what the gradient and
         // the Hessian share (a `sin`) above the branch and leaves its partner (the `cos`) below,
         // where the two can no longer be one `sincos` call.
-        if jacobian.is_some() {
-            for node in &self.nodes {
-                let (w, [a0, a1], [d0, d1]) = node.pair();
-                let plain = node.pair_without_zeros;
-                let (node, rate) = (xi * a1, xi * d1);
-                // As the general path's `seeded` along the directions of ξ_0 and ξ_1.
-                let (x, y) = (
-                    Seed {
-                        position: a0,
-                        velocity: d0,
-                    },
-                    Seed {
-                        position: a1,
-                        velocity: d1,
-                    },
-                );
-                let hessian = chart.closed_hessian(&node, &rate)?;
-                let l = if plain {
-                    seeded_without_zero_weights(&hessian, x, y, zeros)
+        if let Some(jacobian) = jacobian {
+            for node in nodes {
+                let (_, [_, a1], [_, d1]) = node.pair();
+                let hessian = chart.closed_hessian(&(xi * a1), &(xi * d1))?;
+                // As the general path's `seeded` along the directions of ξ_0 and ξ_1: where a
+                // weight is zero its terms are left out, not multiplied by zero.
+                if node.pair_without_zeros {
+                    sums.add_hessian(&hessian, zeros, node.pair(), jacobian, |x, c| x * c);
                 } else {
-                    seeded_from_hessian(&hessian, x, y, zeros)
-                };
-                if zeros == HessianZeros::NONE {
-                    block += l.mixed * w;
-                } else {
-                    zeros.for_each_live(|i, j| block[(i, j)] += l.mixed[(i, j)] * w);
+                    sums.add_hessian(&hessian, zeros, node.pair(), jacobian, |x, c| {
+                        if c == 0.0 { 0.0 } else { x * c }
+                    });
                 }
-                row += l.first * w;
-                impulse += (l.first + l.second) * w;
-                end += l.second * w;
-                magnitude += l.first.abs() * w;
             }
         } else {
-            for node in &self.nodes {
-                let (w, [a0, a1], [d0, d1]) = node.pair();
-                let (node, rate) = (xi * a1, xi * d1);
-                let g = chart.closed_gradient(&node, &rate)?;
-                let first = g.q * a0 + g.v * d0;
-                row += first * w;
-                impulse += g.q * w;
-                end += (g.q * a1 + g.v * d1) * w;
-                magnitude += first.abs() * w;
-            }
-        }
-        residual.fixed_rows_mut::<N>(0).copy_from(&row);
-        if let Some(jacobian) = jacobian.as_deref_mut() {
-            let mut target = jacobian.fixed_view_mut::<N, N>(0, 0);
-            if zeros == HessianZeros::NONE {
-                target += block;
-            } else {
-                zeros.for_each_live(|i, j| target[(i, j)] += block[(i, j)]);
+            for node in nodes {
+                let (_, [_, a1], [_, d1]) = node.pair();
+                let gradient = chart.closed_gradient(&(xi * a1), &(xi * d1))?;
+                sums.add_gradient(&gradient, node.pair());
             }
         }
         Some((StepCovectors { impulse, end }, magnitude.amax()))

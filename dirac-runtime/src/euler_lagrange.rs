@@ -821,6 +821,61 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         )
     }
 
+    /// The rows of a degree-1 step without holonomic rows or a coupling, its one-forms (if
+    /// any) in closed form: the pair of slots and the one-forms straight from the closed forms
+    /// into the buffers (the Jacobian by columns). `None`, with nothing written, where the
+    /// Lagrangian has no closed forms.
+    #[inline(always)]
+    fn direct_rows(
+        &mut self,
+        state: &State<N>,
+        xi: &SVector<f64, N>,
+        x: &DVector<f64>,
+        residual: &mut [f64],
+        jacobian: Option<&mut [f64]>,
+    ) -> Option<f64> {
+        // The unknowns are the end point's increment and the multipliers. Cut to their number,
+        // a constant here, the buffers' lengths are known below, and so is every index.
+        let n = N + S::ONE_FORMS;
+        let x = x.as_slice();
+        if x.len() != n
+            || residual.len() != n
+            || jacobian.as_ref().is_some_and(|j| j.len() != n * n)
+        {
+            return None;
+        }
+        let (x, residual) = (&x[..n], &mut residual[..n]);
+        let mut jacobian = jacobian.map(|j| &mut j[..n * n]);
+        let discrete = &self.discrete;
+        let (mut covectors, mut scale) = discrete.pair_in_closed_form(
+            &state.q,
+            xi,
+            &self.momentum,
+            residual,
+            jacobian.as_deref_mut(),
+            true,
+        )?;
+        if S::ONE_FORMS > 0 {
+            let (impulse, size) = constraint::closed_one_forms(
+                discrete.system(),
+                discrete.space(),
+                &state.q,
+                self.point,
+                x,
+                residual,
+                jacobian,
+            );
+            covectors += StepCovectors {
+                impulse,
+                end: impulse * (1.0 - self.point.share()),
+            };
+            scale = scale.max(size);
+        }
+        self.covectors = covectors;
+        self.covectors_pending = false;
+        Some(scale)
+    }
+
     /// [`StepEquations::assemble`] with `scratch` (`n × n`) taking the Jacobian of the rows
     /// beyond the discrete Euler–Lagrange ones when none is asked for. Kept out of line: inlined,
     /// it made Newton's evaluation larger for the degree-1 path too (the knife edge took 56
@@ -834,6 +889,24 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         mut jacobian: Option<&mut DMatrix<f64>>,
         scratch: &mut DMatrix<f64>,
     ) -> f64 {
+        if self.closed_pair {
+            // The end point's increment leads the unknowns of a degree-1 step; the constraint
+            // rows write every row after it (there are no others without a projection).
+            debug_assert_eq!(x.len(), N + S::ONE_FORMS + S::HOLONOMIC);
+            let xi = self.increments[0];
+            if let Some((covectors, scale)) = self.discrete.pair_in_closed_form(
+                &state.q,
+                &xi,
+                &self.momentum,
+                residual.as_mut_slice(),
+                jacobian.as_deref_mut().map(|j| j.as_mut_slice()),
+                false,
+            ) {
+                self.covectors_pending = false;
+                return self
+                    .add_constraints_and_coupling(state, x, residual, jacobian, covectors, scale);
+            }
+        }
         let discrete = &self.discrete;
         if self.projected() || self.first_order() {
             // First-order (collocated) steps take their rows' derivatives together.
@@ -1186,22 +1259,28 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         residual: &mut DVector<f64>,
         mut jacobian: Option<&mut DMatrix<f64>>,
     ) -> f64 {
-        if self.closed_pair {
-            // The end point's increment leads the unknowns of a degree-1 step; the constraint
-            // rows write every row after it (there are no others without a projection).
-            debug_assert_eq!(x.len(), N + S::ONE_FORMS + S::HOLONOMIC);
+        // A degree-1 step with closed forms on a one-node rule, without holonomic rows or a
+        // coupling, and with the one-forms (if any) in closed form: the rows go straight from
+        // the closed forms into the buffers. Inlined into Newton's evaluation; every other
+        // step is assembled out of line (`assemble_into`).
+        let direct = S::HOLONOMIC == 0
+            && (S::ONE_FORMS == 0 || (C::TRANSLATION && S::ONE_FORM_DERIVATIVES))
+            && self.closed_pair
+            && self.coupling.is_none()
+            && self.discrete.one_node();
+        if direct {
             let xi = x.fixed_rows::<N>(0).into_owned();
             self.increments[0] = xi;
-            if let Some((covectors, scale)) = self.discrete.pair_in_closed_form(
-                &state.q,
-                &xi,
-                &self.momentum,
-                residual,
-                &mut jacobian,
-            ) {
-                self.covectors_pending = false;
-                return self
-                    .add_constraints_and_coupling(state, x, residual, jacobian, covectors, scale);
+            let rows = residual.as_mut_slice();
+            // Two calls, each with its case known: one code for each (see `closed_one_forms`).
+            let scale = match jacobian.as_deref_mut() {
+                Some(jacobian) => {
+                    self.direct_rows(state, &xi, x, rows, Some(jacobian.as_mut_slice()))
+                }
+                None => self.direct_rows(state, &xi, x, rows, None),
+            };
+            if let Some(scale) = scale {
+                return scale;
             }
         }
         for (j, z) in self.increments.iter_mut().enumerate() {
