@@ -337,22 +337,78 @@ struct Separable;
 #[derive(Debug, Clone, Copy)]
 struct Skew;
 
+/// A model written by hand whose closed forms stop at `x > 0.5` (dual numbers take over there):
+/// a step of the trapezoid rule from `x = 0.4` has them at its first node and not at its second.
+#[derive(Debug, Clone, Copy)]
+struct Partial;
+
+impl DiracSystem<3> for Partial {
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+        v.dot(v) * 0.5 + q[0].cos() - q[1] * q[1] * q[2]
+    }
+
+    fn lagrangian_gradient(
+        &self,
+        q: &SVector<f64, 3>,
+        v: &SVector<f64, 3>,
+    ) -> Option<dirac::LagrangianGradient<3>> {
+        (q[0] <= 0.5).then(|| dirac::LagrangianGradient {
+            value: self.lagrangian(q, v),
+            q: SVector::from([-q[0].sin(), -2.0 * q[1] * q[2], -q[1] * q[1]]),
+            v: *v,
+        })
+    }
+
+    fn lagrangian_hessian(
+        &self,
+        q: &SVector<f64, 3>,
+        v: &SVector<f64, 3>,
+    ) -> Option<dirac::LagrangianHessian<3>> {
+        let gradient = self.lagrangian_gradient(q, v)?;
+        let qq = dirac::nalgebra::Matrix3::new(
+            -q[0].cos(),
+            0.0,
+            0.0,
+            0.0,
+            -2.0 * q[2],
+            -2.0 * q[1],
+            0.0,
+            -2.0 * q[1],
+            0.0,
+        );
+        Some(dirac::LagrangianHessian {
+            gradient,
+            qq,
+            qv: dirac::nalgebra::Matrix3::zeros(),
+            vv: dirac::nalgebra::Matrix3::identity(),
+        })
+    }
+}
+
 /// The Jacobian the assembly adds is the derivative of its residual: against central
 /// differences, off the solution with multipliers that are not zero, at each constraint point,
-/// for a one-form in closed form (with a Lagrangian whose `∂²L/∂q²` and `∂²L/∂q∂v` vanish), for
-/// one beside a holonomic constraint, for a separable Lagrangian and for one whose `∂²L/∂q∂v`
-/// has a single entry off its diagonal.
+/// under the midpoint and trapezoid rules, for a one-form in closed form (with a Lagrangian whose
+/// `∂²L/∂q²` and `∂²L/∂q∂v` vanish), for
+/// one beside a holonomic constraint, for a separable Lagrangian, for one whose `∂²L/∂q∂v`
+/// has a single entry off its diagonal, and for closed forms that stop within a step.
 #[test]
 fn the_jacobian_is_the_residuals_derivative() {
     use dirac::euler_lagrange::EulerLagrange;
     fn check<S: DiracSystem<3> + Copy>(system: S, q: SVector<f64, 3>, v: SVector<f64, 3>) {
         let state = State::new(0.0, q, v, v);
-        for point in [
+        // The midpoint rule (one node: the rows straight into the buffers where they can) and
+        // the trapezoid rule (two nodes, zero weights among their seeds: out of line).
+        let rules = [Quadrature::midpoint(), Quadrature::trapezoid()];
+        let points = [
             ConstraintPoint::Start,
             ConstraintPoint::Midpoint,
             ConstraintPoint::End,
-        ] {
-            let discrete = DiscreteLagrangian::new(system, Quadrature::midpoint(), 0.05);
+        ];
+        for (rule, point) in rules
+            .iter()
+            .flat_map(|rule| points.iter().map(move |point| (rule, *point)))
+        {
+            let discrete = DiscreteLagrangian::new(system, rule.clone(), 0.05);
             let mut equations = EulerLagrange::new(discrete).unwrap();
             equations.set_constraint_point(point);
             equations.begin(&state);
@@ -368,7 +424,7 @@ fn the_jacobian_is_the_residuals_derivative() {
             // The residual is the same function with a Jacobian and without, bit for bit.
             let mut plain = DVector::zeros(n);
             equations.assemble(&state, &x, &mut plain, None);
-            assert_eq!(residual, plain, "{point:?}");
+            assert_eq!(residual, plain, "{} {point:?}", rule.name());
             let delta = 1e-6;
             let mut differenced = DMatrix::zeros(n, n);
             for j in 0..n {
@@ -383,7 +439,8 @@ fn the_jacobian_is_the_residuals_derivative() {
             let error = (&jacobian - &differenced).amax();
             assert!(
                 error <= 1e-6 * (1.0 + differenced.amax()),
-                "{point:?}: {jacobian} against {differenced} (error {error:e})"
+                "{} {point:?}: {jacobian} against {differenced} (error {error:e})",
+                rule.name()
             );
         }
     }
@@ -399,6 +456,7 @@ fn the_jacobian_is_the_residuals_derivative() {
     );
     check(Separable, vector![0.6, -0.3, 0.8], vector![0.2, 1.0, -0.4]);
     check(Skew, vector![0.6, -0.3, 0.8], vector![0.2, 1.0, -0.4]);
+    check(Partial, vector![0.4, -0.3, 0.8], vector![3.0, 1.0, -0.4]);
     // The step skipped the Hessian's products it was told vanish: they did.
     let (blade, separable) = (
         Blade::LAGRANGIAN_HESSIAN_ZEROS,

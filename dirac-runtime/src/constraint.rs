@@ -184,9 +184,10 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
 {
     /// The one-forms of a degree-1 step, held at its constraint point `ξ_c = θ ξ_s`: adds
     /// `σ Ã(ξ_c)ᵀμ` to the rows of `p_k`'s equation, writes the rows `Ã(ξ_c) ξ_s`, fills the
-    /// matching Jacobian entries where one is asked for (else the one-forms are read without
-    /// their derivatives), and returns the impulse `Ã(ξ_c)ᵀμ` (its end point's share is
-    /// `1 − σ`) with the size of the rows' terms.
+    /// matching Jacobian entries where one is asked for, and returns the impulse `Ã(ξ_c)ᵀμ` (its
+    /// end point's share is `1 − σ`) with the size of the rows' terms. Closed forms on a
+    /// translation chart go to [`closed_one_forms`]; by dual numbers, the one-forms are read
+    /// without their derivatives where no Jacobian is asked for.
     #[inline(always)]
     pub(crate) fn add_one_forms(
         &self,
@@ -305,15 +306,13 @@ pub(crate) fn closed_one_forms<
         });
         // The chart's row (the model's, on a translation chart).
         let row = space.pull_back(base, &xi_c, &row);
-        let (mut value, mut size) = (0.0, 0.0);
         for i in 0..N {
             impulse[i] += row[i] * mu;
             residual[i] += share * mu * row[i];
-            value += row[i] * step[i];
-            size += row[i].abs() * step[i].abs();
         }
-        residual[col] = value;
-        scale = scale.max(size);
+        // The same sums as the general path's, in its order (nalgebra's `dot`).
+        residual[col] = row.dot(&step);
+        scale = scale.max(row.abs().dot(&step.abs()));
         if let Some(jacobian) = jacobian.as_deref_mut() {
             for i in 0..N {
                 jacobian[col * n + i] += row[i] * share;

@@ -324,11 +324,7 @@ pub(crate) fn seeded<F: PhaseFunction<N>, const N: usize>(
 /// not multiplied by zero (see [`seeded`]); where no weight is zero, as at every interior node
 /// of a step, the products are plain, without the selects that leaving terms out costs.
 #[inline(always)]
-pub(crate) fn seeded_from_hessian<const N: usize>(
-    h: &LagrangianHessian<N>,
-    x: Seed,
-    y: Seed,
-) -> Seeded<N> {
+fn seeded_from_hessian<const N: usize>(h: &LagrangianHessian<N>, x: Seed, y: Seed) -> Seeded<N> {
     let g = &h.gradient;
     if ![x.position, x.velocity, y.position, y.velocity].contains(&0.0) {
         return seeded_without_zero_weights(h, x, y);

@@ -104,7 +104,7 @@ struct NodeSums<const N: usize> {
 /// slot covectors and the size of the terms (the Jacobian's block, where one is asked for, is
 /// added with them).
 struct PairSums<'a, const N: usize> {
-    residual: &'a mut [f64],
+    row: &'a mut SVector<f64, N>,
     impulse: &'a mut SVector<f64, N>,
     end: &'a mut SVector<f64, N>,
     magnitude: &'a mut SVector<f64, N>,
@@ -121,7 +121,7 @@ impl<const N: usize> PairSums<'_, N> {
     ) {
         for i in 0..N {
             let first = g.q[i] * a0 + g.v[i] * d0;
-            self.residual[i] += first * w;
+            self.row[i] += first * w;
             self.impulse[i] += g.q[i] * w;
             self.end[i] += (g.q[i] * a1 + g.v[i] * d1) * w;
             self.magnitude[i] += first.abs() * w;
@@ -129,19 +129,19 @@ impl<const N: usize> PairSums<'_, N> {
     }
 
     /// Adds the node from `L`'s closed-form Hessian there, each product by `times`, and its
-    /// part of the block of `ξ` to `jacobian` (`n × n` by columns, `n` the residual's length):
-    /// `Σ` of the Hessian's blocks' entries by the products of the seeds `(a_0, d_0)` and
-    /// `(a_1, d_1)`, the entries `zeros` says vanish left out.
+    /// part of the block of `ξ` to `block` (by columns of `stride`): `Σ` of the Hessian's
+    /// blocks' entries by the products of the seeds `(a_0, d_0)` and `(a_1, d_1)`, the entries
+    /// `zeros` says vanish left out.
     #[inline(always)]
     fn add_hessian(
         &mut self,
         hessian: &LagrangianHessian<N>,
         zeros: HessianZeros<N>,
         (w, [a0, a1], [d0, d1]): (f64, [f64; 2], [f64; 2]),
-        jacobian: &mut [f64],
+        block: &mut [f64],
+        stride: usize,
         times: impl Fn(f64, f64) -> f64,
     ) {
-        let n = self.residual.len();
         let g = &hessian.gradient;
         let c = [a0 * a1, a0 * d1, d0 * a1, d0 * d1];
         for j in 0..N {
@@ -162,13 +162,13 @@ impl<const N: usize> PairSums<'_, N> {
                         entry = Some(entry.map_or(term, |e| e + term));
                     }
                 }
-                jacobian[j * n + i] += entry.unwrap_or(0.0) * w;
+                block[j * stride + i] += entry.unwrap_or(0.0) * w;
             }
         }
         for i in 0..N {
             let first = times(g.q[i], a0) + times(g.v[i], d0);
             let second = times(g.q[i], a1) + times(g.v[i], d1);
-            self.residual[i] += first * w;
+            self.row[i] += first * w;
             self.impulse[i] += (first + second) * w;
             self.end[i] += second * w;
             self.magnitude[i] += first.abs() * w;
@@ -579,6 +579,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         );
         // Cut to one node, the loop over the nodes has a known length, and the compiler sees
         // the node's code whole.
+        debug_assert!(!one_node || self.nodes.len() == 1);
         let nodes = match one_node {
             true => self.nodes.get(..1)?,
             false => self.nodes.as_slice(),
@@ -589,11 +590,16 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             true => S::LAGRANGIAN_HESSIAN_ZEROS,
             false => HessianZeros::NONE,
         };
-        residual[..N].copy_from_slice(momentum.as_slice());
-        let (mut magnitude, mut impulse, mut end) =
-            (momentum.abs(), SVector::zeros(), SVector::zeros());
+        let n = residual.len();
+        debug_assert!(jacobian.as_ref().is_none_or(|j| j.len() == n * n));
+        let (mut row, mut magnitude, mut impulse, mut end) = (
+            *momentum,
+            momentum.abs(),
+            SVector::zeros(),
+            SVector::zeros(),
+        );
         let mut sums = PairSums {
-            residual,
+            row: &mut row,
             impulse: &mut impulse,
             end: &mut end,
             magnitude: &mut magnitude,
@@ -602,17 +608,31 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         // the Hessian share (a `sin`) above the branch and leaves its partner (the `cos`) below,
         // where the two can no longer be one `sincos` call.
         if let Some(jacobian) = jacobian {
+            // Nothing is written before every node has its closed forms: the block of a rule of
+            // several nodes is summed aside (by columns of `N`) and added after them.
+            let mut block = SMatrix::<f64, N, N>::zeros();
+            let (target, stride) = match one_node {
+                true => (&mut *jacobian, n),
+                false => (block.as_mut_slice(), N),
+            };
             for node in nodes {
                 let (_, [_, a1], [_, d1]) = node.pair();
                 let hessian = chart.closed_hessian(&(xi * a1), &(xi * d1))?;
                 // As the general path's `seeded` along the directions of ξ_0 and ξ_1: where a
                 // weight is zero its terms are left out, not multiplied by zero.
                 if node.pair_without_zeros {
-                    sums.add_hessian(&hessian, zeros, node.pair(), jacobian, |x, c| x * c);
+                    sums.add_hessian(&hessian, zeros, node.pair(), target, stride, |x, c| x * c);
                 } else {
-                    sums.add_hessian(&hessian, zeros, node.pair(), jacobian, |x, c| {
+                    sums.add_hessian(&hessian, zeros, node.pair(), target, stride, |x, c| {
                         if c == 0.0 { 0.0 } else { x * c }
                     });
+                }
+            }
+            if !one_node {
+                for j in 0..N {
+                    for i in 0..N {
+                        jacobian[j * n + i] += block[(i, j)];
+                    }
                 }
             }
         } else {
@@ -622,6 +642,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                 sums.add_gradient(&gradient, node.pair());
             }
         }
+        residual[..N].copy_from_slice(row.as_slice());
         Some((StepCovectors { impulse, end }, magnitude.amax()))
     }
 
