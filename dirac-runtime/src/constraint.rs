@@ -193,7 +193,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         &self,
         x: &DVector<f64>,
         residual: &mut DVector<f64>,
-        mut jacobian: Option<&mut DMatrix<f64>>,
+        jacobian: Option<&mut DMatrix<f64>>,
     ) -> (SVector<f64, N>, f64) {
         let Self {
             system,
@@ -218,43 +218,46 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                 jacobian.map(|j| j.as_mut_slice()),
             );
         }
-        let step_col = layout.end_point();
-        let step = x.fixed_rows::<N>(step_col).into_owned();
+        // A degree-1 step: the end point's increment leads the unknowns, the multipliers follow.
+        debug_assert!(layout.end_point() == 0 && layout.one_form(0) == N);
+        let (x, residual) = (x.as_slice(), residual.as_mut_slice());
+        let mut jacobian = jacobian.map(|j| j.as_mut_slice());
+        let n = x.len();
+        let step = SVector::<f64, N>::from_fn(|i, _| x[i]);
         let (theta, share) = (point.theta(), point.share());
         let mut impulse = SVector::<f64, N>::zeros();
         let mut scale = 0.0_f64;
         let xi_c = step * theta;
         for a in 0..S::ONE_FORMS {
-            let col = layout.one_form(a);
-            let mu = x[col];
             let (row, derivative) = if jacobian.is_some() {
                 one_form_in_chart(system, space, base, &xi_c, a)
             } else {
                 (one_form_value_in_chart(system, space, base, &xi_c, a), None)
             };
-            impulse += row * mu;
-            for i in 0..N {
-                residual[i] += share * mu * row[i];
-            }
-            // Ã_a(ξ_c) · ξ_s and its derivative in ξ_s (ξ_c moves with ξ_s by θ).
-            residual[col] = row.dot(&step);
-            scale = scale.max(row.abs().dot(&step.abs()));
-            let Some(jacobian) = jacobian.as_deref_mut() else {
-                continue;
-            };
-            let mut force = jacobian.fixed_view_mut::<N, 1>(0, col);
-            force += row * share;
-            let turning = match derivative {
-                None => row,
-                Some(derivative) => {
-                    let mut block = jacobian.fixed_view_mut::<N, N>(0, step_col);
-                    block += derivative * (share * theta * mu);
-                    row + derivative.transpose() * step * theta
+            let mu = x[N + a];
+            let turning = jacobian.as_deref_mut().map(|jacobian| {
+                let Some(derivative) = derivative else {
+                    return (jacobian, row);
+                };
+                let weight = share * theta * mu;
+                for j in 0..N {
+                    for i in 0..N {
+                        jacobian[j * n + i] += derivative[(i, j)] * weight;
+                    }
                 }
-            };
-            jacobian
-                .fixed_view_mut::<1, N>(col, step_col)
-                .copy_from(&turning.transpose());
+                (jacobian, row + derivative.transpose() * step * theta)
+            });
+            let size = add_one_form_row(
+                &row,
+                &step,
+                mu,
+                share,
+                N + a,
+                residual,
+                &mut impulse,
+                turning,
+            );
+            scale = scale.max(size);
         }
         (impulse, scale)
     }
@@ -306,21 +309,46 @@ pub(crate) fn closed_one_forms<
         });
         // The chart's row (the model's, on a translation chart).
         let row = space.pull_back(base, &xi_c, &row);
-        for i in 0..N {
-            impulse[i] += row[i] * mu;
-            residual[i] += share * mu * row[i];
-        }
-        // The same sums as the general path's, in its order (nalgebra's `dot`).
-        residual[col] = row.dot(&step);
-        scale = scale.max(row.abs().dot(&step.abs()));
-        if let Some(jacobian) = jacobian.as_deref_mut() {
-            for i in 0..N {
-                jacobian[col * n + i] += row[i] * share;
-                jacobian[i * n + col] = row[i] + sum[i] * theta;
-            }
-        }
+        // `∂(A ξ_s)/∂ξ_s = A + θ ξ_sᵀ ∂A`, over the closed form's entries.
+        let turning = jacobian.as_deref_mut().map(|j| (j, row + sum * theta));
+        let size = add_one_form_row(&row, &step, mu, share, col, residual, &mut impulse, turning);
+        scale = scale.max(size);
     }
     (impulse, scale)
+}
+
+/// One-form row `row` (in the chart, at the constraint point) of a degree-1 step whose end
+/// point's increment `step` leads the unknowns, its multiplier `μ` in column `col`: adds `σ μ row`
+/// to the rows `0..N` and `μ row` to `impulse`, writes the constraint row `row · ξ_s`, and where a
+/// Jacobian is given (`n × n` by columns, `n = residual.len()`) adds `σ row` to the column of `μ`
+/// and writes the constraint row's derivative in `ξ_s`, `turning`, into row `col`. Returns the
+/// size of the row's terms.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn add_one_form_row<const N: usize>(
+    row: &SVector<f64, N>,
+    step: &SVector<f64, N>,
+    mu: f64,
+    share: f64,
+    col: usize,
+    residual: &mut [f64],
+    impulse: &mut SVector<f64, N>,
+    turning: Option<(&mut [f64], SVector<f64, N>)>,
+) -> f64 {
+    let n = residual.len();
+    for i in 0..N {
+        impulse[i] += row[i] * mu;
+        residual[i] += share * mu * row[i];
+    }
+    // The same sums as nalgebra's `dot`, in its order.
+    residual[col] = row.dot(step);
+    if let Some((jacobian, turning)) = turning {
+        for i in 0..N {
+            jacobian[col * n + i] += row[i] * share;
+            jacobian[i * n + col] = turning[i];
+        }
+    }
+    row.abs().dot(&step.abs())
 }
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
