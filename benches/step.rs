@@ -3,9 +3,6 @@
 //! `cargo bench --bench step`. Compare figures within one run only: the ratio generated / hand is
 //! what the README reports.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
-
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -15,7 +12,7 @@ use scenes::hand_written::{Galerkin2, HandStepper, KnifeEdgeMidpoint, Midpoint};
 use scenes::{chain, double_pendulum, knife_edge};
 
 /// One step of the generated steppers against the hand-written ones (analytic derivatives, the
-/// same Newton, the same predictor; `tests/golden.rs` checks they follow the same trajectories),
+/// same Newton, the same predictor; `tests/suite/golden.rs` checks they follow the same trajectories),
 /// h = 0.01: the double pendulum under the midpoint rule and `galerkin(2)`, the knife edge under
 /// the midpoint rule with its one-form at the midpoint.
 fn generated_vs_hand(c: &mut Criterion) {
@@ -286,7 +283,7 @@ fn recording(c: &mut Criterion) {
 /// the generated Lie group variational integrator (midpoint and trapezoid in the Cayley chart)
 /// against Lee, Leok and McClamroch's written by hand (Newton on the Cayley parameter, analytic
 /// derivatives, the same Newton solver). The schemes differ in their discrete Lagrangian but are
-/// both of order 2, with errors within 1 % of each other on this scene (tests/lie_group.rs).
+/// both of order 2, with errors within 1 % of each other on this scene (tests/suite/lie_group.rs).
 fn lie_group(c: &mut Criterion) {
     use scenes::{hand_written_lgvi::HandLgvi, rigid_body};
     let mut group = c.benchmark_group("pendulum_3d_step");

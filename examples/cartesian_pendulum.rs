@@ -1,7 +1,5 @@
 //! The cartesian pendulum scene: `cargo run --release --example cartesian_pendulum`.
 
-mod scenes;
-
 use dirac::Quadrature;
 
 fn main() -> Result<(), dirac::DiracError> {

@@ -1,8 +1,6 @@
 //! The chain scene with every tour quadrature: `cargo run --release --example chain`.
 //! Prints the table and writes one CSV trajectory per quadrature to `output/`.
 
-mod scenes;
-
 fn main() -> Result<(), dirac::DiracError> {
     let reports = scenes::quadratures()
         .into_iter()

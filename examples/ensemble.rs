@@ -4,8 +4,6 @@
 //!
 //! `cargo run --release --example ensemble`
 
-mod scenes;
-
 use std::time::{Duration, Instant};
 
 use dirac::prelude::*;

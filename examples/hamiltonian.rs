@@ -5,8 +5,6 @@
 //! steps), Kepler's angular momentum, the knife edge written with `H` against its closed form,
 //! and `H = p(1 − q²)`, which has no Lagrangian, against its exact flow.
 
-mod scenes;
-
 use dirac::prelude::*;
 use scenes::hamiltonian::{Kepler, KnifeEdge, Lifted, lifted_exact};
 

@@ -1,8 +1,6 @@
 //! The knife edge on an incline with the one-form evaluated at q_k, the midpoint and q_{k+1}:
 //! `cargo run --release --example knife_edge`.
 
-mod scenes;
-
 use dirac::ConstraintPoint;
 
 fn main() -> Result<(), dirac::DiracError> {

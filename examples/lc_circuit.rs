@@ -1,8 +1,6 @@
 //! The seed's LC circuit and its RLC variant: `cargo run --release --example lc_circuit`.
 //! Kirchhoff's laws are constraint one-forms; the capacitor charges have no kinetic energy.
 
-mod scenes;
-
 use dirac::Quadrature;
 
 fn main() -> Result<(), dirac::DiracError> {

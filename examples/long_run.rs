@@ -3,8 +3,6 @@
 //!
 //! `cargo run --release --example long_run`
 
-mod scenes;
-
 use std::time::Instant;
 
 use dirac::prelude::*;

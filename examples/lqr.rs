@@ -2,8 +2,6 @@
 //! upright from a 0.3 rad tilt by feedback through the model's input, simulated by the
 //! variational integrator. `cargo run --release --example lqr` writes `output/cart_pole_lqr.png`.
 
-mod scenes;
-
 use scenes::cart_pole;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

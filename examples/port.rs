@@ -1,7 +1,5 @@
 //! The port scene: `cargo run --release --example port`.
 
-mod scenes;
-
 use dirac::Quadrature;
 
 fn main() -> Result<(), dirac::DiracError> {

@@ -4,8 +4,6 @@
 //! across iterations and steps (simplified Newton):
 //! `cargo run --release --example rigid_body`.
 
-mod scenes;
-
 use dirac::prelude::*;
 use scenes::rigid_body;
 

@@ -2,8 +2,6 @@
 //! one-forms at q_k, the midpoint and q_{k+1}, against its closed form:
 //! `cargo run --release --example rolling_ball`.
 
-mod scenes;
-
 use dirac::ConstraintPoint;
 
 fn main() -> Result<(), dirac::DiracError> {

@@ -4,8 +4,6 @@
 //! and with the solver's tolerances at 1e-15:
 //! `cargo run --release --example spherical_pendulum`.
 
-mod scenes;
-
 use dirac::prelude::*;
 use scenes::spherical_pendulum::{SCENE, SphericalPendulum, start, vertical_momentum};
 

@@ -12,8 +12,6 @@
 //!
 //! `cargo run --release --example tour`
 
-mod scenes;
-
 use dirac::{ConstraintPoint, DiracError, Product, Quadrature};
 use scenes::{Report, circuit, knife_edge, rigid_body, rolling_ball};
 

@@ -63,3 +63,11 @@ pub struct ReadmeDoctests;
 #[doc = include_str!("../docs/guide.md")]
 #[cfg(doctest)]
 pub struct GuideDoctests;
+
+#[doc = include_str!("../docs/syntax.md")]
+#[cfg(doctest)]
+pub struct SyntaxDoctests;
+
+#[doc = include_str!("../docs/mathematics.md")]
+#[cfg(doctest)]
+pub struct MathematicsDoctests;

@@ -2,9 +2,6 @@
 //! pendulum do not grow with `n` (counted by a global allocator that counts the allocations made
 //! on the test's own thread: the test harness's thread may allocate while the test runs).
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
-
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 

@@ -3,7 +3,7 @@
 
 /// Where on a step the constraint one-forms are evaluated.
 ///
-/// Measured on the knife edge (`tests/dirac.rs`): `Start` and `End` are first order, `Midpoint`
+/// Measured on the knife edge (`tests/suite/discrete_dirac.rs`): `Start` and `End` are first order, `Midpoint`
 /// second order. For the same scene `Start` loses energy and `End` gains it, while `Midpoint`
 /// keeps it bounded. Where the one-forms are constant (circuits, interconnections) all three
 /// coincide.

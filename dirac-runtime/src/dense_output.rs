@@ -17,7 +17,7 @@
 //! defects at the ends (zero for an unconstrained regular model), so it passes through `p_k` and
 //! `p_{k+1}`.
 //!
-//! Measured orders (`tests/run.rs`, oscillator, 7 points inside every step): positions 2, 4, 4
+//! Measured orders (`tests/suite/run.rs`, oscillator, 7 points inside every step): positions 2, 4, 4
 //! and velocities and momenta 2, 3, 3 for the midpoint rule, `galerkin(2)` and `galerkin(3)`. The
 //! internal points are accurate to `O(h^{s+1})` only, so inside a step `galerkin(3)` is of order
 //! 4, not 6 (ten times more accurate than `galerkin(2)` at the same step).

@@ -45,7 +45,7 @@
 //! gradient of `q2 sin q1` the error of `galerkin(2)` grows ×9 over the same run and the
 //! midpoint rule's by ×22 until Newton stops contracting. Collocation is therefore the default.
 //!
-//! Two variational alternatives were measured and dropped (`tests/first_order.rs` has the
+//! Two variational alternatives were measured and dropped (`tests/suite/first_order.rs` has the
 //! figures of the kept ones):
 //!
 //! - Keeping the internal points' stationarity and replacing the two end-point rows by their

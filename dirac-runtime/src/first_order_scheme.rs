@@ -5,7 +5,7 @@
 /// keep the momentum on the primary constraint `p = ϑ(q)` at every step and reach order `2s`
 /// with `galerkin(s)` (Gauss rules only); they differ in what they do over long times and in
 /// how they depend on the gauge of `ϑ` (the mathematics and the figures are in the
-/// `first_order` module of this crate and in `tests/first_order.rs`).
+/// `first_order` module of this crate and in `tests/suite/first_order.rs`).
 ///
 /// - `Collocation` collocates the first-order Euler–Lagrange equations at the Gauss nodes. It
 ///   depends on `ϑ` only through the form `dϑ`, so its trajectory is the same in every gauge
@@ -18,7 +18,7 @@
 ///   `ϑ·q̇` well (`ϑ` rational in `q`, as in the usual gauges) the error in `H` stays bounded
 ///   with no drift (the same run: 1.1248e-6 in the first and in the last tenth). It depends on
 ///   the gauge: with `ϑ` changed by the gradient of `q2 sin q1` its orders hold but `H` drifts,
-///   faster than under collocation (measured in `tests/first_order.rs`).
+///   faster than under collocation (measured in `tests/suite/first_order.rs`).
 ///
 /// ```
 /// use dirac_runtime::FirstOrderScheme;

@@ -36,7 +36,7 @@
 //! **When the two routes agree.** Where `∂²H/∂p²` is invertible, the stationarity in `P_i`
 //! is the Legendre transform at the node, and `P_i Q̇_i − H(Q_i, P_i) = L(Q_i, Q̇_i)`: `𝕃`
 //! extremised over the momenta is the Galerkin discrete Lagrangian of the same path and
-//! quadrature, so both routes take the same steps (`tests/hamiltonian.rs` checks it to
+//! quadrature, so both routes take the same steps (`tests/suite/hamiltonian.rs` checks it to
 //! round-off on a non-separable `H`). They differ where there is no Lagrangian: a Hamiltonian
 //! whose `∂²H/∂p²` is singular (`H = p f(q)`, whose steps are the Gauss collocation of
 //! `q̇ = f(q)` with its adjoint) has no Lagrangian route at all.

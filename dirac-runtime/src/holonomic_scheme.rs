@@ -8,7 +8,7 @@
 /// the impulse `dg(q_{k+1})ᵀν` for which the velocity of `p_{k+1}` is tangent,
 /// `dg(q_{k+1}) v_{k+1} = 0`, so that the state lies on the constraint's cotangent bundle and
 /// `g = 0`, `dg v = 0` hold to round-off at every step. Measured on the Cartesian pendulum in
-/// `tests/constrained.rs`. The velocity a stepper reports ([`Stepper::v`](crate::Stepper::v))
+/// `tests/suite/constrained.rs`. The velocity a stepper reports ([`Stepper::v`](crate::Stepper::v))
 /// is tangent under both, and so is the energy computed from it: the schemes differ in the
 /// momentum they store, and only `Shake` has derivatives of its step map
 /// ([`Stepper::step_linearised`](crate::Stepper::step_linearised)).

@@ -22,7 +22,7 @@
 //! point `Midpoint` (the impulse split `σ = ½`) and components whose Lagrangians are quadratic
 //! and who have no holonomic constraints, each component's energy then changes over the step by
 //! exactly its port work plus its own forces' work: `E_A(k+1) − E_A(k) = W_A` for a
-//! conservative component (`tests/interconnection.rs` checks both to round-off). For a
+//! conservative component (`tests/suite/interconnection.rs` checks both to round-off). For a
 //! nonlinear component the balance holds to the method's order.
 //!
 //! ```

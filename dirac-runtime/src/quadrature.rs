@@ -10,7 +10,7 @@
 //!
 //! The midpoint rule is degree 1 with the 1-point Gauss–Legendre rule, the trapezoid rule degree 1
 //! with the 2-point Gauss–Lobatto rule. Measured orders are in the README and asserted in
-//! `tests/convergence.rs`.
+//! `tests/suite/convergence.rs`.
 
 use nalgebra::SVector;
 

@@ -96,7 +96,7 @@ impl<const N: usize, M: Manifold<N>> State<N, M> {
 /// Implemented by [`EulerLagrange`](crate::euler_lagrange::EulerLagrange); a
 /// [`Stepper`](crate::Stepper) drives any implementation ([`Stepper::with_equations`]) with the
 /// same Newton solve, error handling, trajectories and guarantees (a failed step changes
-/// nothing). `tests/step_equations.rs` drives the implicit midpoint rule of a Hamiltonian this
+/// nothing). `tests/suite/step_equations.rs` drives the implicit midpoint rule of a Hamiltonian this
 /// way. The guarantee holds as long as `predict` and `assemble` keep only per-step scratch in
 /// `&mut self`: anything that must survive a step belongs in the [`State`].
 ///

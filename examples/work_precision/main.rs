@@ -14,9 +14,6 @@
 //!
 //! `cargo run --release --example work_precision` (16 minutes here; `-- 10` runs T = 10 only)
 
-#[path = "../scenes/mod.rs"]
-mod scenes;
-
 use std::fmt::Write as _;
 
 use dirac::prelude::*;

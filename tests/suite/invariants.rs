@@ -1,10 +1,8 @@
 //! Long-run invariants: bounded energy error without drift and discrete Noether conservation of
 //! angular momentum. Symplecticity of the step map is checked exactly, on the step's own
-//! derivatives, in `tests/step_derivatives.rs`.
+//! derivatives, in `tests/suite/step_derivatives.rs`.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
-mod support;
+use crate::support;
 
 use dirac::prelude::*;
 use scenes::{kepler, pendulum};

@@ -2,9 +2,7 @@
 //! differences (δ = 1e-5, as trep checks its derivatives) of the step itself, and the structure
 //! they must have: `AᵀJA = J` for conservative models, `det A = 1` for one degree of freedom.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
-mod support;
+use crate::support;
 
 use dirac::euler_lagrange::EulerLagrange;
 use dirac::nalgebra::{DMatrix, DVector};

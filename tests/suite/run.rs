@@ -2,9 +2,7 @@
 //! events against closed forms, observers, failures that keep what was made, trajectories with
 //! velocities, metadata and columns, and serde.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
-mod support;
+use crate::support;
 
 use std::f64::consts::PI;
 use std::ops::ControlFlow;

@@ -1,7 +1,5 @@
 //! Bad input gives an error that says what is wrong, and a failed step changes nothing.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
 
 use dirac::prelude::*;
 use scenes::pendulum::{self, Pendulum, SCENE};

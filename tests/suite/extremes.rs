@@ -1,11 +1,9 @@
 //! Numerical stability at the extremes: what a user gets from every quadrature on a stiff spring
 //! far beyond the resolved step, near singular mass matrices, with tiny and huge steps, and over a
 //! million steps. Each case asserts either a bounded answer or a refusal with a named error;
-//! never an `Ok` that is wrong. `cargo test --test extremes -- --nocapture` prints the table the
+//! never an `Ok` that is wrong. `cargo test --test suite extremes -- --nocapture` prints the table the
 //! README quotes.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
 
 use dirac::prelude::*;
 use scenes::double_pendulum::{self, DoublePendulum};

@@ -1,8 +1,6 @@
 //! Ensembles across threads: a stepper is `Clone + Send`, and members run in parallel give the
 //! numbers each member gives alone, bit for bit, whatever the thread count.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
 
 use dirac::prelude::*;
 use scenes::double_pendulum::SCENE;

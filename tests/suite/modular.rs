@@ -2,8 +2,6 @@
 //! junctions' Schur complement, step exactly the monolithic interconnection's equations; the
 //! ports keep Tellegen's theorem; what the modular step cannot do it refuses.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
 
 use dirac::interconnection::{Interconnection, Junction};
 use dirac::nalgebra::DVector;

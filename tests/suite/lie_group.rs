@@ -3,15 +3,13 @@
 //! closed forms and against an independent Dop853 reference, one-forms at the three constraint
 //! points, torque inputs, hand-written models, and the errors a bad start gets.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
 
 use dirac::prelude::*;
 use dirac::product::Product;
 use scenes::{rigid_body, rolling_ball, satellite, spherical_pendulum};
 use support::assert_order;
 
-mod support;
+use crate::support;
 
 /// Asserts the order of `(h, error)` pairs (see `support::assert_order`).
 fn order_of(what: &str, errors: &[(f64, f64)], expected: f64) {

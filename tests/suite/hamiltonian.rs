@@ -4,9 +4,7 @@
 //! its closed form and the Lagrangian scene, forces and inputs, a Hamiltonian with no Lagrangian,
 //! and the errors.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
-mod support;
+use crate::support;
 
 use dirac::prelude::*;
 use dirac::{Hamilton, HamiltonianSystem, StepEquations};
@@ -423,7 +421,7 @@ fn largest_gap<A: HamiltonianSystem<N>, B: DiracSystem<N>, const N: usize>(
 
 #[test]
 fn forces_of_the_position_momentum_time_and_input_act_as_on_the_lagrangian_route() {
-    // The Lagrangian route reads forces at the nodes' times t_k + c_i h (tests/step_derivatives.rs
+    // The Lagrangian route reads forces at the nodes' times t_k + c_i h (tests/suite/step_derivatives.rs
     // pins that); a force read at another time, or at another point, would part the routes.
     for quadrature in rules() {
         let (worst, size) = largest_gap(

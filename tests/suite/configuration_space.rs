@@ -8,9 +8,9 @@
 //! `Rⁿ`'s at second order, so a scheme that ignored the retraction anywhere (the Lagrangian's
 //! nodes, the forces, the one-forms, the holonomic constraints, the momentum carried to the next
 //! chart) would not converge to the closed form, or would lose its order. Orders are measured as
-//! least-squares slopes over four step sizes (tolerance ±0.3, as in `tests/convergence.rs`).
+//! least-squares slopes over four step sizes (tolerance ±0.3, as in `tests/suite/convergence.rs`).
 
-mod support;
+use crate::support;
 
 use dirac::prelude::*;
 use support::slope;

@@ -1,7 +1,5 @@
 //! Known answers from DESIGN.md.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
 
 use dirac::prelude::*;
 use scenes::hand_written::{Galerkin2, HandEquations, HandStepper, KnifeEdgeMidpoint, Midpoint};

@@ -5,9 +5,7 @@
 //! Tolerance on a slope: ±0.3. Over a factor 8 in h, a pre-asymptotic term of relative size
 //! O(h) moves the fitted slope by well under that, while a wrong order moves it by ≥ 1.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
-mod support;
+use crate::support;
 
 use dirac::prelude::*;
 use scenes::{double_pendulum, pendulum};

@@ -2,8 +2,6 @@
 //! first-order forms of the seven scenes and dirac's discrete Lagrangian are independent
 //! derivations of the same dynamics, so agreement at tight tolerance checks both.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
 
 use dirac::prelude::*;
 use scenes::first_order::FirstOrder;

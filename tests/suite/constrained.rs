@@ -2,9 +2,7 @@
 //! velocities the constraints allow, restarts from a running stepper's own state, and RATTLE
 //! against SHAKE.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
-mod support;
+use crate::support;
 
 use dirac::prelude::*;
 use dirac::step_equations::State;

@@ -3,9 +3,7 @@
 //! computed here by an independent method (classical Runge–Kutta on the vector field derived by
 //! hand).
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
-mod support;
+use crate::support;
 
 use dirac::prelude::*;
 use scenes::lotka_volterra::{self, LotkaVolterra};

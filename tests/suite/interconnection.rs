@@ -2,9 +2,7 @@
 //! the same models written as one struct, and the ports keep Tellegen's theorem and each
 //! component's energy balance step by step.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
-mod support;
+use crate::support;
 
 use support::slope;
 

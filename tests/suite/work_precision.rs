@@ -2,8 +2,6 @@
 //! converges by itself, the chooser picking the cheapest run that truly meets a target, and the
 //! refusals.
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
 
 use dirac::prelude::*;
 use dirac::work_precision::Study;

@@ -1,9 +1,7 @@
 //! Discrete Dirac mechanics: constraint one-forms, holonomic constraints, degenerate Lagrangians,
 //! forces and inputs, on the scenes with known answers (DESIGN.md).
 
-#[path = "../examples/scenes/mod.rs"]
-mod scenes;
-mod support;
+use crate::support;
 
 use dirac::prelude::*;
 use scenes::{cartesian_pendulum, circuit, double_pendulum, knife_edge, pendulum, port};
@@ -279,7 +277,7 @@ fn driven_rlc_reaches_the_phasor_amplitude() {
 /// Constraint one-forms of a Galerkin step are held at the nodes of its Gauss rule: a Lobatto
 /// rule (a node more than the path's free points) is refused for them rather than integrated
 /// wrongly. Holonomic constraints are held at every point of the path: degree 2 is accepted
-/// (order 4, `tests/constrained.rs`), degree 3 refused (it measured order 4 too, not 6).
+/// (order 4, `tests/suite/constrained.rs`), degree 3 refused (it measured order 4 too, not 6).
 #[test]
 fn constrained_systems_refuse_quadratures_they_cannot_hold() {
     let lobatto = Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3)).unwrap();

@@ -1,0 +1,29 @@
+//! The integration tests, one module per subject, linked into one binary so that the models they
+//! define and the scenes they use compile once. `cargo test --test suite MODULE` runs one subject,
+//! e.g. `cargo test --test suite convergence`. The allocation count (`tests/allocation.rs`) keeps a
+//! binary of its own: it installs a global allocator.
+
+mod support;
+
+mod closed_form;
+mod configuration_space;
+mod constrained;
+mod convergence;
+mod discrete_dirac;
+mod ensemble;
+mod errors;
+mod extremes;
+mod first_order;
+mod golden;
+mod hamiltonian;
+mod interconnection;
+mod invariants;
+mod lie_group;
+mod modular;
+mod peers;
+mod rigid_components;
+mod run;
+mod step_derivatives;
+mod step_equations;
+mod vector_algebra;
+mod work_precision;
