@@ -5,11 +5,14 @@ use proc_macro2::{Span, TokenStream};
 use quote::{quote, quote_spanned};
 use syn::spanned::Spanned;
 
-use crate::ast::{
-    Arguments, Coordinate, Kind, Lagrangian, Model, Shape, dimension, offsets, product_sizes,
+use crate::check::model::Model;
+use crate::check::validate::{self, Outcome};
+use crate::internals::ast::{
+    Arguments, Coordinate, Kind, Lagrangian, Shape, dimension, offsets, product_sizes,
 };
-use crate::expression::{Context, MAX_NESTING, MAX_TOKEN_NESTING, bind_coordinate, part_ident};
-use crate::validate::{self, Outcome};
+use crate::lower::expression::{
+    Context, MAX_NESTING, MAX_TOKEN_NESTING, bind_coordinate, part_ident,
+};
 
 /// Entry point: parse, validate, expand; on error the struct, the errors and a stub impl.
 pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
@@ -37,7 +40,7 @@ pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
     };
     match validate::model(arguments, item) {
         Outcome::Valid(model) => expand(&model),
-        Outcome::Composite(composite) => crate::subsystems::expand(&composite),
+        Outcome::Composite(composite) => crate::check::subsystems::expand(&composite),
         Outcome::Invalid {
             errors,
             coordinates,
@@ -153,7 +156,7 @@ fn expand(model: &Model) -> TokenStream {
         false => quote!(lagrangian),
     };
     let offsets = offsets(&model.coordinates);
-    let kind_indices = crate::ast::kind_indices(&model.coordinates);
+    let kind_indices = crate::internals::ast::kind_indices(&model.coordinates);
     let bindings = |velocities: bool| {
         // Parameters stay f64: constant subexpressions cost no dual-number work.
         let parameters = model.parameters.iter().map(|p| {
@@ -463,7 +466,7 @@ fn parts(model: &Model, space: &Space, bindings: &dyn Fn(bool) -> TokenStream) -
 }
 
 /// `Σ_k c_k · e_{i_k}` into a vector named `target`.
-fn accumulate(target: &TokenStream, terms: &[crate::ast::Term]) -> TokenStream {
+fn accumulate(target: &TokenStream, terms: &[crate::internals::ast::Term]) -> TokenStream {
     let terms = terms.iter().map(|t| {
         let (index, coefficient) = (&t.index, &t.coefficient);
         quote_spanned!(t.span=> #target[#index] += #coefficient;)

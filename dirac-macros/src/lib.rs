@@ -1,20 +1,17 @@
-//! The `#[dirac_system(...)]` attribute. It parses the model (`ast`), checks it and collects
-//! every error with its span (`validate`), rewrites the Lagrangian and the one-forms into generic
-//! scalar code (`expression`, `one_form`), derives the Lagrangian's gradient and Hessian in
-//! closed form where the expression allows (`symbolic`) and implements `dirac::DiracSystem`
-//! (`expand`). It never panics on input.
+//! The `#[dirac_system(...)]` attribute, in four layers, each using only those below it:
+//! `internals` (the attribute's syntax as parsed, and the error collector every stage pushes
+//! into), `lower` (the Lagrangian and the one-forms rewritten into generic scalar code, vectors
+//! and matrices lowered to their entries, closed-form derivatives where the expression allows,
+//! the quadrature), `check` (the attribute and the struct validated into a model, every error
+//! collected with its span) and `expand` (the `impl dirac::DiracSystem`). It never panics on
+//! input.
 
 use proc_macro::TokenStream;
 
-mod ast;
+mod check;
 mod expand;
-mod expression;
-mod one_form;
-mod quadrature;
-mod subsystems;
-mod symbolic;
-mod validate;
-mod vector_algebra;
+mod internals;
+mod lower;
 
 /// Turns a struct of parameters into a `dirac::DiracSystem`.
 ///

@@ -6,7 +6,7 @@ use proptest::prelude::*;
 use proptest::sample::select;
 
 use crate::expand::dirac_system;
-use crate::expression::{BINARY, UNARY};
+use crate::lower::expression::{BINARY, UNARY};
 
 const ITEM: &str = "struct S { m: f64, k: [f64; 2] }";
 

@@ -14,7 +14,7 @@
 
 use nalgebra::SVector;
 
-use crate::error::DiracError;
+use crate::base::error::DiracError;
 
 /// The quadrature rule on `[0, 1]` used to integrate the Lagrangian along one step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

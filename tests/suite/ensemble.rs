@@ -1,7 +1,6 @@
 //! Ensembles across threads: a stepper is `Clone + Send`, and members run in parallel give the
 //! numbers each member gives alone, bit for bit, whatever the thread count.
 
-
 use dirac::prelude::*;
 use scenes::double_pendulum::SCENE;
 use scenes::ensemble;

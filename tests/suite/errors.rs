@@ -1,6 +1,5 @@
 //! Bad input gives an error that says what is wrong, and a failed step changes nothing.
 
-
 use dirac::prelude::*;
 use scenes::pendulum::{self, Pendulum, SCENE};
 

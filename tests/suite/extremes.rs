@@ -4,7 +4,6 @@
 //! never an `Ok` that is wrong. `cargo test --test suite extremes -- --nocapture` prints the table the
 //! README quotes.
 
-
 use dirac::prelude::*;
 use scenes::double_pendulum::{self, DoublePendulum};
 use scenes::pendulum;

@@ -1,6 +1,5 @@
 //! Known answers from DESIGN.md.
 
-
 use dirac::prelude::*;
 use scenes::hand_written::{Galerkin2, HandEquations, HandStepper, KnifeEdgeMidpoint, Midpoint};
 use scenes::{double_pendulum, knife_edge, oscillator, pendulum};

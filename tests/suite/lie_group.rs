@@ -3,7 +3,6 @@
 //! closed forms and against an independent Dop853 reference, one-forms at the three constraint
 //! points, torque inputs, hand-written models, and the errors a bad start gets.
 
-
 use dirac::prelude::*;
 use dirac::product::Product;
 use scenes::{rigid_body, rolling_ball, satellite, spherical_pendulum};

@@ -18,6 +18,7 @@ mod golden;
 mod hamiltonian;
 mod interconnection;
 mod invariants;
+mod layers;
 mod lie_group;
 mod modular;
 mod peers;

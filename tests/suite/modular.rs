@@ -2,7 +2,6 @@
 //! junctions' Schur complement, step exactly the monolithic interconnection's equations; the
 //! ports keep Tellegen's theorem; what the modular step cannot do it refuses.
 
-
 use dirac::interconnection::{Interconnection, Junction};
 use dirac::nalgebra::DVector;
 use dirac::prelude::*;

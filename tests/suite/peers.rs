@@ -2,7 +2,6 @@
 //! first-order forms of the seven scenes and dirac's discrete Lagrangian are independent
 //! derivations of the same dynamics, so agreement at tight tolerance checks both.
 
-
 use dirac::prelude::*;
 use scenes::first_order::FirstOrder;
 use scenes::peers::{self, Peer};

@@ -4,7 +4,6 @@
 //! order to an independent reference (midpoint), moves as the free body where the shaft's force
 //! vanishes, and keeps Tellegen's theorem; what it cannot do is refused.
 
-
 use dirac::modular::Modular;
 use dirac::nalgebra::DVector;
 use dirac::prelude::*;

@@ -9,7 +9,6 @@
 //! Its step is the Cayley transform of the generator, a rotation of `(ω q, p)` by
 //! `θ = 2 atan(hω/2)`: after `n` steps the state is known in closed form, and `H` is conserved.
 
-
 use dirac::nalgebra::{DMatrix, DVector};
 use dirac::newton::{Newton, NewtonFailure};
 use dirac::prelude::*;

@@ -2,7 +2,6 @@
 //! converges by itself, the chooser picking the cheapest run that truly meets a target, and the
 //! refusals.
 
-
 use dirac::prelude::*;
 use dirac::work_precision::Study;
 use scenes::{knife_edge, pendulum};

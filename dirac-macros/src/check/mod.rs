@@ -1,0 +1,6 @@
+//! Checking: the attribute and the struct validated into a [`Model`](model::Model) (or a model
+//! of subsystems), every error collected with its span. Uses `internals` and `lower`.
+
+pub mod model;
+pub mod subsystems;
+pub mod validate;

@@ -1,0 +1,1632 @@
+//! The stepper: drives the [`StepEquations`] of a model with Newton's method on the exact
+//! Jacobian, one step at a time. For a Lagrangian model these are the discrete Euler–Lagrange
+//! equations in position–momentum form ([`EulerLagrange`]),
+//!
+//! ```text
+//! p_k + D_1 L_d(q_k, q_{k+1}) = 0          (solved for q_{k+1} and the internal points)
+//! p_{k+1} = D_2 L_d(q_k, q_{k+1})
+//! ```
+//!
+//! A failed step returns an error and changes nothing. Runs over a time span, with saved
+//! times, events and an observer, are in `stepper/integrate.rs` ([`Stepper::solve`]).
+
+use std::marker::PhantomData;
+
+mod integrate;
+
+use nalgebra::{DVector, SVector};
+
+use crate::base::error::DiracError;
+use crate::base::first_order_scheme::FirstOrderScheme;
+use crate::base::holonomic_scheme::HolonomicScheme;
+use crate::base::input::Input;
+use crate::discrete::constraint::ConstraintPoint;
+use crate::discrete::discrete_lagrangian::DiscreteLagrangian;
+use crate::integrate::trajectory::{Metadata, Trajectory};
+use crate::model::hamiltonian_system::HamiltonianSystem;
+use crate::model::legendre;
+use crate::model::system::DiracSystem;
+use crate::quadrature::Quadrature;
+use crate::solve::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
+use crate::solve::predictor::Predictor;
+use crate::space::configuration_space::{ConfigurationSpace, Euclidean};
+use crate::space::manifold::{Manifold, Vectors};
+use crate::step::euler_lagrange::{EulerLagrange, check_finite};
+use crate::step::group_euler_lagrange::GroupEulerLagrange;
+use crate::step::hamilton::Hamilton;
+use crate::step::step_derivatives::{StepDerivatives, StepHessians};
+use crate::step::step_equations::{Point, State, StepEquations, Tangent};
+
+/// The relative consistency an initial state must have with the model's constraints, at the
+/// default solver tolerance.
+const START_TOLERANCE: f64 = 1e-9;
+
+/// Which solve a Newton failure comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Problem {
+    /// The step equations.
+    Step,
+    /// The velocity at a state (the Legendre inversion).
+    Velocity,
+}
+
+/// A solved step, not yet current: the new state and how Newton went.
+#[derive(Debug, Clone, Copy)]
+struct Proposal<const N: usize, M: Manifold<N>> {
+    next: State<N, M>,
+    report: NewtonReport,
+}
+
+/// A variational integrator for one system, one quadrature and one step size: Newton's method on
+/// the model's [`StepEquations`] (`E`, the discrete Euler–Lagrange equations on `Rⁿ` unless
+/// chosen otherwise).
+///
+/// Each step of a Lagrangian model solves for the chart coordinates `ξ_j` of the `s` points of
+/// the step (the internal points and `q_{k+1}`) in the chart centred at `q_k`; on `Rⁿ` these are
+/// the increments `Q_j − q_k`, so velocities carry no cancellation. On `Rⁿ` the momentum is
+/// advanced by the impulse `Σ_j ∂L_d/∂Q_j = h Σ_i b_i ∂_q L`, which equals `D_2 L_d` at the
+/// solution; both updates are compensated sums.
+///
+/// ```
+/// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+/// use nalgebra::{SVector, vector};
+///
+/// struct Oscillator { m: f64, k: f64 }
+/// impl DiracSystem<1> for Oscillator {
+///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+///         v[0] * v[0] * (0.5 * self.m) - q[0] * q[0] * (0.5 * self.k)
+///     }
+/// }
+///
+/// let mut stepper = Stepper::new(Oscillator { m: 1.0, k: 0.5 }, Quadrature::galerkin(2)?, 0.1)?;
+/// stepper.start_from_momentum(vector![0.5], vector![0.0])?;
+/// let trajectory = stepper.run(10)?;
+/// let exact = 0.5 * 0.5_f64.sqrt().cos();
+/// assert!((trajectory.q()[10][0] - exact).abs() < 1e-6);
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Stepper<S, const N: usize, E: StepEquations<N> = EulerLagrange<S, N, Euclidean>> {
+    equations: E,
+    newton: Newton,
+    /// The workspaces of the velocity solves of recorded samples (reused: no allocation per
+    /// sample).
+    velocity: VelocitySolver,
+    state: Option<State<N, E::Manifold>>,
+    /// The state the last step started from (none before the first step of a run).
+    before: Option<State<N, E::Manifold>>,
+    /// The time the next start from a position, velocity or momentum begins at.
+    initial_time: f64,
+    /// Time of the initial state.
+    start: f64,
+    /// The initial state, which the equations examined when the run began.
+    origin: Option<State<N, E::Manifold>>,
+    steps: u64,
+    /// Newton unknowns (the iterate), laid out by the equations.
+    unknowns: DVector<f64>,
+    /// The unknowns of the last accepted steps, extrapolated into the next step's predictor.
+    predictor: Predictor,
+    report: Option<NewtonReport>,
+    /// Constraint violation of the last step where it is settled (0 at a start; measured
+    /// before the equations' settings change), else measured on request from `before`, `state`
+    /// and the predictor's last solution: a step does not pay for it.
+    violation: Option<f64>,
+    /// Multipliers of the last step (zeros before the first).
+    multipliers: Vec<f64>,
+    system: PhantomData<fn() -> S>,
+}
+
+impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
+    /// A stepper for `system` on `Rⁿ` with `quadrature` and step `h`. Fails on a non-positive
+    /// or non-finite step, a non-finite parameter, or a constrained system with a quadrature of
+    /// degree above 1 (constraints are imposed on the step's end points only).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let stepper = Stepper::new(Oscillator, Quadrature::galerkin(2)?, 0.1)?;
+    /// assert_eq!((stepper.h(), stepper.quadrature().name()), (0.1, "galerkin(2)".to_string()));
+    /// assert!(Stepper::new(Oscillator, Quadrature::midpoint(), -0.1).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn new(system: S, quadrature: Quadrature, h: f64) -> Result<Self, DiracError> {
+        Self::on_space(system, Euclidean, quadrature, h)
+    }
+
+    /// A stepper with the system's own quadrature (the one named in `#[dirac_system]`).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracError, DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::SVector;
+    /// struct Oscillator;
+    /// impl DiracSystem<1> for Oscillator {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn quadrature(&self) -> Result<Quadrature, DiracError> {
+    ///         Quadrature::galerkin(3)
+    ///     }
+    /// }
+    /// let stepper = Stepper::from_system(Oscillator, 0.1)?;
+    /// assert_eq!(stepper.quadrature().name(), "galerkin(3)");
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn from_system(system: S, h: f64) -> Result<Self, DiracError> {
+        let quadrature = system.quadrature()?;
+        Self::new(system, quadrature, h)
+    }
+}
+
+impl<S: HamiltonianSystem<N>, const N: usize> Stepper<S, N, Hamilton<S, N>> {
+    /// A stepper for a model given by its Hamiltonian, on the discrete Hamiltonian route
+    /// ([`Hamilton`]: the Galerkin discrete Hamiltonian `H_d⁺` of `quadrature`) with step `h`.
+    /// Fails as [`Hamilton::new`] does.
+    ///
+    /// ```
+    /// use dirac_runtime::{HamiltonianSystem, Quadrature, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// /// A pendulum, H = p²/2 − cos q.
+    /// struct Pendulum;
+    /// impl HamiltonianSystem<1> for Pendulum {
+    ///     fn hamiltonian<D: Scalar>(&self, q: &SVector<D, 1>, p: &SVector<D, 1>) -> D {
+    ///         p[0] * p[0] * 0.5 - q[0].cos()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::hamiltonian(Pendulum, Quadrature::midpoint(), 0.01)?;
+    /// stepper.start_from_momentum(vector![1.0], vector![0.0])?;
+    /// let trajectory = stepper.run(1000)?;
+    /// assert!(trajectory.max_energy_error() < 1e-4);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn hamiltonian(system: S, quadrature: Quadrature, h: f64) -> Result<Self, DiracError> {
+        Self::with_equations(Hamilton::new(system, quadrature, h)?)
+    }
+
+    /// A stepper with the system's own quadrature (the one named in `#[dirac_system]`), on the
+    /// discrete Hamiltonian route.
+    pub fn hamiltonian_from_system(system: S, h: f64) -> Result<Self, DiracError> {
+        let quadrature = system.quadrature()?;
+        Self::hamiltonian(system, quadrature, h)
+    }
+
+    /// The quadrature of the phase-space action.
+    pub fn quadrature(&self) -> &Quadrature {
+        self.equations.quadrature()
+    }
+}
+
+impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
+    Stepper<S, N, EulerLagrange<S, N, C>>
+{
+    /// A stepper for `system` whose steps work in the charts of `space` (see
+    /// [`configuration_space`](crate::space::configuration_space)); otherwise as [`Stepper::new`].
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::Positive;
+    /// // Every point of every step stays positive.
+    /// let mut stepper = Stepper::on_space(Oscillator, Positive, Quadrature::galerkin(2)?, 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run(10)?;
+    /// assert!((stepper.q()[0] - 1.0_f64.cos()).abs() < 1e-5); // order 4
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn on_space(
+        system: S,
+        space: C,
+        quadrature: Quadrature,
+        h: f64,
+    ) -> Result<Self, DiracError> {
+        let discrete = DiscreteLagrangian::on_space(system, space, quadrature, h);
+        Self::with_equations(EulerLagrange::new(discrete)?)
+    }
+
+    /// Evaluates the constraint one-forms at `point` of each step instead of the system's default.
+    ///
+    /// ```
+    /// # use dirac_runtime::{ConstraintPoint, DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// A knife edge in the plane: it moves only along its heading, sin φ ẋ − cos φ ẏ = 0.
+    /// struct KnifeEdge;
+    /// impl DiracSystem<3> for KnifeEdge {
+    ///     const ONE_FORMS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * 0.5
+    ///     }
+    ///     fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, _a: usize) -> SVector<D, 3> {
+    ///         SVector::from([q[2].sin(), -q[2].cos(), D::from(0.0)])
+    ///     }
+    /// }
+    /// let stepper = Stepper::new(KnifeEdge, Quadrature::midpoint(), 0.1)?
+    ///     .with_constraint_point(ConstraintPoint::Start);
+    /// assert_eq!(stepper.constraint_point(), ConstraintPoint::Start);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn with_constraint_point(mut self, point: ConstraintPoint) -> Self {
+        self.settle_violation();
+        self.equations.set_constraint_point(point);
+        self
+    }
+
+    /// Starts a Lagrangian linear in the velocities, `L = ϑ(q)·v − H(q)`, from its position
+    /// alone at the [start time](Self::with_start_time): its momentum is `ϑ(q0)` and its velocity solves its first-order
+    /// equations `(ϑ'ᵀ − ϑ') v = ∇H`. Fails for a model with kinetic energy (whose state needs a
+    /// velocity or momentum too) or with constraints.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// /// A particle in the plane in a unit magnetic field, without mass: it drifts along the
+    /// /// level sets of the potential, q̇ = (−∂V/∂y, ∂V/∂x) with V = (x² + y²)/2.
+    /// struct Drift;
+    /// impl DiracSystem<2> for Drift {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+    ///         (q[0] * v[1] - q[1] * v[0]) * 0.5 - (q[0] * q[0] + q[1] * q[1]) * 0.5
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Drift, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_position(vector![1.0, 0.0])?;
+    /// assert!((stepper.v()? - vector![0.0, 1.0]).amax() < 1e-14);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn start_from_position(&mut self, q0: SVector<f64, N>) -> Result<(), DiracError> {
+        check_finite(self.system(), "initial position", &q0)?;
+        let zero = SVector::zeros();
+        if !crate::discrete::first_order::is_first_order(self.system(), &q0, &zero) {
+            return Err(DiracError::InconsistentInitialState(
+                "the position alone is the state of a Lagrangian linear in the velocities \
+                 without constraints; this model needs a velocity or a momentum too"
+                    .into(),
+            ));
+        }
+        let theta = legendre::momentum(self.system(), &q0, &zero);
+        let t0 = self.initial_time;
+        let v0 = self.velocity_at(t0, &q0, &theta, &zero, false)?;
+        let p0 = legendre::momentum(self.system(), &q0, &v0);
+        check_finite(self.system(), "initial momentum", &p0)?;
+        self.start_from_state(State::new(t0, q0, p0, v0))
+    }
+
+    /// Advances one step and returns the first and second derivatives of the step map at the
+    /// state it started from (see [`StepHessians`]); for models on `Rⁿ` without constraints
+    /// (with forces and inputs), others are refused with `Unsupported`. On error the state is
+    /// unchanged.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// let (first, second) = stepper.step_second_order()?;
+    /// // A linear model: the step map is linear, its second derivatives vanish.
+    /// assert!(first.symplecticity_defect() < 1e-14);
+    /// assert!(second.q.iter().chain(&second.p).all(|h| h.amax() < 1e-12));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn step_second_order(
+        &mut self,
+    ) -> Result<(StepDerivatives<N>, StepHessians<N>), DiracError> {
+        let proposal = self.solve_step_at_root()?;
+        let state = self.factorise_at_root()?;
+        let first = self
+            .equations
+            .linearise(&state, &self.unknowns, &self.newton)?;
+        let second = self
+            .equations
+            .second_derivatives(&state, &self.unknowns, &self.newton)?;
+        self.accept(proposal);
+        Ok((first, second))
+    }
+
+    /// Chooses what a step does with the momentum of a model with holonomic constraints
+    /// (default [`HolonomicScheme::Shake`]).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, HolonomicScheme, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// A pendulum in Cartesian coordinates: x² + y² = 1.
+    /// struct Pendulum;
+    /// impl DiracSystem<2> for Pendulum {
+    ///     const HOLONOMIC: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1]) * 0.5 - q[1]
+    ///     }
+    ///     fn holonomic<D: Scalar>(&self, q: &SVector<D, 2>, _b: usize) -> D {
+    ///         q[0] * q[0] + q[1] * q[1] - 1.0
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Pendulum, Quadrature::midpoint(), 0.01)?
+    ///     .with_holonomic_scheme(HolonomicScheme::Rattle);
+    /// stepper.start_from_velocity(vector![1.0, 0.0], vector![0.0, 0.0])?;
+    /// stepper.run(100)?;
+    /// assert!((stepper.q().norm() - 1.0).abs() < 1e-12);
+    /// // RATTLE keeps the velocity tangent to the circle too.
+    /// assert!(stepper.q().dot(&stepper.v()?).abs() < 1e-10);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn with_holonomic_scheme(mut self, scheme: HolonomicScheme) -> Self {
+        self.equations.set_holonomic_scheme(scheme);
+        self
+    }
+
+    /// Chooses which step a Lagrangian linear in the velocities is advanced by (default
+    /// [`FirstOrderScheme::Collocation`]); taken up by the next start.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, FirstOrderScheme, Quadrature, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// /// Lotka–Volterra, L = ϑ(q)·v − H(q) with ϑ = (ln q2 / q1, 0).
+    /// struct LotkaVolterra;
+    /// impl DiracSystem<2> for LotkaVolterra {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+    ///         q[1].ln() / q[0] * v[0] - (q[0] + q[1] - q[0].ln() - q[1].ln() * 2.0)
+    ///     }
+    /// }
+    /// let h = |q: &SVector<f64, 2>| q[0] + q[1] - q[0].ln() - 2.0 * q[1].ln();
+    /// let mut stepper = Stepper::new(LotkaVolterra, Quadrature::galerkin(2)?, 0.05)?
+    ///     .with_first_order_scheme(FirstOrderScheme::SymmetricProjection);
+    /// let q0 = vector![2.0, 1.0];
+    /// stepper.start_from_position(q0)?;
+    /// stepper.run(200)?;
+    /// assert!((h(&stepper.q()) - h(&q0)).abs() < 1e-5);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn with_first_order_scheme(mut self, scheme: FirstOrderScheme) -> Self {
+        self.settle_violation();
+        self.equations.set_first_order_scheme(scheme);
+        self
+    }
+
+    /// Where the constraint one-forms are evaluated on a step.
+    ///
+    /// ```
+    /// # use dirac_runtime::{ConstraintPoint, DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// A knife edge in the plane: it moves only along its heading, sin φ ẋ − cos φ ẏ = 0.
+    /// struct KnifeEdge;
+    /// impl DiracSystem<3> for KnifeEdge {
+    ///     const ONE_FORMS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * 0.5
+    ///     }
+    ///     fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, _a: usize) -> SVector<D, 3> {
+    ///         SVector::from([q[2].sin(), -q[2].cos(), D::from(0.0)])
+    ///     }
+    /// }
+    /// let stepper = Stepper::new(KnifeEdge, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.constraint_point(), ConstraintPoint::Midpoint);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn constraint_point(&self) -> ConstraintPoint {
+        self.equations.constraint_point()
+    }
+
+    /// The configuration space whose charts the steps work in.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::Euclidean;
+    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.space(), &Euclidean);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn space(&self) -> &C {
+        self.equations.discrete().space()
+    }
+
+    /// The quadrature.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let stepper = Stepper::new(Oscillator, Quadrature::galerkin(2)?, 0.1)?;
+    /// assert_eq!(stepper.quadrature().degree(), 2);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn quadrature(&self) -> &Quadrature {
+        self.equations.discrete().quadrature()
+    }
+}
+
+/// A [`Stepper`] of a model on rotations and unit vectors whose steps work in the charts of `C`
+/// (see [`Stepper::on_manifold`]).
+pub type ManifoldStepper<S, const N: usize, C> = Stepper<S, N, GroupEulerLagrange<S, N, C>>;
+
+impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
+    Stepper<S, N, GroupEulerLagrange<S, N, C>>
+{
+    /// A stepper for a model on rotations and unit vectors (a [`Product`](crate::Product) of
+    /// them with ordinary coordinates) whose steps work in the charts of `space`, with
+    /// `quadrature` and step `h` (see [`GroupEulerLagrange`]). Fails as
+    /// [`GroupEulerLagrange::new`] does.
+    ///
+    /// ```
+    /// use dirac_runtime::{Configuration, DiracSystem, Product, Quadrature, Rates, Scalar, Stepper};
+    /// use nalgebra::{Matrix3, vector};
+    ///
+    /// /// A free rigid body with principal moments of inertia (1, 2, 3).
+    /// struct Body;
+    /// impl DiracSystem<3, Product<0, 1, 0>> for Body {
+    ///     fn lagrangian<D: Scalar>(
+    ///         &self,
+    ///         _q: &Configuration<D, 0, 1, 0>,
+    ///         v: &Rates<D, 0, 1, 0>,
+    ///     ) -> D {
+    ///         let w = v.rotation[0];
+    ///         (w[0] * w[0] + w[1] * w[1] * 2.0 + w[2] * w[2] * 3.0) * 0.5
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::on_manifold(Body, Product::cayley(), Quadrature::midpoint(), 0.05)?;
+    /// let start = Configuration { vector: vector![], rotation: [Matrix3::identity()], direction: [] };
+    /// let spin = Rates { vector: vector![], rotation: [vector![0.3, 1.0, 0.2]], direction: [] };
+    /// stepper.start_from_velocity(start, spin)?;
+    /// let before = stepper.q().spatial(&stepper.p(), 0);
+    /// stepper.run(200)?;
+    /// let after = stepper.q().spatial(&stepper.p(), 0);
+    /// assert!((after - before).amax() < 1e-13); // discrete Noether
+    /// let r = stepper.q().rotation[0];
+    /// assert!((r.transpose() * r - Matrix3::identity()).amax() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn on_manifold(
+        system: S,
+        space: C,
+        quadrature: Quadrature,
+        h: f64,
+    ) -> Result<Self, DiracError> {
+        let discrete = DiscreteLagrangian::on_space(system, space, quadrature, h);
+        Self::with_equations(GroupEulerLagrange::new(discrete)?)
+    }
+
+    /// Evaluates the constraint one-forms at `point` of each step instead of the system's default.
+    pub fn with_constraint_point(mut self, point: ConstraintPoint) -> Self {
+        self.settle_violation();
+        self.equations.set_constraint_point(point);
+        self
+    }
+
+    /// Where the constraint one-forms are evaluated on a step.
+    pub fn constraint_point(&self) -> ConstraintPoint {
+        self.equations.constraint_point()
+    }
+
+    /// The configuration space whose charts the steps work in.
+    pub fn space(&self) -> &C {
+        self.equations.discrete().space()
+    }
+
+    /// The quadrature.
+    pub fn quadrature(&self) -> &Quadrature {
+        self.equations.discrete().quadrature()
+    }
+}
+
+impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
+    /// A stepper that solves `equations` on each step, with default Newton options.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::{DiscreteLagrangian, euler_lagrange::EulerLagrange};
+    /// let discrete = DiscreteLagrangian::new(Oscillator, Quadrature::midpoint(), 0.1);
+    /// let mut stepper = Stepper::with_equations(EulerLagrange::new(discrete)?)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.step()?;
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn with_equations(equations: E) -> Result<Self, DiracError> {
+        let unknowns = equations.unknowns();
+        if equations.first_multiplier() + equations.multipliers() > unknowns {
+            return Err(DiracError::Dimension(format!(
+                "{}: multipliers {}..{} outside the {unknowns} unknowns",
+                E::NAME,
+                equations.first_multiplier(),
+                equations.first_multiplier() + equations.multipliers()
+            )));
+        }
+        let newton = Newton::new(unknowns, NewtonOptions::default())?;
+        let velocity = VelocitySolver::new(equations.velocity_unknowns(), newton.options())?;
+        Ok(Self {
+            velocity,
+            multipliers: vec![0.0; equations.multipliers()],
+            equations,
+            newton,
+            state: None,
+            before: None,
+            initial_time: 0.0,
+            start: 0.0,
+            origin: None,
+            steps: 0,
+            unknowns: DVector::zeros(unknowns),
+            predictor: Predictor::new(unknowns),
+            report: None,
+            violation: Some(0.0),
+            system: PhantomData,
+        })
+    }
+
+    /// Sets the time the next start from a position, velocity or momentum begins at (0 by
+    /// default; [`start_from_state`](Self::start_from_state) takes the state's own time).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Free;
+    /// # impl DiracSystem<1> for Free {
+    /// #     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         v[0] * v[0] * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Free, Quadrature::midpoint(), 0.25)?.with_start_time(10.0);
+    /// stepper.start_from_velocity(vector![0.0], vector![1.0])?;
+    /// let trajectory = stepper.run_until(11.0)?;
+    /// assert_eq!(trajectory.t().last(), Some(&11.0));
+    /// assert_eq!(trajectory.len(), 5);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn with_start_time(mut self, t0: f64) -> Self {
+        self.initial_time = t0;
+        self
+    }
+
+    /// Replaces the Newton options (tolerances, iteration cap, root acceptance); fails on
+    /// options out of range.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::NewtonOptions;
+    /// let tight = NewtonOptions { residual_tolerance: 1e-14, ..NewtonOptions::default() };
+    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?.with_newton_options(tight)?;
+    /// let negative = NewtonOptions { residual_tolerance: -1.0, ..NewtonOptions::default() };
+    /// assert!(stepper.with_newton_options(negative).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn with_newton_options(mut self, options: NewtonOptions) -> Result<Self, DiracError> {
+        self.newton = Newton::new(self.unknowns.len(), options)?;
+        self.velocity = VelocitySolver::new(self.equations.velocity_unknowns(), &options)?;
+        Ok(self)
+    }
+
+    /// Starts from position `q0` and velocity `v0` at the [start time](Self::with_start_time), with `p0 = ∂L/∂v(q0, v0)`.
+    /// Fails if `(q0, v0)` violates a constraint, including the hidden constraints of
+    /// coordinates without kinetic energy.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.5])?;
+    /// assert_eq!((stepper.t(), stepper.p()[0]), (0.0, 0.5));
+    /// assert!(stepper.start_from_velocity(vector![f64::NAN], vector![0.0]).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn start_from_velocity(
+        &mut self,
+        q0: Point<E, N>,
+        v0: Tangent<E, N>,
+    ) -> Result<(), DiracError> {
+        let p0 = self.equations.momentum(&q0, &v0)?;
+        self.start_from_state(State::new(self.initial_time, q0, p0, v0))
+    }
+
+    /// Starts from position `q0` and momentum `p0` at the [start time](Self::with_start_time). The velocity is found by a
+    /// globalised Newton solve of `∂L/∂v(q0, v) = p0` from `v = 0`; when that fails (several
+    /// velocities share the momentum, or `v = 0` is far from the answer), use
+    /// [`start_from_momentum_near`](Self::start_from_momentum_near).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_momentum(vector![1.0], vector![0.5])?;
+    /// assert!((stepper.v()?[0] - 0.5).abs() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn start_from_momentum(
+        &mut self,
+        q0: Point<E, N>,
+        p0: Tangent<E, N>,
+    ) -> Result<(), DiracError> {
+        self.start_from_momentum_near(q0, p0, <E::Manifold as Manifold<N>>::zero())
+    }
+
+    /// Starts from position `q0` and momentum `p0` at the [start time](Self::with_start_time), solving for the velocity from
+    /// the guess `v_guess`.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_momentum_near(vector![1.0], vector![0.5], vector![0.4])?;
+    /// assert!((stepper.v()?[0] - 0.5).abs() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn start_from_momentum_near(
+        &mut self,
+        q0: Point<E, N>,
+        p0: Tangent<E, N>,
+        v_guess: Tangent<E, N>,
+    ) -> Result<(), DiracError> {
+        self.equations.check_finite(&q0, &p0, &v_guess)?;
+        let t0 = self.initial_time;
+        let v0 = self.velocity_at(t0, &q0, &p0, &v_guess, false)?;
+        self.start_from_state(State::new(t0, q0, p0, v0))
+    }
+
+    /// Sets the input called `name` (held constant over the following steps until set again).
+    /// In a loop, resolve the name once with [`input`](Self::input) and use
+    /// [`set_input_value`](Self::set_input_value).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// stepper.set_input("u", 2.0)?;
+    /// assert_eq!(stepper.inputs(), &[2.0]);
+    /// assert!(stepper.set_input("v", 1.0).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), DiracError> {
+        let input = self.input(name)?;
+        self.set_input_value(input, value)
+    }
+
+    /// The input called `name`, or `UnknownInput` naming the system's inputs.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.input("u")?.index(), 0);
+    /// assert!(stepper.input("v").is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn input(&self, name: &str) -> Result<Input, DiracError> {
+        let count = self.equations.inputs().len();
+        (0..count)
+            .find(|&i| self.equations.input_name(i) == name)
+            .map(Input::new)
+            .ok_or_else(|| {
+                let names: Vec<String> = (0..count).map(|i| self.equations.input_name(i)).collect();
+                DiracError::UnknownInput(format!(
+                    "no input called `{name}`; the inputs are {names:?}"
+                ))
+            })
+    }
+
+    /// Sets `input` (held constant over the following steps until set again); a value that is
+    /// not finite is refused and changes nothing.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.01)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// let u = stepper.input("u")?; // resolved once, outside the loop
+    /// for _ in 0..100 {
+    ///     let feedback = -stepper.q()[0]; // a second spring, held over each step
+    ///     stepper.set_input_value(u, feedback)?;
+    ///     stepper.step()?;
+    /// }
+    /// assert!((stepper.q()[0] - 2.0_f64.sqrt().cos()).abs() < 0.05);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn set_input_value(&mut self, input: Input, value: f64) -> Result<(), DiracError> {
+        let index = input.index();
+        let count = self.equations.inputs().len();
+        if index >= count {
+            return Err(DiracError::UnknownInput(format!(
+                "input {index} of a system with {count} input(s)"
+            )));
+        }
+        if !value.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: format!("input {}", self.equations.input_name(index)),
+                value,
+            });
+        }
+        if self.equations.inputs()[index] != value {
+            // A step after a change of inputs is predicted from the last one alone.
+            self.predictor.restart();
+        }
+        self.equations.inputs_mut()[index] = value;
+        Ok(())
+    }
+
+    /// Sets every input at once, in the order of the system's `inputs(...)`.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// stepper.set_inputs(&[1.5])?;
+    /// assert_eq!(stepper.inputs(), &[1.5]);
+    /// assert!(stepper.set_inputs(&[1.0, 2.0]).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
+        let count = self.equations.inputs().len();
+        if values.len() != count {
+            return Err(DiracError::UnknownInput(format!(
+                "the system has {count} input(s), got {} value(s)",
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(DiracError::NonFinite {
+                what: format!("input {}", self.equations.input_name(i)),
+                value: values[i],
+            });
+        }
+        let changed = self.equations.inputs() != values;
+        self.equations.inputs_mut().copy_from_slice(values);
+        if changed {
+            // A step after a change of inputs is predicted from the last one alone.
+            self.predictor.restart();
+        }
+        Ok(())
+    }
+
+    /// Current input values.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator driven by the force `u`.
+    /// struct Driven;
+    /// impl DiracSystem<1> for Driven {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let stepper = Stepper::new(Driven, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.inputs(), &[0.0]); // inputs start at zero
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn inputs(&self) -> &[f64] {
+        self.equations.inputs()
+    }
+
+    /// The system.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.system().coordinate_name(0), "q0");
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn system(&self) -> &E::System {
+        self.equations.system()
+    }
+
+    /// The step equations.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::StepEquations;
+    /// let stepper = Stepper::new(Oscillator, Quadrature::galerkin(2)?, 0.1)?;
+    /// assert_eq!(stepper.equations().unknowns(), 2); // the internal point and the end point
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn equations(&self) -> &E {
+        &self.equations
+    }
+
+    /// The velocity at `(q, p)` by the Legendre inversion from `guess`; `in_run`
+    /// when the state is the running one (see [`StepEquations::velocity_in_run`]).
+    fn velocity_at(
+        &self,
+        t: f64,
+        q: &Point<E, N>,
+        p: &Tangent<E, N>,
+        guess: &Tangent<E, N>,
+        in_run: bool,
+    ) -> Result<Tangent<E, N>, DiracError> {
+        // As a recorded sample's velocity is solved, in a workspace of its own.
+        let mut solver =
+            VelocitySolver::new(self.equations.velocity_unknowns(), self.newton.options())?;
+        let solved = solver.solve(|newton| match in_run {
+            true => self.equations.velocity_in_run(newton, t, q, p, guess),
+            false => self.equations.velocity(newton, t, q, p, guess),
+        });
+        solved.map_err(|f| self.failure(Problem::Velocity, f))
+    }
+
+    /// The velocity of a recorded `state`, solved from `guess` in the stepper's own workspace,
+    /// with the energy there where the solve gives it on its way.
+    fn sample_velocity(
+        &mut self,
+        state: &State<N, E::Manifold>,
+        guess: &Tangent<E, N>,
+    ) -> Result<(Tangent<E, N>, Option<f64>), DiracError> {
+        let unknowns = self.equations.velocity_unknowns();
+        if self.velocity.fast.unknowns() != unknowns {
+            self.velocity = VelocitySolver::new(unknowns, self.newton.options())?;
+        }
+        let (t, q, p) = (state.t, &state.q, &state.p);
+        let equations = &self.equations;
+        let solved = self
+            .velocity
+            .solve(|newton| equations.velocity_and_energy_in_run(newton, t, q, p, guess));
+        solved.map_err(|f| self.failure(Problem::Velocity, f))
+    }
+
+    /// Starts from `state` after the equations have checked it (see
+    /// [`StepEquations::check_start`]) and the first step's equations have been found
+    /// nonsingular there (a singular Jacobian is `SingularJacobian`, naming the unknowns the
+    /// rule does not determine); on error nothing changes.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::State;
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_state(State::new(2.0, vector![1.0], vector![0.0], vector![0.0]))?;
+    /// assert_eq!((stepper.t(), stepper.steps()), (2.0, 0));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn start_from_state(&mut self, state: State<N, E::Manifold>) -> Result<(), DiracError> {
+        if !state.t.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: "the initial time".into(),
+                value: state.t,
+            });
+        }
+        // Consistency to a relative 1e-9, or looser where the solver is asked for less: a state
+        // this stepper (or another) produced is always accepted.
+        let tolerance = START_TOLERANCE.max(100.0 * self.newton.options().residual_tolerance);
+        self.equations.check_start(&state, tolerance)?;
+        // A refused start keeps the last step's violation, which the trial below may no longer
+        // be able to measure (`begin` may clear the predictor's solutions).
+        self.settle_violation();
+        self.begin(&state)?;
+        // A rule that does not determine the model's motion (the first step's Jacobian is
+        // singular) is refused here, before the first step, naming the undetermined unknowns.
+        let equations = &mut self.equations;
+        equations.predict(&state, None, &mut self.unknowns);
+        // The start's own Jacobian decides, not one reused from another run.
+        self.newton.forget_jacobian();
+        let trial = self.newton.solve(&mut self.unknowns, |x, r, j| {
+            equations.assemble(&state, x, r, j)
+        });
+        if let Err(failure @ NewtonFailure::Singular(_)) = trial {
+            let steps = std::mem::replace(&mut self.steps, 0);
+            let error = self.failure(Problem::Step, failure);
+            self.steps = steps;
+            // The equations examine the running start again: they find what they found then.
+            if let Some(origin) = self.origin {
+                self.begin(&origin)?;
+            }
+            return Err(error);
+        }
+        self.reset(state);
+        Ok(())
+    }
+
+    /// Lets the equations examine the start of a run, and sizes the solver for the unknowns
+    /// they then have.
+    fn begin(&mut self, state: &State<N, E::Manifold>) -> Result<(), DiracError> {
+        self.equations.begin(state);
+        let unknowns = self.equations.unknowns();
+        if unknowns != self.unknowns.len() {
+            self.newton = Newton::new(unknowns, *self.newton.options())?;
+            self.unknowns = DVector::zeros(unknowns);
+            self.predictor.clear(unknowns);
+        }
+        Ok(())
+    }
+
+    fn reset(&mut self, state: State<N, E::Manifold>) {
+        self.violation = Some(0.0);
+        self.multipliers.fill(0.0);
+        self.start = state.t;
+        self.origin = Some(state);
+        self.state = Some(state);
+        self.before = None;
+        self.steps = 0;
+        self.predictor.clear(self.unknowns.len());
+        self.report = None;
+    }
+
+    /// Advances one step. On error the state is unchanged.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// use dirac_runtime::DiracError;
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// assert!(matches!(stepper.step(), Err(DiracError::NotStarted)));
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.step()?;
+    /// assert_eq!((stepper.steps(), stepper.t()), (1, 0.1));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn step(&mut self) -> Result<(), DiracError> {
+        let proposal = self.solve_step()?;
+        self.accept(proposal);
+        Ok(())
+    }
+
+    /// Advances one step and returns the derivatives of the step map at the state it started
+    /// from: `A = ∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)` and `B = ∂(q_{k+1}, p_{k+1})/∂u` (see
+    /// [`StepDerivatives`]). On error (including
+    /// `Unsupported` for models the derivatives do not cover yet) the state is unchanged.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// let a = stepper.step_linearised()?;
+    /// // One degree of freedom: symplectic means det A = 1.
+    /// assert!((a.matrix().determinant() - 1.0).abs() < 1e-14);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn step_linearised(&mut self) -> Result<StepDerivatives<N>, DiracError> {
+        let proposal = self.solve_step_at_root()?;
+        let state = self.factorise_at_root()?;
+        let derivatives = self
+            .equations
+            .linearise(&state, &self.unknowns, &self.newton)?;
+        self.accept(proposal);
+        Ok(derivatives)
+    }
+
+    /// [`solve_step`](Self::solve_step) ending, where Newton's method runs, with the Jacobian
+    /// at the root (the derivatives that follow need it).
+    fn solve_step_at_root(&mut self) -> Result<Proposal<N, E::Manifold>, DiracError> {
+        self.newton.set_jacobian_at_root(true);
+        let proposal = self.solve_step();
+        self.newton.set_jacobian_at_root(false);
+        proposal
+    }
+
+    /// Factorises the Jacobian at the root of the step just solved (the implicit function
+    /// theorem needs it there; the solve may have ended with an earlier one) and returns the
+    /// state the step started from.
+    fn factorise_at_root(&mut self) -> Result<State<N, E::Manifold>, DiracError> {
+        let Some(state) = self.state else {
+            return Err(DiracError::NotStarted);
+        };
+        let equations = &mut self.equations;
+        self.newton
+            .factorise_at(&self.unknowns, |x, r, j| {
+                equations.assemble(&state, x, r, j)
+            })
+            .map_err(|f| self.failure(Problem::Step, f))?;
+        Ok(state)
+    }
+
+    /// Solves the next step without making it current: the state is unchanged whatever happens.
+    fn solve_step(&mut self) -> Result<Proposal<N, E::Manifold>, DiracError> {
+        let Some(state) = &self.state else {
+            return Err(DiracError::NotStarted);
+        };
+        // The last solutions extrapolated (see `predictor`).
+        let predictor = self.predictor.predict();
+        let equations = &mut self.equations;
+        equations.predict(state, predictor, &mut self.unknowns);
+        self.newton.set_jacobian_cost(equations.jacobian_cost());
+        let result = self.newton.solve(&mut self.unknowns, |x, r, j| {
+            equations.assemble(state, x, r, j)
+        });
+        let report = result.map_err(|f| self.failure(Problem::Step, f))?;
+        let mut next = self.equations.advance(state, &self.unknowns, self.steps)?;
+        next.t = self.start + (self.steps + 1) as f64 * self.equations.h();
+        Ok(Proposal { next, report })
+    }
+
+    /// Makes a solved step current; its solution is still in `unknowns`.
+    fn accept(&mut self, proposal: Proposal<N, E::Manifold>) {
+        let first = self.equations.first_multiplier();
+        let count = self.multipliers.len();
+        self.multipliers
+            .copy_from_slice(&self.unknowns.as_slice()[first..first + count]);
+        self.predictor.record(&self.unknowns);
+        if let Some(state) = &self.state
+            && !self.equations.charts_continue(&state.q, &proposal.next.q)
+        {
+            // The solutions so far are coordinates in charts that the next one does not continue.
+            self.predictor.detach();
+        }
+        self.violation = None;
+        self.steps += 1;
+        self.before = self.state;
+        self.state = Some(proposal.next);
+        self.report = Some(proposal.report);
+    }
+
+    /// Multipliers of the last step: one per constraint one-form, then one per holonomic
+    /// constraint. `Ãᵀ μ + dg̃ᵀ λ` is the constraint impulse over the step (the constraint force
+    /// times `h`) in the chart at `q_k`; on `Rⁿ`, `A(q_c)ᵀ μ + dg(q_k)ᵀ λ`. Empty for an
+    /// unconstrained system; zeros before the first step.
+    ///
+    /// ```
+    /// # use dirac_runtime::{ConstraintPoint, DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// A knife edge in the plane: it moves only along its heading, sin φ ẋ − cos φ ẏ = 0.
+    /// struct KnifeEdge;
+    /// impl DiracSystem<3> for KnifeEdge {
+    ///     const ONE_FORMS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * 0.5
+    ///     }
+    ///     fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, _a: usize) -> SVector<D, 3> {
+    ///         SVector::from([q[2].sin(), -q[2].cos(), D::from(0.0)])
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(KnifeEdge, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![0.0, 0.0, 0.0], vector![1.0, 0.0, 1.0])?;
+    /// assert_eq!(stepper.multipliers(), &[0.0]);
+    /// stepper.step()?;
+    /// assert!(stepper.multipliers()[0] != 0.0); // the blade pushes sideways as it turns
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn multipliers(&self) -> &[f64] {
+        &self.multipliers
+    }
+
+    /// Largest constraint violation of the last step: `|Ã(ξ_c) ξ|` over the one-forms, with
+    /// `ξ = R_{q_k}⁻¹(q_{k+1})` the stored step in the chart (on `Rⁿ`, `|A(q_c)(q_{k+1} − q_k)|`),
+    /// and `|g(q_{k+1})|` over the holonomic constraints (0 before the first step).
+    ///
+    /// ```
+    /// # use dirac_runtime::{ConstraintPoint, DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// A knife edge in the plane: it moves only along its heading, sin φ ẋ − cos φ ẏ = 0.
+    /// struct KnifeEdge;
+    /// impl DiracSystem<3> for KnifeEdge {
+    ///     const ONE_FORMS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 3>, v: &SVector<D, 3>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * 0.5
+    ///     }
+    ///     fn one_form<D: Scalar>(&self, q: &SVector<D, 3>, _a: usize) -> SVector<D, 3> {
+    ///         SVector::from([q[2].sin(), -q[2].cos(), D::from(0.0)])
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(KnifeEdge, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![0.0, 0.0, 0.0], vector![1.0, 0.0, 1.0])?;
+    /// stepper.run(10)?;
+    /// assert!(stepper.constraint_violation() < 1e-12);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn constraint_violation(&self) -> f64 {
+        if let Some(violation) = self.violation {
+            return violation;
+        }
+        match (&self.before, &self.state, self.predictor.last()) {
+            (Some(from), Some(to), Some(x)) => self.equations.violation(from, to, x),
+            _ => 0.0,
+        }
+    }
+
+    /// Measures the last step's constraint violation now, before the equations' settings change.
+    fn settle_violation(&mut self) {
+        self.violation = Some(self.constraint_violation());
+    }
+
+    /// The step size.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// assert_eq!(Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?.h(), 0.1);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn h(&self) -> f64 {
+        self.equations.h()
+    }
+
+    /// Steps taken since the start.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run(3)?;
+    /// assert_eq!(stepper.steps(), 3);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// The current state (`None` before the start).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// assert!(stepper.state().is_none());
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// assert_eq!(stepper.state().map(|s| s.q()[0]), Some(1.0));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn state(&self) -> Option<&State<N, E::Manifold>> {
+        self.state.as_ref()
+    }
+
+    /// Current time (0 before the start).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run_until(1.0)?;
+    /// assert!((stepper.t() - 1.0).abs() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn t(&self) -> f64 {
+        self.state.map_or(0.0, |s| s.t)
+    }
+
+    /// Current position (zeros before the start).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run_until(1.0)?;
+    /// assert!((stepper.q()[0] - 1.0_f64.cos()).abs() < 1e-2);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn q(&self) -> Point<E, N> {
+        self.state
+            .map_or_else(<E::Manifold as Manifold<N>>::origin, |s| s.q)
+    }
+
+    /// Current momentum (zeros before the start).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run_until(1.0)?;
+    /// assert!((stepper.p()[0] + 1.0_f64.sin()).abs() < 1e-2);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn p(&self) -> Tangent<E, N> {
+        self.state
+            .map_or_else(<E::Manifold as Manifold<N>>::zero, |s| s.p)
+    }
+
+    /// Current velocity: the solution `v` of `∂L/∂v(q, v) = p` (Newton's method with the exact
+    /// Hessian, seeded with the last step's velocity).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.step()?;
+    /// assert_eq!(stepper.v()?, stepper.p()); // L = (v² − q²)/2: p = v
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn v(&self) -> Result<Tangent<E, N>, DiracError> {
+        let Some(state) = self.state else {
+            return Err(DiracError::NotStarted);
+        };
+        self.velocity_at(state.t, &state.q, &state.p, &state.velocity, true)
+    }
+
+    /// Energy `⟨p, v⟩ − L(q, v)` of the current state, with `v` from [`v`](Self::v); an error,
+    /// never NaN, where it is not finite.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run(1000)?;
+    /// // The midpoint rule keeps this quadratic energy exactly, up to round-off.
+    /// assert!((stepper.energy()? - 0.5).abs() < 1e-13);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn energy(&self) -> Result<f64, DiracError> {
+        let Some(state) = self.state else {
+            return Err(DiracError::NotStarted);
+        };
+        self.energy_of(&state, self.steps)
+    }
+
+    /// The energy of `state`, reached after `steps` steps (for the error message).
+    fn energy_of(&self, state: &State<N, E::Manifold>, steps: u64) -> Result<f64, DiracError> {
+        let v = self.velocity_at(state.t, &state.q, &state.p, &state.velocity, true)?;
+        self.energy_at(state, &v, steps)
+    }
+
+    /// The energy of `state` with velocity `v`, reached after `steps` steps; an error where it
+    /// is not finite.
+    fn energy_at(
+        &self,
+        state: &State<N, E::Manifold>,
+        v: &Tangent<E, N>,
+        steps: u64,
+    ) -> Result<f64, DiracError> {
+        let energy = self.equations.energy(&state.q, &state.p, v);
+        if !energy.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: format!("the energy after {steps} steps"),
+                value: energy,
+            });
+        }
+        Ok(energy)
+    }
+
+    /// How Newton's method went on the last step.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let mut stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// assert!(stepper.last_report().is_none());
+    /// stepper.step()?;
+    /// assert!(stepper.last_report().is_some_and(|r| r.iterations <= 3));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn last_report(&self) -> Option<NewtonReport> {
+        self.report
+    }
+
+    /// An empty trajectory with this system's coordinate (and multiplier) columns.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// let trajectory = stepper.trajectory();
+    /// assert!(trajectory.is_empty());
+    /// assert_eq!(trajectory.column_names(), ["t", "q0", "v_q0", "p_q0", "energy"]);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn trajectory(&self) -> Trajectory<N, E::Manifold> {
+        let names = self.coordinate_names();
+        let options = self.newton.options();
+        let model = std::any::type_name::<E::System>();
+        let metadata = Metadata {
+            model: model.rsplit("::").next().unwrap_or(model).to_string(),
+            quadrature: self.equations.method(),
+            h: self.h(),
+            t0: self.state.map_or(self.initial_time, |s| s.t),
+            residual_tolerance: options.residual_tolerance,
+            step_tolerance: options.step_tolerance,
+        };
+        if self.multipliers.is_empty() {
+            Trajectory::new(names)
+        } else {
+            Trajectory::with_multipliers(names, self.equations.multiplier_names())
+        }
+        .expect("one name per coordinate, from coordinate_names")
+        .with_metadata(metadata)
+    }
+
+    /// Coordinate names, from the system.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// # struct Oscillator;
+    /// # impl DiracSystem<1> for Oscillator {
+    /// #     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    /// #         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    /// #     }
+    /// # }
+    /// let stepper = Stepper::new(Oscillator, Quadrature::midpoint(), 0.1)?;
+    /// assert_eq!(stepper.coordinate_names(), ["q0"]);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn coordinate_names(&self) -> Vec<String> {
+        (0..<E::Manifold as Manifold<N>>::VARIABLES)
+            .map(|i| self.equations.coordinate_name(i))
+            .collect()
+    }
+
+    /// Turns a Newton failure into an error naming the step and, if singular, the unknowns.
+    fn failure(&self, which: Problem, failure: NewtonFailure) -> DiracError {
+        let problem = match which {
+            Problem::Step => E::NAME,
+            Problem::Velocity => E::VELOCITY,
+        };
+        let options = self.newton.options();
+        if which == Problem::Step {
+            return failure.into_error(problem, self.steps, options, |column| {
+                self.equations.unknown_name(column)
+            });
+        }
+        match failure {
+            NewtonFailure::NonFinite => DiracError::NonFinite {
+                what: format!(
+                    "the residual of {problem} after {} steps (the velocity iterate left the \
+                     Lagrangian's domain; start_from_momentum_near takes a guess inside it)",
+                    self.steps
+                ),
+                value: f64::NAN,
+            },
+            failure => failure.into_error(problem, self.steps, options, |column| {
+                if column < N {
+                    format!("{} (velocity)", self.equations.coordinate_name(column))
+                } else {
+                    format!("the multiplier of velocity constraint {}", column - N)
+                }
+            }),
+        }
+    }
+}
+
+/// The velocity solves of recorded samples: a simplified Newton solve with the Hessian at the
+/// guess (one Hessian per sample: exact for a Lagrangian quadratic in the velocities), and,
+/// where it fails, a globalised one (line search, no contraction test, at least 50 iterations), both
+/// with the stepper's tolerances.
+#[derive(Debug, Clone)]
+struct VelocitySolver {
+    fast: Newton,
+    globalised: Newton,
+}
+
+impl VelocitySolver {
+    fn new(unknowns: usize, options: &NewtonOptions) -> Result<Self, DiracError> {
+        let fast = NewtonOptions {
+            line_search: false,
+            jacobian_reuse: Some(options.max_contraction.min(1.0)),
+            ..*options
+        };
+        Ok(Self {
+            fast: Newton::new(unknowns, fast)?,
+            globalised: Newton::new(unknowns, velocity_options(options))?,
+        })
+    }
+
+    /// `solve` run by the fast solver, with the Hessian at its guess (none kept from an earlier
+    /// sample), and where that fails by the globalised one, from the same guess.
+    fn solve<T>(
+        &mut self,
+        solve: impl Fn(&mut Newton) -> Result<T, NewtonFailure>,
+    ) -> Result<T, NewtonFailure> {
+        self.fast.forget_jacobian();
+        solve(&mut self.fast).or_else(|_| solve(&mut self.globalised))
+    }
+}
+
+/// The Newton options of a globalised velocity solve: the stepper's, with a line search, no
+/// contraction test and at least 50 iterations.
+fn velocity_options(options: &NewtonOptions) -> NewtonOptions {
+    NewtonOptions {
+        line_search: true,
+        max_contraction: f64::INFINITY,
+        max_iterations: options.max_iterations.max(50),
+        ..*options
+    }
+}

@@ -1,0 +1,16 @@
+//! The continuous model: the traits a model implements (a Lagrangian or a Hamiltonian,
+//! one-forms, holonomic constraints, forces), its derivatives (closed forms from
+//! `#[dirac_system]`, else dual numbers) and its Legendre transform, and models built from
+//! components joined by junctions (interconnection).
+//!
+//! Uses [`base`](crate::base), [`space`](crate::space), [`solve`](crate::solve) and
+//! [`quadrature`](crate::quadrature). A new kind of model term goes here.
+
+pub mod closed_form;
+pub(crate) mod derivatives;
+pub mod hamiltonian_system;
+pub mod interconnection;
+pub mod legendre;
+pub mod repeated;
+pub mod slot;
+pub mod system;

@@ -1,0 +1,453 @@
+//! A block-bordered Jacobian, solved by its diagonal blocks and a Schur complement (see
+//! [`Bordered`]).
+
+use nalgebra::DMatrix;
+use rayon::prelude::*;
+
+use crate::base::error::DiracError;
+use crate::base::float::largest;
+use crate::solve::banded::Banded;
+use crate::solve::jacobian::Jacobian;
+use crate::solve::lu::{self, SingularPivot};
+
+/// A block-bordered Jacobian, solved by its diagonal blocks and a Schur complement.
+///
+/// ```text
+///     ⎡ J_1            E_1 ⎤        J_c   a block's own unknowns (filled per evaluation)
+/// J = ⎢      ⋱          ⋮  ⎥        E_c   how the couplings μ enter block c's rows
+///     ⎢          J_K   E_K ⎥        G_c   how block c's unknowns enter the coupling rows
+///     ⎣ G_1  …   G_K    0  ⎦        (E_c and G_c constant, on the couplings touching c)
+/// ```
+///
+/// `J (x, μ) = (r, s)` is solved by `z_c = J_c⁻¹ r_c`, `Y_c = J_c⁻¹ E_c`, the Schur complement
+/// `S = Σ_c G_c Y_c`, `S μ = Σ_c G_c z_c − s`, and `x_c = z_c − Y_c μ`. Each block is factorised
+/// on its own, so `K` blocks of size `n` cost `O(K n³)`; `S` is a band matrix whose width is the
+/// largest spread of the couplings one block touches (numbered along a chain, a few), so it
+/// costs `O(m b²)` for `m` couplings and half-width `b`. Factorising `S` with partial pivoting
+/// needs every `J_c` regular on its own: a block singular alone (a coordinate that only the
+/// couplings determine) is refused, naming its column.
+///
+/// ```
+/// use dirac_runtime::jacobian::{Bordered, Jacobian};
+/// // Two 1 × 1 blocks coupled by one row x₀ − x₁ (E = Gᵀ).
+/// let mut j = Bordered::new(&[1, 1], &[vec![(0, 0, 1.0)], vec![(0, 0, -1.0)]], &[
+///     vec![(0, 0, 1.0)],
+///     vec![(0, 0, -1.0)],
+/// ])?;
+/// j.matrix()[0][(0, 0)] = 2.0;
+/// j.matrix()[1][(0, 0)] = 4.0;
+/// j.factorise(1e-13).unwrap();
+/// // [[2, 0, 1], [0, 4, −1], [1, −1, 0]] (x₀, x₁, μ) = (3, 3, 0)
+/// let mut b = [3.0, 3.0, 0.0];
+/// j.solve(&mut b);
+/// assert!((b[0] - 1.0).abs() < 1e-15 && (b[1] - 1.0).abs() < 1e-15 && (b[2] - 1.0).abs() < 1e-15);
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Bordered {
+    /// The diagonal blocks `J_c`, filled by the residual's closure.
+    diagonal: Vec<DMatrix<f64>>,
+    blocks: Vec<Block>,
+    /// The number of couplings (the last unknowns and rows).
+    couplings: usize,
+    size: usize,
+    schur: Banded,
+    /// Blocks per parallel task (`usize::MAX`: one after another).
+    grain: usize,
+    /// The coupling rows' absolute sums (scratch of the norm).
+    coupling_sums: Vec<f64>,
+}
+
+/// What a diagonal block keeps beside its matrix.
+#[derive(Debug, Clone)]
+struct Block {
+    /// The first unknown (and row) of the block.
+    offset: usize,
+    /// The couplings that touch the block, ascending.
+    touching: Vec<usize>,
+    /// `E_c`: rows of the block × `touching`.
+    e: DMatrix<f64>,
+    /// `G_c`: `touching` × columns of the block.
+    g: DMatrix<f64>,
+    /// `J_c⁻¹ E_c` after factorising.
+    y: DMatrix<f64>,
+    pivots: Vec<usize>,
+    scales: Vec<f64>,
+}
+
+impl Bordered {
+    /// Blocks of `sizes` unknowns; `rows[c]` lists the entries `(row of block c, coupling,
+    /// value)` of `E_c` and `columns[c]` the entries `(coupling, column of block c, value)` of
+    /// `G_c`. The couplings are the unknowns after the blocks' (as many as the largest coupling
+    /// named, plus one). `Err(Dimension)` where the lists are not one per block, an entry lies
+    /// outside its block, or a coupling has no entry in any `E` or in any `G` (its Schur column
+    /// or row would be zero); `Unsupported` where the Schur complement's band would not fit in
+    /// memory (a coupling of blocks far apart in their order).
+    pub fn new(
+        sizes: &[usize],
+        rows: &[Vec<(usize, usize, f64)>],
+        columns: &[Vec<(usize, usize, f64)>],
+    ) -> Result<Self, DiracError> {
+        let invalid = |why: String| Err(DiracError::Dimension(why));
+        if rows.len() != sizes.len() || columns.len() != sizes.len() {
+            return invalid(format!(
+                "{} blocks with {} lists of E entries and {} of G entries",
+                sizes.len(),
+                rows.len(),
+                columns.len()
+            ));
+        }
+        for (c, &n) in sizes.iter().enumerate() {
+            let outside = |i: usize| i >= n;
+            if rows[c].iter().any(|e| outside(e.0)) || columns[c].iter().any(|g| outside(g.1)) {
+                return invalid(format!("an entry of block {c} outside its {n} unknowns"));
+            }
+        }
+        let couplings = rows
+            .iter()
+            .flatten()
+            .map(|e| e.1 + 1)
+            .chain(columns.iter().flatten().map(|g| g.0 + 1))
+            .max()
+            .unwrap_or(0);
+        let mut offset = 0;
+        let mut spread = 0;
+        let blocks: Vec<Block> = sizes
+            .iter()
+            .enumerate()
+            .map(|(c, &n)| {
+                let mut touching: Vec<usize> = rows[c]
+                    .iter()
+                    .map(|e| e.1)
+                    .chain(columns[c].iter().map(|g| g.0))
+                    .collect();
+                touching.sort_unstable();
+                touching.dedup();
+                if let (Some(first), Some(last)) = (touching.first(), touching.last()) {
+                    spread = spread.max(last - first);
+                }
+                let at = |coupling| touching.binary_search(&coupling).expect("listed");
+                let mut e = DMatrix::zeros(n, touching.len());
+                for &(i, j, v) in &rows[c] {
+                    e[(i, at(j))] += v;
+                }
+                let mut g = DMatrix::zeros(touching.len(), n);
+                for &(j, i, v) in &columns[c] {
+                    g[(at(j), i)] += v;
+                }
+                let block = Block {
+                    offset,
+                    y: DMatrix::zeros(n, touching.len()),
+                    touching,
+                    e,
+                    g,
+                    pivots: vec![0; n],
+                    scales: vec![0.0; n],
+                };
+                offset += n;
+                block
+            })
+            .collect();
+        // Every coupling needs entries in some E (its column) and some G (its row).
+        let (mut in_e, mut in_g) = (vec![false; couplings], vec![false; couplings]);
+        rows.iter().flatten().for_each(|e| in_e[e.1] = true);
+        columns.iter().flatten().for_each(|g| in_g[g.0] = true);
+        if let Some(j) = (0..couplings).find(|&j| !(in_e[j] && in_g[j])) {
+            return invalid(format!(
+                "coupling {j} has no entry in any block's {}: its Schur row or column would be \
+                 zero",
+                if in_e[j] { "G" } else { "E" }
+            ));
+        }
+        Ok(Self {
+            diagonal: sizes.iter().map(|&n| DMatrix::zeros(n, n)).collect(),
+            blocks,
+            couplings,
+            size: offset + couplings,
+            schur: Banded::within_memory(
+                couplings,
+                spread,
+                spread,
+                "the junctions' Schur complement",
+            )?,
+            coupling_sums: vec![0.0; couplings],
+            grain: usize::MAX,
+        })
+    }
+
+    /// Factorises and solves the blocks across rayon's threads, `grain` blocks or more per
+    /// task (`usize::MAX`, the default: one after another). The result is the same bit for bit.
+    pub fn parallel(mut self, grain: usize) -> Self {
+        self.grain = grain.max(1);
+        self
+    }
+
+    /// The half-width of the Schur complement's band.
+    pub fn band(&self) -> usize {
+        self.blocks
+            .iter()
+            .filter_map(|b| Some(b.touching.last()? - b.touching.first()?))
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Where the couplings' unknowns begin.
+    fn first_coupling(&self) -> usize {
+        self.size - self.couplings
+    }
+}
+
+impl Jacobian for Bordered {
+    type Matrix = Vec<DMatrix<f64>>;
+
+    fn size(&self) -> usize {
+        self.size
+    }
+
+    fn matrix(&mut self) -> &mut Vec<DMatrix<f64>> {
+        &mut self.diagonal
+    }
+
+    fn clear(&mut self) {
+        self.diagonal.iter_mut().for_each(|j| j.fill(0.0));
+    }
+
+    fn fits(&self, n: usize) -> bool {
+        n == self.size
+            && self.diagonal.len() == self.blocks.len()
+            && self
+                .diagonal
+                .iter()
+                .zip(&self.blocks)
+                .all(|(j, b)| j.shape() == (b.pivots.len(), b.pivots.len()))
+    }
+
+    fn restore(&mut self, _n: usize) {
+        self.diagonal = self
+            .blocks
+            .iter()
+            .map(|b| DMatrix::zeros(b.pivots.len(), b.pivots.len()))
+            .collect();
+    }
+
+    fn norm(&mut self) -> f64 {
+        // The largest row sum, NaN where a sum is (a NaN entry), as `row_sum_norm`.
+        let mut sums: Vec<f64> = std::mem::take(&mut self.coupling_sums);
+        sums.iter_mut().for_each(|s| *s = 0.0);
+        let mut norm: f64 = 0.0;
+        for (j, block) in self.diagonal.iter().zip(&self.blocks) {
+            let n = j.nrows();
+            let (a, e, g) = (j.as_slice(), block.e.as_slice(), block.g.as_slice());
+            let t = block.touching.len();
+            for i in 0..n {
+                let mut sum = 0.0;
+                for k in 0..n {
+                    sum += a[i + k * n].abs();
+                }
+                for c in 0..t {
+                    sum += e[i + c * n].abs();
+                }
+                norm = largest([norm, sum]);
+            }
+            for (c, &coupling) in block.touching.iter().enumerate() {
+                for k in 0..n {
+                    sums[coupling] += g[c + k * t].abs();
+                }
+            }
+        }
+        for &sum in &sums {
+            norm = largest([norm, sum]);
+        }
+        self.coupling_sums = sums;
+        norm
+    }
+
+    fn is_finite(&self) -> bool {
+        self.diagonal
+            .iter()
+            .all(|j| j.iter().all(|v| v.is_finite()))
+    }
+
+    fn factorise(&mut self, tolerance: f64) -> Result<(), SingularPivot> {
+        let factorise = |(j, block): (&mut DMatrix<f64>, &mut Block)| {
+            lu::factorise(j, &mut block.pivots, &mut block.scales, tolerance).map_err(|p| {
+                SingularPivot {
+                    column: block.offset + p.column,
+                    involved: p.involved.iter().map(|i| block.offset + i).collect(),
+                }
+            })?;
+            block.y.copy_from(&block.e);
+            let n = j.nrows();
+            for column in block.y.as_mut_slice().chunks_exact_mut(n.max(1)) {
+                lu::solve(j, &block.pivots, column);
+            }
+            Ok(())
+        };
+        // The first singular block (by column) whichever thread met it.
+        let first = |a: Result<(), SingularPivot>, b: Result<(), SingularPivot>| match (a, b) {
+            (Err(a), Err(b)) => Err(if a.column <= b.column { a } else { b }),
+            (Err(e), Ok(())) | (Ok(()), Err(e)) => Err(e),
+            (Ok(()), Ok(())) => Ok(()),
+        };
+        if self.grain < self.blocks.len() {
+            self.diagonal
+                .par_iter_mut()
+                .zip(self.blocks.par_iter_mut())
+                .with_min_len(self.grain)
+                .map(factorise)
+                .reduce(|| Ok(()), first)?;
+        } else {
+            let pairs = self.diagonal.iter_mut().zip(self.blocks.iter_mut());
+            pairs.map(factorise).try_for_each(|r| r)?;
+        }
+        // Σ_c G_c Y_c into the Schur complement, without a temporary.
+        self.schur.clear();
+        for block in &self.blocks {
+            let n = block.y.nrows();
+            for (a, &row) in block.touching.iter().enumerate() {
+                for (b, &column) in block.touching.iter().enumerate() {
+                    let mut entry = 0.0;
+                    for i in 0..n {
+                        entry += block.g[(a, i)] * block.y[(i, b)];
+                    }
+                    self.schur.add(row, column, entry);
+                }
+            }
+        }
+        let first = self.first_coupling();
+        self.schur.factorise(tolerance).map_err(|p| SingularPivot {
+            column: first + p.column,
+            involved: p.involved.iter().map(|j| first + j).collect(),
+        })
+    }
+
+    fn solve(&self, b: &mut [f64]) {
+        let first = self.first_coupling();
+        let (own, coupling) = b.split_at_mut(first);
+        let (diagonal, blocks, grain) = (&self.diagonal, &self.blocks, self.grain);
+        each_block(diagonal, blocks, own, grain, &|j, block, z| {
+            lu::solve(j, &block.pivots, z)
+        });
+        // s − Σ G_c z_c, negated.
+        for block in blocks {
+            let z = &own[block.offset..block.offset + block.y.nrows()];
+            for (a, &c) in block.touching.iter().enumerate() {
+                let g = block.g.row(a);
+                coupling[c] -= g.iter().zip(z).map(|(g, z)| g * z).sum::<f64>();
+            }
+        }
+        coupling.iter_mut().for_each(|v| *v = -*v);
+        self.schur.solve(coupling);
+        // x_c = z_c − Y_c μ: a few operations a block, not worth a parallel pass.
+        for block in blocks {
+            let z = &mut own[block.offset..block.offset + block.y.nrows()];
+            for (a, &c) in block.touching.iter().enumerate() {
+                for (i, zi) in z.iter_mut().enumerate() {
+                    *zi -= block.y[(i, a)] * coupling[c];
+                }
+            }
+        }
+    }
+}
+
+/// Applies `f` to each block with its rows of `b` (which begins at the first block's rows),
+/// halving the blocks across rayon's threads while more than `grain` remain.
+fn each_block<F>(diagonal: &[DMatrix<f64>], blocks: &[Block], b: &mut [f64], grain: usize, f: &F)
+where
+    F: Fn(&DMatrix<f64>, &Block, &mut [f64]) + Sync,
+{
+    let Some(start) = blocks.first().map(|block| block.offset) else {
+        return;
+    };
+    if blocks.len() <= grain {
+        for (j, block) in diagonal.iter().zip(blocks) {
+            let at = block.offset - start;
+            f(j, block, &mut b[at..at + j.nrows()]);
+        }
+        return;
+    }
+    let mid = blocks.len() / 2;
+    let (left, right) = b.split_at_mut(blocks[mid].offset - start);
+    rayon::join(
+        || each_block(&diagonal[..mid], &blocks[..mid], left, grain, f),
+        || each_block(&diagonal[mid..], &blocks[mid..], right, grain, f),
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solve::jacobian::Dense;
+    use nalgebra::DVector;
+
+    /// A chain of `k` blocks of `n` unknowns, coupling `i` joining the last unknown of block `i`
+    /// to the first of block `i + 1` (`E = σ Gᵀ`), with nonsymmetric blocks.
+    fn chain(k: usize, n: usize) -> (Bordered, Dense) {
+        let mut rows = vec![Vec::new(); k];
+        let mut columns = vec![Vec::new(); k];
+        for i in 0..k - 1 {
+            rows[i].push((n - 1, i, 0.5));
+            columns[i].push((i, n - 1, 1.0));
+            rows[i + 1].push((0, i, -0.5));
+            columns[i + 1].push((i, 0, -1.0));
+        }
+        let mut bordered = Bordered::new(&vec![n; k], &rows, &columns).unwrap();
+        let size = bordered.size();
+        let mut dense = Dense::new(size);
+        for (c, j) in bordered.matrix().iter_mut().enumerate() {
+            for r in 0..n {
+                for s in 0..n {
+                    let v = ((3 * c + 5 * r + 7 * s) % 11) as f64 - 5.0
+                        + if r == s { 9.0 } else { 0.0 };
+                    j[(r, s)] = v;
+                    dense.matrix()[(c * n + r, c * n + s)] = v;
+                }
+            }
+        }
+        for (c, (rows, columns)) in rows.iter().zip(&columns).enumerate() {
+            for &(i, j, v) in rows {
+                dense.matrix()[(c * n + i, k * n + j)] = v;
+            }
+            for &(j, i, v) in columns {
+                dense.matrix()[(k * n + j, c * n + i)] = v;
+            }
+        }
+        (bordered, dense)
+    }
+
+    #[test]
+    fn solves_and_measures_as_the_dense_matrix() {
+        for (k, n) in [(2, 1), (5, 3), (12, 2)] {
+            let (mut bordered, mut dense) = chain(k, n);
+            assert_eq!(bordered.norm(), dense.norm());
+            assert_eq!(bordered.band(), usize::from(k > 2));
+            bordered.factorise(1e-13).unwrap();
+            dense.factorise(1e-13).unwrap();
+            let b = DVector::from_fn(bordered.size(), |i, _| (i as f64).sin());
+            let (mut x, mut y) = (b.clone(), b.clone());
+            bordered.solve(x.as_mut_slice());
+            dense.solve(y.as_mut_slice());
+            assert!((&x - &y).amax() < 1e-13 * y.amax(), "k {k}, n {n}");
+        }
+    }
+
+    #[test]
+    fn malformed_borders_are_refused() {
+        let one = vec![(0, 0, 1.0)];
+        let twice = [one.clone(), one.clone()];
+        assert!(Bordered::new(&[1, 1], std::slice::from_ref(&one), &twice).is_err());
+        // A row index outside its block; a coupling without a G entry.
+        assert!(Bordered::new(&[1], &[vec![(1, 0, 1.0)]], std::slice::from_ref(&one)).is_err());
+        assert!(Bordered::new(&[1], std::slice::from_ref(&one), &[Vec::new()]).is_err());
+        assert!(
+            Bordered::new(&[1], std::slice::from_ref(&one), std::slice::from_ref(&one)).is_ok()
+        );
+    }
+
+    #[test]
+    fn a_block_singular_alone_names_its_column() {
+        let (mut bordered, _) = chain(3, 2);
+        bordered.matrix()[1].fill(0.0);
+        assert_eq!(bordered.factorise(1e-13).unwrap_err().column, 2);
+    }
+}

@@ -1,0 +1,291 @@
+//! The seam between a discretisation and the [`Stepper`](crate::Stepper): the equations of one
+//! step, their unknowns, and how a solution advances the state.
+//!
+//! A step from the [`State`] `(t_k, q_k, p_k)` is a square system `F(x) = 0` in unknowns `x`
+//! whose layout belongs to the equations. The stepper asks the equations for a predictor, hands
+//! [`assemble`](StepEquations::assemble) to Newton's method, and, once Newton has accepted a
+//! root, asks [`advance`](StepEquations::advance) for the next state. It never looks inside `x`:
+//! the discrete Euler–Lagrange equations ([`EulerLagrange`](crate::step::euler_lagrange::EulerLagrange))
+//! are one implementation; the discrete Hamiltonian route and interconnected systems are others.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::base::error::DiracError;
+use crate::solve::newton::{Newton, NewtonFailure};
+use crate::space::manifold::Manifold;
+use crate::step::dense_output::Sample;
+use crate::step::step_derivatives::StepDerivatives;
+
+pub use crate::discrete::state::State;
+
+/// The point type of the step equations `E` (on `Rⁿ`, `SVector<f64, N>`).
+pub type Point<E, const N: usize> = <<E as StepEquations<N>>::Manifold as Manifold<N>>::Point<f64>;
+
+/// The tangent vector (and covector) type of the step equations `E`.
+pub type Tangent<E, const N: usize> =
+    <<E as StepEquations<N>>::Manifold as Manifold<N>>::Tangent<f64>;
+
+/// The equations of one step of an integrator on a state of `N` coordinates.
+///
+/// Implemented by [`EulerLagrange`](crate::step::euler_lagrange::EulerLagrange); a
+/// [`Stepper`](crate::Stepper) drives any implementation ([`Stepper::with_equations`]) with the
+/// same Newton solve, error handling, trajectories and guarantees (a failed step changes
+/// nothing). `tests/suite/step_equations.rs` drives the implicit midpoint rule of a Hamiltonian this
+/// way. The guarantee holds as long as `predict` and `assemble` keep only per-step scratch in
+/// `&mut self`: anything that must survive a step belongs in the [`State`].
+///
+/// [`Stepper::with_equations`]: crate::Stepper::with_equations
+pub trait StepEquations<const N: usize> {
+    /// The model the equations discretise.
+    type System;
+
+    /// The points and tangent vectors of the model's configuration.
+    type Manifold: Manifold<N>;
+
+    /// The model.
+    fn system(&self) -> &Self::System;
+
+    /// What the equations are, for error messages ("the discrete Euler–Lagrange equations").
+    const NAME: &'static str;
+    /// What the velocity solve is, for error messages.
+    const VELOCITY: &'static str;
+
+    /// The step size.
+    fn h(&self) -> f64;
+
+    /// The method, for a trajectory's metadata (by default [`NAME`](Self::NAME)).
+    fn method(&self) -> String {
+        Self::NAME.to_string()
+    }
+
+    /// Number of unknowns of a step (read again after [`begin`](Self::begin): it may depend on
+    /// what the equations find at the start of a run).
+    fn unknowns(&self) -> usize;
+
+    /// Number of multipliers among the unknowns (constraint impulses).
+    fn multipliers(&self) -> usize;
+
+    /// Names of the multipliers, for trajectories.
+    fn multiplier_names(&self) -> Vec<String>;
+
+    /// The name of coordinate `i`.
+    fn coordinate_name(&self, i: usize) -> String;
+
+    /// Checks that `state` is a valid initial state (finite, in the model's domain, consistent
+    /// with its constraints to the relative `tolerance`, which the stepper scales to its solver
+    /// tolerance): the error says what is violated.
+    fn check_start(
+        &self,
+        state: &State<N, Self::Manifold>,
+        tolerance: f64,
+    ) -> Result<(), DiracError>;
+
+    /// Called once a checked `state` becomes the start of a run, before its first step: what the
+    /// equations find out about the model there (e.g. which coordinates carry no kinetic
+    /// energy) they keep for the run.
+    fn begin(&mut self, state: &State<N, Self::Manifold>) {
+        let _ = state;
+    }
+
+    /// Whether the chart of a step from `to` continues that of a step from `from` (see
+    /// [`ConfigurationSpace::charts_continue`](crate::space::configuration_space::ConfigurationSpace::charts_continue)):
+    /// where it does not, the stepper predicts the next step afresh rather than from the last
+    /// solutions. Always, by default.
+    fn charts_continue(
+        &self,
+        from: &<Self::Manifold as Manifold<N>>::Point<f64>,
+        to: &<Self::Manifold as Manifold<N>>::Point<f64>,
+    ) -> bool {
+        let _ = (from, to);
+        true
+    }
+
+    /// Prepares the step from `state` and writes the predictor into `x`. `previous` holds the
+    /// stepper's prediction from the accepted steps, when there is one: the last solution, or
+    /// the last two or three extrapolated (the line `2 x_k − x_{k−1}`, the parabola
+    /// `3 x_k − 3 x_{k−1} + x_{k−2}`; not across a start or a change of inputs).
+    fn predict(
+        &mut self,
+        state: &State<N, Self::Manifold>,
+        previous: Option<&DVector<f64>>,
+        x: &mut DVector<f64>,
+    );
+
+    /// Writes the residual `F(x)` and, when one is asked for, adds its Jacobian into
+    /// `jacobian` (zeroed by the caller; Newton asks only when a Jacobian is due, see
+    /// [`Newton::solve`]); returns the size of the terms summed into the residual (its round-off
+    /// floor is a few ulps of this). What [`advance`](Self::advance) needs must not depend on
+    /// whether the Jacobian was asked for.
+    fn assemble(
+        &mut self,
+        state: &State<N, Self::Manifold>,
+        x: &DVector<f64>,
+        residual: &mut DVector<f64>,
+        jacobian: Option<&mut DMatrix<f64>>,
+    ) -> f64;
+
+    /// What assembling with the Jacobian costs against assembling the residual alone: Newton
+    /// keeps a Jacobian across iterations and steps the longer, the more it costs (see
+    /// [`Newton::solve`]). By default 1 (Newton's method).
+    fn jacobian_cost(&self) -> f64 {
+        1.0
+    }
+
+    /// The state after the step from `state` solved by `x` (the point assembled last), without
+    /// its time. `step` counts the steps before this one, for error messages.
+    fn advance(
+        &self,
+        state: &State<N, Self::Manifold>,
+        x: &DVector<f64>,
+        step: u64,
+    ) -> Result<State<N, Self::Manifold>, DiracError>;
+
+    /// The constraint violation of the step from `from` to `to` that `x` solved (`to` as
+    /// [`advance`](Self::advance) returned it): 0 for equations without constraints. A
+    /// [`Stepper`](crate::Stepper) measures it only when asked
+    /// ([`Stepper::constraint_violation`](crate::Stepper::constraint_violation), a recorded
+    /// sample), so a step does not pay for it; it must therefore depend on nothing but its
+    /// arguments and the equations' settings.
+    fn violation(
+        &self,
+        from: &State<N, Self::Manifold>,
+        to: &State<N, Self::Manifold>,
+        x: &DVector<f64>,
+    ) -> f64;
+
+    /// Where in `x` the multipliers are: they are `x[first..first + multipliers()]`.
+    fn first_multiplier(&self) -> usize;
+
+    /// The name of unknown `column` of a step (a coordinate of a point of the step, or a
+    /// multiplier).
+    fn unknown_name(&self, column: usize) -> String;
+
+    /// Number of unknowns of the velocity solve (`N` unless the velocity comes with
+    /// multipliers).
+    fn velocity_unknowns(&self) -> usize {
+        N
+    }
+
+    /// The velocity of a state of the running run (after [`begin`](Self::begin)): the
+    /// equations may rely on what they found when it began. By default,
+    /// [`velocity`](Self::velocity).
+    fn velocity_in_run(
+        &self,
+        newton: &mut Newton,
+        t: f64,
+        q: &Point<Self, N>,
+        p: &Tangent<Self, N>,
+        guess: &Tangent<Self, N>,
+    ) -> Result<Tangent<Self, N>, NewtonFailure> {
+        self.velocity(newton, t, q, p, guess)
+    }
+
+    /// [`velocity_in_run`](Self::velocity_in_run) with the energy at the velocity found, where
+    /// the solve gives it on its way with the numbers [`energy`](Self::energy) would (`None`:
+    /// the caller asks `energy`). By default `None`.
+    fn velocity_and_energy_in_run(
+        &self,
+        newton: &mut Newton,
+        t: f64,
+        q: &Point<Self, N>,
+        p: &Tangent<Self, N>,
+        guess: &Tangent<Self, N>,
+    ) -> Result<(Tangent<Self, N>, Option<f64>), NewtonFailure> {
+        self.velocity_in_run(newton, t, q, p, guess)
+            .map(|v| (v, None))
+    }
+
+    /// The velocity at `(q, p)` at time `t`, solved from `guess` by `newton` (sized for
+    /// [`velocity_unknowns`](Self::velocity_unknowns)) where it is implicit.
+    fn velocity(
+        &self,
+        newton: &mut Newton,
+        t: f64,
+        q: &Point<Self, N>,
+        p: &Tangent<Self, N>,
+        guess: &Tangent<Self, N>,
+    ) -> Result<Tangent<Self, N>, NewtonFailure>;
+
+    /// The momentum `∂L/∂v` at position `q` with velocity `v`, for a start from a velocity; an
+    /// error names the first of the position, the velocity and the momentum that is not finite.
+    fn momentum(
+        &self,
+        q: &Point<Self, N>,
+        v: &Tangent<Self, N>,
+    ) -> Result<Tangent<Self, N>, DiracError>;
+
+    /// Fails naming the first of the position `q`, the momentum `p` and the velocity guess that
+    /// is not finite (a start from a momentum).
+    fn check_finite(
+        &self,
+        q: &Point<Self, N>,
+        p: &Tangent<Self, N>,
+        guess: &Tangent<Self, N>,
+    ) -> Result<(), DiracError> {
+        let point = <Self::Manifold as Manifold<N>>::point_components(q);
+        let tangent = <Self::Manifold as Manifold<N>>::tangent_components;
+        [
+            ("initial position", point),
+            ("initial momentum", tangent(p)),
+            ("velocity guess", tangent(guess)),
+        ]
+        .into_iter()
+        .find_map(|(what, values)| {
+            let value = values.into_iter().find(|x| !x.is_finite())?;
+            Some(DiracError::NonFinite {
+                what: what.into(),
+                value,
+            })
+        })
+        .map_or(Ok(()), Err)
+    }
+
+    /// Current values of the model's inputs (none by default).
+    fn inputs(&self) -> &[f64] {
+        &[]
+    }
+
+    /// The inputs' values, to be set (in range and finite: the stepper checks them).
+    fn inputs_mut(&mut self) -> &mut [f64] {
+        &mut []
+    }
+
+    /// The name of input `i`.
+    fn input_name(&self, i: usize) -> String {
+        format!("u{i}")
+    }
+
+    /// Dense output: the solution at fraction `theta ∈ [0, 1]` of the step between `ends` (the
+    /// state it started from and the one it reached, with their exact velocities) solved by `x`
+    /// (see [`dense_output`](crate::step::dense_output)). `None` where the equations have no path to
+    /// interpolate (the default): the stepper then refuses dense output with `Unsupported`.
+    fn dense(
+        &self,
+        ends: [&Sample<N, Self::Manifold>; 2],
+        x: &DVector<f64>,
+        theta: f64,
+    ) -> Option<Sample<N, Self::Manifold>> {
+        let _ = (ends, x, theta);
+        None
+    }
+
+    /// The energy at position `q` with velocity `v` and momentum `p`.
+    fn energy(&self, q: &Point<Self, N>, p: &Tangent<Self, N>, v: &Tangent<Self, N>) -> f64;
+
+    /// The derivatives of the step from `state` solved by `x` (the point assembled last) with
+    /// respect to `(q_k, p_k)` and the inputs `u`; `newton` must hold the Jacobian factorised at
+    /// `x`, the root of its last solve ([`Newton::factorise_at`]; otherwise an error). The
+    /// default refuses: equations that can differentiate their step override it.
+    fn linearise(
+        &self,
+        state: &State<N, Self::Manifold>,
+        x: &DVector<f64>,
+        newton: &Newton,
+    ) -> Result<StepDerivatives<N>, DiracError> {
+        let _ = (state, x, newton);
+        Err(DiracError::Unsupported(format!(
+            "derivatives of the step map of {}",
+            Self::NAME
+        )))
+    }
+}

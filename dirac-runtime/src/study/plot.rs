@@ -1,0 +1,153 @@
+//! Line charts drawn to PNG (feature `plot`) by plotters' pure-Rust bitmap backend with the
+//! bundled DejaVu Sans (Bitstream Vera licence): no system font library is needed. The tour's
+//! figures and the work–precision charts use them.
+//!
+//! ```
+//! use dirac_runtime::plot::{Series, line_chart};
+//! let parabola = Series {
+//!     label: "x²".into(),
+//!     points: (0..=10).map(|i| (i as f64, (i * i) as f64)).collect(),
+//! };
+//! let path = std::env::temp_dir().join("dirac_plot_example.png");
+//! line_chart(&path, "a parabola", ("x", "x²"), &[parabola])?;
+//! assert!(std::fs::metadata(&path)?.len() > 1000);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::path::Path;
+use std::sync::Once;
+
+use plotters::prelude::*;
+
+use crate::base::error::DiracError;
+
+/// One labelled curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// The legend's label.
+    pub label: String,
+    /// The points, in drawing order (non-finite ones are left out).
+    pub points: Vec<(f64, f64)>,
+}
+
+impl Series {
+    /// One series per label, in order of first appearance, each series' points sorted by `x`.
+    ///
+    /// ```
+    /// use dirac_runtime::plot::Series;
+    /// let lines = Series::by_label([("a", (2.0, 1.0)), ("b", (0.0, 0.0)), ("a", (1.0, 3.0))]);
+    /// assert_eq!(lines[0].label, "a");
+    /// assert_eq!(lines[0].points, vec![(1.0, 3.0), (2.0, 1.0)]);
+    /// assert_eq!(lines[1].points, vec![(0.0, 0.0)]);
+    /// ```
+    pub fn by_label<L: AsRef<str>>(
+        points: impl IntoIterator<Item = (L, (f64, f64))>,
+    ) -> Vec<Series> {
+        let mut series: Vec<Series> = Vec::new();
+        for (label, point) in points {
+            let label = label.as_ref();
+            match series.iter_mut().find(|s| s.label == label) {
+                Some(line) => line.points.push(point),
+                None => series.push(Series {
+                    label: label.to_string(),
+                    points: vec![point],
+                }),
+            }
+        }
+        for line in &mut series {
+            line.points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
+        series
+    }
+}
+
+/// Makes the bundled font available as "sans-serif" (once per process).
+fn register_font() -> Result<(), DiracError> {
+    static REGISTER: Once = Once::new();
+    let mut result = Ok(());
+    REGISTER.call_once(|| {
+        let bytes: &'static [u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+        if plotters::style::register_font("sans-serif", FontStyle::Normal, bytes).is_err() {
+            result = Err(DiracError::Io("the bundled font could not be read".into()));
+        }
+    });
+    result
+}
+
+/// Draws `series` as lines on one chart, 900×600, with a legend, to the PNG file `path` (its
+/// directory created if needed). An error when nothing is finite or the file cannot be written.
+pub fn line_chart(
+    path: impl AsRef<Path>,
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    series: &[Series],
+) -> Result<(), DiracError> {
+    let path = path.as_ref();
+    register_font()?;
+    draw(path, title, (x_label, y_label), series)
+        .map_err(|e| DiracError::Io(format!("{}: {e}", path.display())))
+}
+
+fn draw(
+    path: &Path,
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    series: &[Series],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let points = series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|(x, y)| x.is_finite() && y.is_finite());
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &(x, y) in points {
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    }
+    if x0 >= x1 || !x0.is_finite() {
+        return Err("nothing to draw".into());
+    }
+    let pad = 0.05 * (y1 - y0).max(1e-12);
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)?;
+    }
+    let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 24))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .label_style(("sans-serif", 15))
+        .draw()?;
+    for (k, s) in series.iter().enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        let finite = s
+            .points
+            .iter()
+            .cloned()
+            .filter(|(x, y)| x.is_finite() && y.is_finite());
+        chart
+            .draw_series(LineSeries::new(finite, color.stroke_width(2)))?
+            .label(s.label.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 15))
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
