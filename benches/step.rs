@@ -1,7 +1,7 @@
 //! One step of the generated stepper against the hand-written limit, and how the cost grows.
 //!
 //! `cargo bench --bench step`. Compare figures within one run only: the ratio generated / hand is
-//! what the README reports.
+//! what `docs/performance.md` reports (`scripts/performance.sh` writes it from this bench).
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};

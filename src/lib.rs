@@ -22,7 +22,8 @@
 //! # Ok::<(), DiracError>(())
 //! ```
 //!
-//! See the crate README for the attribute's syntax, the quadratures and their measured orders.
+//! The attribute's syntax is in `docs/syntax.md`, the quadratures and their measured orders in
+//! `docs/mathematics.md`.
 
 pub use dirac_macros::dirac_system;
 pub use dirac_runtime::*;

@@ -94,8 +94,7 @@ fn recording_allocates_nothing_per_sample() {
 /// midpoint and at the Gauss nodes, SHAKE, a Galerkin step with internal points, and the LC
 /// circuit's hidden constraint checked at each midpoint step's end. (A projection that moves
 /// `q`, as under Galerkin rules, which hold the hidden constraint at their nodes only, and
-/// hidden constraints not fixed along the motion still allocate; see the README's performance
-/// section.)
+/// hidden constraints not fixed along the motion still allocate.)
 #[test]
 fn constrained_and_galerkin_steps_allocate_nothing() {
     fn after_a_step<S: DiracSystem<N>, const N: usize>(

@@ -9,7 +9,7 @@
 //! ```
 //!
 //! The midpoint rule is degree 1 with the 1-point Gauss–Legendre rule, the trapezoid rule degree 1
-//! with the 2-point Gauss–Lobatto rule. Measured orders are in the README and asserted in
+//! with the 2-point Gauss–Lobatto rule. Measured orders are in `docs/mathematics.md` and asserted in
 //! `tests/suite/convergence.rs`.
 
 use nalgebra::SVector;

@@ -1,6 +1,6 @@
 //! Components written once: circuit elements and mechanical parts, each an ordinary
 //! `#[dirac_system]` model, joined into larger models by
-//! [`Interconnection`](dirac::interconnection::Interconnection) (`circuit.rs`, `port.rs`).
+//! [`dirac::interconnection::Interconnection`] (`circuit.rs`, `port.rs`).
 //! Each element's coordinate is its charge (electrical) or its position (mechanical); a
 //! two-terminal mechanical part has one coordinate per end.
 

@@ -1,4 +1,4 @@
-//! The scenes with known answers (DESIGN.md), shared by the examples, the tour, the tests and the
+//! The scenes with known answers (`docs/scenes.md`), shared by the examples, the tour, the tests and the
 //! benches so that each model is written once.
 #![allow(dead_code)]
 

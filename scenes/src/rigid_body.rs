@@ -222,8 +222,8 @@ pub fn reference(
     with_wheel(top, 0.0, r0, omega0, t_end, tolerance)
 }
 
-/// [`reference`] with a flywheel of inertia `wheel` on the third body axis (see
-/// [`QuaternionOde`]); the momentum returned is `J Ω` with `J` the body's and the wheel's.
+/// [`reference()`] with a flywheel of inertia `wheel` on the third body axis (see
+/// `QuaternionOde`); the momentum returned is `J Ω` with `J` the body's and the wheel's.
 pub fn with_wheel(
     top: &HeavyTop,
     wheel: f64,

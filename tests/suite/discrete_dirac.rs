@@ -1,5 +1,5 @@
 //! Discrete Dirac mechanics: constraint one-forms, holonomic constraints, degenerate Lagrangians,
-//! forces and inputs, on the scenes with known answers (DESIGN.md).
+//! forces and inputs, on the scenes with known answers (`docs/scenes.md`).
 
 use crate::support;
 

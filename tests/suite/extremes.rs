@@ -2,7 +2,7 @@
 //! far beyond the resolved step, near singular mass matrices, with tiny and huge steps, and over a
 //! million steps. Each case asserts either a bounded answer or a refusal with a named error;
 //! never an `Ok` that is wrong. `cargo test --test suite extremes -- --nocapture` prints the table the
-//! README quotes.
+//! `docs/mathematics.md` quotes.
 
 use dirac::prelude::*;
 use scenes::double_pendulum::{self, DoublePendulum};
@@ -18,7 +18,7 @@ struct Spring {
 
 const STIFF: Spring = Spring { m: 1.0, k: 1e8 };
 
-/// Every quadrature the README lists.
+/// Every quadrature the library offers.
 fn quadratures() -> Vec<Quadrature> {
     let mut all = scenes::quadratures();
     all.push(Quadrature::galerkin_with_rule(2, Rule::GaussLobatto(3)).unwrap());
@@ -141,7 +141,7 @@ fn a_million_unresolved_stiff_steps_keep_the_energy() {
 /// `UntrustedStep`: Newton would reach a root only through non-contracting updates (the far root
 /// galerkin(2) took before the root-acceptance rule). The trapezoid rule steps through the
 /// aligned configuration with a bounce the Lagrangian does not determine, and is refused a few
-/// dozen steps later; that limitation is stated in the README.
+/// dozen steps later; that limitation is stated in the README (Not supported yet).
 #[test]
 fn a_massless_bob_is_followed_to_the_singularity_and_refused_there() {
     let model = DoublePendulum {

@@ -1,4 +1,4 @@
-//! Known answers from DESIGN.md.
+//! Known answers from `docs/scenes.md`.
 
 use dirac::prelude::*;
 use scenes::hand_written::{Galerkin2, HandEquations, HandStepper, KnifeEdgeMidpoint, Midpoint};

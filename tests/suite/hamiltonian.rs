@@ -488,7 +488,7 @@ fn a_holonomic_constraint_is_held_and_the_lagrangian_routes_steps_are_taken() {
         assert!(violation < 1e-13, "{}: {violation}", quadrature.name());
         assert!(worst < 1e-11, "{}: {worst}", quadrature.name());
     }
-    // The order against the pendulum's q(5) (the DESIGN scene): 2 and 4.
+    // The order against the pendulum's q(5) (`docs/scenes.md`): 2 and 4.
     for (quadrature, order) in [
         (Quadrature::midpoint(), 2.0),
         (Quadrature::galerkin(2).unwrap(), 4.0),

@@ -1,7 +1,7 @@
 //! The vector and matrix algebra of Lagrangians on rotations and unit vectors, checked against
 //! the documented mathematics written out by hand in plain `f64` nalgebra code.
 //!
-//! Conventions (README, "Rotations and unit vectors"): `R: SO3` is the attitude (body to space
+//! Conventions (`docs/mathematics.md`, "Rotations and unit vectors"): `R: SO3` is the attitude (body to space
 //! axes), `omega(R)` the body angular velocity `Ω` with `Ṙ = R Ω̂` (`Ω̂ y = Ω × y`), `dot(R)` the
 //! matrix `R Ω̂`; `n: S2` is a unit vector, `dot(n)` its velocity `ṅ`, `omega(n) = n × ṅ`.
 //! A parameter `p: [[f64; 3]; 3]` is the matrix whose row `i`, column `j` is `p[i][j]` (so `p[i]`

@@ -221,7 +221,7 @@ impl Modular {
     /// Whether the components are assembled, factorised, solved and advanced in parallel
     /// (rayon); by default not. The steps are the same bit for bit. On a 2-core machine it paid
     /// 1.26× once on 10 000 tethered masses and nothing in another run, and cost more below
-    /// thousands of components (see the README's cost table): each step makes about seven
+    /// thousands of components (see the `modular_step` table of `docs/performance.md`): each step makes about seven
     /// parallel passes, and a pass costs tens of microseconds.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = Some(parallel);
