@@ -26,10 +26,6 @@ const GROUPS: &[(&str, &str)] = &[
         "One double-pendulum step (h = 0.01) for each quadrature.",
     ),
     (
-        "chain_step",
-        "One step of the n-link chain in reduced coordinates, by number of links.",
-    ),
-    (
         "chain_trep_scene",
         "The n-link chain of trep's benchmark, by number of links (trep's own times come from its \
          scripts, run beside the bench).",
@@ -74,8 +70,15 @@ const GROUPS: &[(&str, &str)] = &[
 const PAIRS: &[(&str, &str)] = &[
     ("generated", "hand_written"),
     ("modular", "monolithic"),
+    ("modular", "one_model"),
     ("hamiltonian", "lagrangian"),
     ("run", "step_loop"),
+];
+
+/// Groups whose every benchmark is divided by one of them.
+const BASELINES: &[(&str, &str)] = &[
+    ("pendulum_3d_step", "hand_written_lgvi"),
+    ("interconnection_step", "lc_monolithic"),
 ];
 
 /// One criterion result: its id within the group and the median time with its 95 % interval, ns.
@@ -189,7 +192,7 @@ fn write(groups: &BTreeMap<String, Vec<Result>>, study: Option<String>) -> Strin
          within a table, where every figure comes from the same run. The bench profile uses \
          `codegen-units = 1` and `lto = \"fat\"`. A ratio divides the first of a pair by its \
          twin (generated / hand-written, modular / monolithic, Hamiltonian / Lagrangian, run / \
-         step loop).\n"
+         step loop) or a benchmark by its group's baseline.\n"
     );
     let described = |name: &str| GROUPS.iter().find(|(g, _)| *g == name).map(|(_, d)| *d);
     let mut names: Vec<&String> = groups.keys().collect();
@@ -219,7 +222,20 @@ fn write(groups: &BTreeMap<String, Vec<Result>>, study: Option<String>) -> Strin
             );
         }
         let mut ratios = String::new();
+        let baseline = BASELINES
+            .iter()
+            .find(|(g, _)| g == name)
+            .and_then(|(_, id)| sorted.iter().find(|r| r.id == *id));
         for r in &sorted {
+            if let Some(d) = baseline.filter(|d| d.id != r.id) {
+                let _ = writeln!(
+                    ratios,
+                    "| {} / {} | {:.2} |",
+                    r.id,
+                    d.id,
+                    r.median / d.median
+                );
+            }
             for (from, to) in PAIRS {
                 let Some(other) = twin(&r.id, from, to) else {
                     continue;
@@ -252,8 +268,12 @@ fn write(groups: &BTreeMap<String, Vec<Result>>, study: Option<String>) -> Strin
     }
     let _ = writeln!(
         out,
-        "\n## Reproduce\n\n```text\nscripts/performance.sh            # every bench, then the \
-         study, then this file\nscripts/performance.sh --no-study # the benches only\n```"
+        "\n## Reproduce\n\n```text\nscripts/performance.sh             # every bench, then the \
+         study, then this file\nscripts/performance.sh --no-study  # the benches only\n\
+         cargo test --test allocation       # allocations per step and per recorded sample\n\
+         cargo run --release --example long_run   # ten million pendulum steps\n\
+         cargo run --release --example ensemble   # ensembles across cores\n\
+         scripts/compile_times.sh           # build times of 100 to 10 000-term models\n```"
     );
     out
 }

@@ -2,20 +2,23 @@
 # Renews docs/performance.md from one bench run: every criterion bench of `benches/step.rs`, then
 # (unless --no-study) the work–precision study, then `examples/performance.rs`, which writes the
 # tables from target/criterion and output/work_precision/summary.md.
-# Usage: scripts/performance.sh [--no-study] [CRITERION FILTER...]
+# Usage: scripts/performance.sh [--no-study]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 study=yes
-if [ "${1:-}" = --no-study ]; then
-    study=no
-    shift
-fi
-# One run: results of earlier runs must not mix into the tables.
-rm -rf target/criterion
-cargo bench --bench step -- "$@"
-summary=()
+case "${1:-}" in
+    "") ;;
+    --no-study) study=no ;;
+    *) echo "usage: $0 [--no-study]" >&2; exit 2 ;;
+esac
+criterion="${CARGO_TARGET_DIR:-target}/criterion"
+# One run of every bench: results of earlier runs must not mix into the tables.
+rm -rf "$criterion"
+cargo bench --bench step
 if [ "$study" = yes ]; then
     cargo run --release --example work_precision
-    summary=(output/work_precision/summary.md)
+    cargo run --example performance -- "$criterion" docs/performance.md \
+        output/work_precision/summary.md
+else
+    cargo run --example performance -- "$criterion" docs/performance.md
 fi
-cargo run --example performance -- target/criterion docs/performance.md "${summary[@]}"

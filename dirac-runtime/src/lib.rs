@@ -31,7 +31,7 @@ pub mod step;
 pub mod study;
 
 pub use base::{error, scalar};
-pub use discrete::discrete_lagrangian;
+pub use discrete::{constraint, discrete_lagrangian};
 pub use integrate::{event, run, stepper, trajectory};
 pub use model::{
     closed_form, hamiltonian_system, interconnection, legendre, repeated, slot, system,

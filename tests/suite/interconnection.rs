@@ -405,7 +405,7 @@ fn the_attributes_subsystems_equal_the_plain_rust_interconnection() {
 /// The LC ladder and the chain of masses, 16 cells in a ring built from components, carry a
 /// travelling wave of wave number `κ = 2π m / 16` with the phase advance per step of the
 /// discrete dispersion relation `θ = 2 atan(h Ω / 2)`, `Ω = 2 ω₀ |sin(κ/2)|` (derived in
-/// `examples/scenes/ladder.rs`), to 1e-12 relative, for three modes and three steps; the wave's
+/// `scenes/src/ladder.rs`), to 1e-12 relative, for three modes and three steps; the wave's
 /// amplitude stays to 1e-13.
 #[test]
 fn ladder_and_chain_follow_the_discrete_dispersion_relation() {

@@ -5,7 +5,7 @@
 //! axes), `omega(R)` the body angular velocity `Ω` with `Ṙ = R Ω̂` (`Ω̂ y = Ω × y`), `dot(R)` the
 //! matrix `R Ω̂`; `n: S2` is a unit vector, `dot(n)` its velocity `ṅ`, `omega(n) = n × ṅ`.
 //! A parameter `p: [[f64; 3]; 3]` is the matrix whose row `i`, column `j` is `p[i][j]` (so `p[i]`
-//! is row `i`): `examples/scenes/rigid_body.rs` writes the same `j * omega(R)` by hand as
+//! is row `i`): `scenes/src/rigid_body.rs` writes the same `j * omega(R)` by hand as
 //! `Matrix3::from_fn(|a, b| j[a][b]) * w`, and `Matrix3::from_fn` fills entry (row `a`, column `b`).
 //!
 //! Every parameter matrix here is far from symmetric, every vector generic, and the points are

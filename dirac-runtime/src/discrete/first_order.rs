@@ -1,4 +1,5 @@
-//! Lagrangians linear in the velocities, `L = ϑ(q)·v − H(q)`: their step equations.
+//! Lagrangians linear in the velocities, `L = ϑ(q)·v − H(q)`: the residual rows of their discrete
+//! equations, which the step layer assembles.
 //!
 //! Such a Lagrangian has no kinetic energy in any coordinate (`∂²L/∂v² = 0`). Its
 //! Euler–Lagrange equations are of first order, `ρ(q, q̇) = ∂L/∂q − (∂²L/∂q∂v)ᵀ q̇ =

@@ -8,5 +8,6 @@ pub mod run;
 pub mod stepper;
 pub mod trajectory;
 
+/// A configuration space's test that needs a stepper to drive it.
 #[cfg(test)]
 mod affine_chart;

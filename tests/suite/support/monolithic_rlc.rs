@@ -1,5 +1,5 @@
 //! The RLC circuit written as one struct: the model the interconnection (LC + resistor +
-//! source, `examples/scenes/circuit.rs`) replaced in the scenes, kept as the reference it must
+//! source, `scenes/src/circuit.rs`) replaced in the scenes, kept as the reference it must
 //! reproduce and as a constrained, driven model whose step map has derivatives.
 
 use dirac::prelude::*;
