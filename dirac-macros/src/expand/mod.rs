@@ -1,5 +1,8 @@
 //! Emits the struct unchanged and its `impl __dirac::DiracSystem<N>` (or, for a model given by
-//! a Hamiltonian, `impl __dirac::HamiltonianSystem<N>`).
+//! a Hamiltonian, `impl __dirac::HamiltonianSystem<N>`; for a model of subsystems, see
+//! `subsystems`).
+
+mod subsystems;
 
 use proc_macro2::{Span, TokenStream};
 use quote::{quote, quote_spanned};
@@ -40,7 +43,7 @@ pub fn dirac_system(args: TokenStream, item: TokenStream) -> TokenStream {
     };
     match validate::model(arguments, item) {
         Outcome::Valid(model) => expand(&model),
-        Outcome::Composite(composite) => crate::check::subsystems::expand(&composite),
+        Outcome::Composite(composite) => subsystems::expand(&composite),
         Outcome::Invalid {
             errors,
             coordinates,
