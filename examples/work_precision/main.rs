@@ -193,9 +193,11 @@ impl Runner {
                 };
                 let _ = writeln!(
                     out,
-                    "| {} | {} | {what} ≤ {target:e} | {} | {} | {ratio} |",
+                    "| {} | {} | {} ≤ {target:e} | {} | {} | {ratio} |",
                     r.scene,
                     r.horizon,
+                    // A `|` inside a cell would end it.
+                    what.replace('|', "\\|"),
                     describe(dirac),
                     describe(peer)
                 );
