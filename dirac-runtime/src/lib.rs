@@ -54,7 +54,7 @@ pub use base::input::Input;
 pub use base::scalar::Scalar;
 pub use discrete::discrete_lagrangian::DiscreteLagrangian;
 pub use integrate::event::{Crossing, Direction, Event};
-pub use integrate::run::{Progress, Run, Solution, Status};
+pub use integrate::run::{Feedback, Progress, Run, Solution, Status};
 pub use integrate::stepper::{ManifoldStepper, Stepper};
 pub use integrate::trajectory::{Interrupted, Metadata, Trajectory};
 pub use model::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};

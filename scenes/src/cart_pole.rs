@@ -33,12 +33,6 @@ pub const SCENE: CartPole = CartPole {
     g: 9.81,
 };
 
-/// The step and the state (q, p) as one vector.
-fn state(stepper: &Stepper<CartPole, 2>) -> DMatrix<f64> {
-    let (q, p) = (stepper.q(), stepper.p());
-    DMatrix::from_column_slice(4, 1, &[q[0], q[1], p[0], p[1]])
-}
-
 /// The step's derivatives at the upright equilibrium and the LQR gain.
 pub struct Lqr {
     /// `∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)`.
@@ -92,23 +86,27 @@ pub fn linearisation_and_gain(h: f64, r: f64) -> Result<Lqr, DiracError> {
     })
 }
 
-/// Closed loop from the cart at rest with the pole tilted by `theta0`, one sample per step.
+/// Closed loop from the cart at rest with the pole tilted by `theta0`, one sample per step: the
+/// feedback `u_k = −K (q_k, p_k)` set by the run's controller before each step and held over it.
 pub fn closed_loop(h: f64, theta0: f64, steps: usize) -> Result<Vec<Sample>, DiracError> {
     let k = linearisation_and_gain(h, 0.1)?.k;
     let mut stepper = Stepper::from_system(SCENE, h)?;
     stepper.start_from_velocity(vector![0.0, theta0], SVector::zeros())?;
-    let force = stepper.input("u")?;
+    let force = stepper.input("u")?.index();
     let mut samples = Vec::with_capacity(steps + 1);
-    for _ in 0..=steps {
-        let u = -(&k * state(&stepper))[(0, 0)];
-        samples.push(Sample {
-            t: stepper.t(),
-            x: stepper.q()[0],
-            theta: stepper.q()[1],
-            u,
+    let run = Run::<2>::steps(steps as u64 + 1)
+        .every(steps + 1)
+        .control(|now, inputs| {
+            let (q, p) = (now.sample.q, now.sample.p);
+            let u = -(&k * DMatrix::from_column_slice(4, 1, &[q[0], q[1], p[0], p[1]]))[(0, 0)];
+            inputs[force] = u;
+            samples.push(Sample {
+                t: now.sample.t,
+                x: q[0],
+                theta: q[1],
+                u,
+            });
         });
-        stepper.set_input_value(force, u)?;
-        stepper.step()?;
-    }
+    stepper.solve(run)?;
     Ok(samples)
 }

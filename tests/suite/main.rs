@@ -8,6 +8,7 @@ mod support;
 mod closed_form;
 mod configuration_space;
 mod constrained;
+mod control;
 mod convergence;
 mod discrete_dirac;
 mod ensemble;

@@ -5,6 +5,12 @@
 //! that reach `t_end` (exactly `(t_end − t)/h` of them when that is a whole number to 1e-9).
 //! Samples are the states the stepper reaches (every step, or every `k`-th, and always the last)
 //! or, with [`Run::saveat`], the [dense output](crate::step::dense_output) at the given times.
+//!
+//! A [controller](Run::control) closes a loop inside the run: before each step it reads the
+//! state the step starts from and sets the inputs, which are then held over the step (a
+//! zero-order hold). The step's discrete forces are the quadrature of `F(q, q̇, t, u)` along
+//! the step with `u` constant; for the midpoint rule `f⁻ = f⁺ = (h/2) F(q_{k+½}, (q_{k+1} −
+//! q_k)/h, t_{k+½}, u_k)`.
 
 use std::ops::ControlFlow;
 
@@ -22,6 +28,9 @@ enum Horizon {
     Steps(u64),
     Until(f64),
 }
+
+/// The controller of a run.
+type Controller<'a, const N: usize, M> = Box<dyn FnMut(&Feedback<'_, N, M>, &mut [f64]) + 'a>;
 
 /// The watcher of a run.
 type Observer<'a, const N: usize, M> = Box<dyn FnMut(&Progress<'_, N, M>) -> ControlFlow<()> + 'a>;
@@ -58,6 +67,7 @@ pub struct Run<'a, const N: usize, M: Manifold<N> = Vectors> {
     every: usize,
     pub(crate) events: Vec<Event<'a, N, M>>,
     pub(crate) observer: Option<Observer<'a, N, M>>,
+    pub(crate) controller: Option<Controller<'a, N, M>>,
 }
 
 impl<const N: usize, M: Manifold<N>> std::fmt::Debug for Run<'_, N, M> {
@@ -68,6 +78,7 @@ impl<const N: usize, M: Manifold<N>> std::fmt::Debug for Run<'_, N, M> {
             .field("every", &self.every)
             .field("events", &self.events)
             .field("observer", &self.observer.is_some())
+            .field("controller", &self.controller.is_some())
             .finish()
     }
 }
@@ -90,6 +101,7 @@ impl<'a, const N: usize, M: Manifold<N>> Run<'a, N, M> {
             every: 1,
             events: Vec::new(),
             observer: None,
+            controller: None,
         }
     }
 
@@ -127,6 +139,56 @@ impl<'a, const N: usize, M: Manifold<N>> Run<'a, N, M> {
         }
     }
 
+    /// Calls `controller` before every step with the state the step starts from and the
+    /// system's inputs (indexed as its `inputs(...)`, see [`Input::index`]), holding at their
+    /// current values; the values it leaves are held over the step (a zero-order hold, see the
+    /// [module](self)) and stay set after the run. The velocity it sees is solved, not
+    /// estimated, so a controlled run solves it at every step. Events, save times, recording
+    /// and partial results are as without a controller. A value that is not finite ends the run
+    /// with an error before that step is taken. The closure's argument types are inferred once
+    /// the run's dimension is known: name it, `Run::<N>::steps(..)`, when the closure reads the
+    /// state.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Quadrature, Run, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// /// A unit mass pushed by the input u.
+    /// struct Pushed;
+    /// impl DiracSystem<1> for Pushed {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn input_name(&self, _i: usize) -> String {
+    ///         "u".into()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Pushed, Quadrature::midpoint(), 0.01)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// let u = stepper.input("u")?.index();
+    /// // A spring and a damper in the loop: u = −x − ẋ, held over each step.
+    /// let damped = Run::<1>::until(20.0).every(100).control(|now, inputs| {
+    ///     inputs[u] = -now.sample.q[0] - now.sample.v[0];
+    /// });
+    /// let solution = stepper.solve(damped)?;
+    /// assert_eq!(solution.trajectory.len(), 21);
+    /// assert!(stepper.q()[0].abs() < 1e-4); // ẍ + ẋ + x = 0 decays as e^{−t/2}
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    ///
+    /// [`Input::index`]: crate::Input::index
+    pub fn control(self, controller: impl FnMut(&Feedback<'_, N, M>, &mut [f64]) + 'a) -> Self {
+        Self {
+            controller: Some(Box::new(controller)),
+            ..self
+        }
+    }
+
     /// Every `k`-th step is saved.
     pub(crate) fn stride(&self) -> usize {
         self.every
@@ -135,6 +197,11 @@ impl<'a, const N: usize, M: Manifold<N>> Run<'a, N, M> {
     /// Whether the run needs the dense output.
     pub(crate) fn dense(&self) -> bool {
         self.saveat.is_some() || !self.events.is_empty()
+    }
+
+    /// Whether every step's velocity is needed: for the dense output, or for a controller.
+    pub(crate) fn exact(&self) -> bool {
+        self.dense() || self.controller.is_some()
     }
 
     /// The number of steps from time `t` with step `h`, and the save times checked against the
@@ -197,6 +264,18 @@ pub struct Progress<'s, const N: usize, M: Manifold<N> = Vectors> {
     pub state: &'s State<N, M>,
     /// How Newton's method went on the step.
     pub newton: NewtonReport,
+}
+
+/// What a controller sees before each step of a run: the state the step starts from.
+#[derive(Debug, Clone, Copy)]
+pub struct Feedback<'s, const N: usize, M: Manifold<N> = Vectors> {
+    /// Steps taken in this run before the coming one.
+    pub steps: u64,
+    /// The state the step starts from: time, position, velocity and momentum.
+    pub sample: &'s Sample<N, M>,
+    /// The Lagrange multipliers of the last step (zeros before the stepper's first step; empty
+    /// without constraints).
+    pub multipliers: &'s [f64],
 }
 
 /// How a run ended.

@@ -6,7 +6,7 @@ use std::ops::ControlFlow;
 use super::Stepper;
 use crate::base::error::DiracError;
 use crate::integrate::event::{self, Crossing};
-use crate::integrate::run::{self, Progress, Run, Solution, Status};
+use crate::integrate::run::{self, Feedback, Progress, Run, Solution, Status};
 use crate::integrate::trajectory::{Interrupted, Trajectory};
 use crate::space::manifold::Manifold;
 use crate::step::dense_output::Sample;
@@ -211,7 +211,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let h = self.h();
         let (total, saveat) = run.plan(start.t, h)?;
         let saveat = saveat.map(<[f64]>::to_vec);
-        let (dense, every) = (run.dense(), run.stride() as u64);
+        let (every, exact) = (run.stride() as u64, run.exact());
         let trajectory = &mut solution.trajectory;
         // Room for the samples the run will save, up to 2²⁰ (a run that an event or observer
         // may stop early should not claim memory it might never use): recording allocates
@@ -244,12 +244,24 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             .iter_mut()
             .map(|event| event.value(&current))
             .collect::<Result<Vec<f64>, _>>()?;
+        // The controller's inputs, copied in and out without allocating per step.
+        let mut inputs = self.inputs().to_vec();
         for k in 1..=total {
             let last = k == total;
+            if let Some(controller) = &mut run.controller {
+                inputs.copy_from_slice(self.inputs());
+                let feedback = Feedback {
+                    steps: k - 1,
+                    sample: &current,
+                    multipliers: &self.multipliers,
+                };
+                controller(&feedback, &mut inputs);
+                self.set_inputs(&inputs)?;
+            }
             let proposal = self.solve_step()?;
             let sampled = saveat.is_none() && (k % every == 0 || last);
             // The velocity is solved where it is used; otherwise the state's hint stands in.
-            let exact = sampled || dense;
+            let exact = sampled || exact;
             let (reached, energy) = if exact {
                 // The step's velocity hint is its mean velocity, half a step behind its end:
                 // extrapolated by half the change since the last one, it is O(h²) off.

@@ -1,0 +1,167 @@
+//! Controllers inside runs: the inputs set before each step from the state it starts from, held
+//! over the step, with events, save times, recording and partial results as without them.
+
+use dirac::prelude::*;
+use scenes::knife_edge;
+
+/// `ẍ = −x + u`: an oscillator pushed by the input `u`.
+#[dirac_system(
+    coordinates(x),
+    lagrangian = 0.5 * dot(x).powi(2) - 0.5 * x * x,
+    forces(u * dx),
+    inputs(u),
+)]
+#[derive(Debug, Clone, Copy)]
+struct Pushed;
+
+/// The feedback of the tests: a spring and a damper, `u = −x − ẋ`.
+fn feedback(x: f64, v: f64) -> f64 {
+    -x - v
+}
+
+fn started(quadrature: Quadrature, h: f64) -> Stepper<Pushed, 1> {
+    let mut stepper = Stepper::new(Pushed, quadrature, h).unwrap();
+    stepper
+        .start_from_velocity(vector![1.0], vector![0.0])
+        .unwrap();
+    stepper
+}
+
+#[test]
+fn a_controlled_run_is_the_loop_written_by_hand() {
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let h = 0.05;
+        let mut by_hand = started(quadrature.clone(), h);
+        let u = by_hand.input("u").unwrap();
+        let mut expected = vec![(by_hand.t(), by_hand.q()[0], by_hand.p()[0])];
+        for _ in 0..200 {
+            let (x, v) = (by_hand.q()[0], by_hand.v().unwrap()[0]);
+            by_hand.set_input_value(u, feedback(x, v)).unwrap();
+            by_hand.step().unwrap();
+            expected.push((by_hand.t(), by_hand.q()[0], by_hand.p()[0]));
+        }
+        let mut stepper = started(quadrature.clone(), h);
+        let mut seen = Vec::new();
+        let run = Run::<1>::steps(200).control(|now, inputs| {
+            seen.push(now.steps);
+            inputs[u.index()] = feedback(now.sample.q[0], now.sample.v[0]);
+        });
+        let solution = stepper.solve(run).unwrap();
+        assert_eq!(
+            seen,
+            (0..200).collect::<Vec<u64>>(),
+            "called before each step"
+        );
+        let trajectory = &solution.trajectory;
+        assert_eq!(trajectory.len(), expected.len());
+        for (k, &(t, x, p)) in expected.iter().enumerate() {
+            // The two loops solve the velocity from different guesses, so the inputs agree to
+            // Newton's tolerance, not bit for bit.
+            assert_eq!(trajectory.t()[k], t);
+            assert!(
+                (trajectory.q()[k][0] - x).abs() < 1e-12,
+                "{quadrature:?} x at {k}"
+            );
+            assert!(
+                (trajectory.p()[k][0] - p).abs() < 1e-12,
+                "{quadrature:?} p at {k}"
+            );
+        }
+        // The closed loop ẍ + ẋ + 2x = 0 decays as e^{−t/2}, from an amplitude below 2.
+        let end = trajectory.q()[200][0].abs();
+        assert!(
+            end < 2.0 * (-0.5 * 10.0_f64).exp(),
+            "{quadrature:?}: |x(10)| = {end}"
+        );
+        assert!(
+            (stepper.inputs()[0] - by_hand.inputs()[0]).abs() < 1e-12,
+            "the last input stays set"
+        );
+    }
+}
+
+#[test]
+fn a_controller_that_keeps_the_inputs_changes_nothing() {
+    let zero = || {
+        Event::new("x = 0", |_t, q: &SVector<f64, 1>, _v: &SVector<f64, 1>| {
+            q[0]
+        })
+    };
+    let times: Vec<f64> = (0..=40).map(|i| 0.25 * f64::from(i)).collect();
+    let make = || {
+        let mut stepper = started(Quadrature::galerkin(2).unwrap(), 0.1);
+        stepper.set_input("u", 0.25).unwrap();
+        stepper
+    };
+    let plain = make()
+        .solve(Run::until(10.0).saveat(times.clone()).event(zero()))
+        .unwrap();
+    let mut calls = 0;
+    let controlled = make()
+        .solve(
+            Run::until(10.0)
+                .saveat(times)
+                .event(zero())
+                .control(|_, inputs| {
+                    calls += 1;
+                    assert_eq!(inputs, &[0.25]);
+                }),
+        )
+        .unwrap();
+    assert_eq!(calls, 100);
+    assert_eq!(controlled, plain, "samples, events and status bit for bit");
+    assert_eq!(plain.events.len(), 3);
+}
+
+#[test]
+fn a_non_finite_input_ends_the_run_before_that_step() {
+    let mut stepper = started(Quadrature::midpoint(), 0.1);
+    let run = Run::<1>::steps(10).control(|now, inputs| {
+        inputs[0] = if now.steps < 5 { 0.5 } else { f64::NAN };
+    });
+    let interrupted = stepper.solve(run).unwrap_err();
+    assert!(
+        matches!(interrupted.error, DiracError::NonFinite { .. }),
+        "{}",
+        interrupted.error
+    );
+    assert_eq!(stepper.steps(), 5, "the failing step is not taken");
+    assert_eq!(
+        interrupted.trajectory.len(),
+        6,
+        "the start and five steps are kept"
+    );
+    assert_eq!(
+        stepper.inputs(),
+        &[0.5],
+        "the inputs stay at their last good values"
+    );
+    assert_eq!(interrupted.trajectory.q()[5], stepper.q());
+}
+
+#[test]
+fn the_controller_sees_the_last_steps_multipliers() {
+    let start = |stepper: &mut Stepper<knife_edge::KnifeEdge, 3>| {
+        stepper
+            .start_from_velocity(vector![0.0, 0.0, 0.0], vector![1.0, 0.0, 1.0])
+            .unwrap();
+    };
+    let mut by_hand = Stepper::from_system(knife_edge::SCENE, 0.1).unwrap();
+    start(&mut by_hand);
+    let mut expected = Vec::new();
+    for _ in 0..20 {
+        expected.push(by_hand.multipliers().to_vec());
+        by_hand.step().unwrap();
+    }
+    let mut stepper = Stepper::from_system(knife_edge::SCENE, 0.1).unwrap();
+    start(&mut stepper);
+    let mut seen = Vec::new();
+    stepper
+        .solve(Run::<3>::steps(20).control(|now, inputs| {
+            assert!(inputs.is_empty());
+            seen.push(now.multipliers.to_vec());
+        }))
+        .unwrap();
+    assert_eq!(seen, expected);
+    assert!(seen[1][0] != 0.0, "the blade pushes sideways as it turns");
+}
