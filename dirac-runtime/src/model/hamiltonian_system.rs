@@ -38,6 +38,11 @@ use crate::quadrature::Quadrature;
 /// assert!(drift < 1e-6);
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` is not a model given by a Hamiltonian",
+    label = "not a `HamiltonianSystem<{N}>`",
+    note = "`Stepper::hamiltonian` and `Stepper::hamiltonian_from_system` take models with `hamiltonian = ...` in `#[dirac_system(...)]` (or an impl of `HamiltonianSystem<N>`); a model given by a Lagrangian is stepped by `Stepper::new` or `Stepper::from_system`"
+)]
 pub trait HamiltonianSystem<const N: usize> {
     /// Number of constraint one-forms `w^a(q)` (rows of `A(q)`).
     const ONE_FORMS: usize = 0;

@@ -43,6 +43,12 @@ use crate::space::manifold::{Manifold, Vectors};
 /// assert!((stepper.q()[0] - 0.1_f64.cos()).abs() < 1e-3);
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` is not a model on the configuration space `{M}`",
+    label = "not a `DiracSystem<{N}, {M}>`",
+    note = "a model with rotations (`SO3`) or directions (`S2`) among its coordinates is stepped by `Stepper::on_manifold(model, quadrature, h)`; `Stepper::new` and `Stepper::from_system` take models on Rⁿ",
+    note = "a model is a struct under `#[dirac_system(...)]`, or implements `DiracSystem<N>` by hand"
+)]
 pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// Number of constraint one-forms `w^a(q)` (rows of `A(q)`).
     const ONE_FORMS: usize = 0;
