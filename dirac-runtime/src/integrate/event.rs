@@ -30,7 +30,8 @@ type EventFunction<'a, const N: usize, M> = Box<
 >;
 
 /// An event of a [`Run`](crate::Run): a function `g(t, q, v)` whose sign changes are located
-/// inside the steps, optionally ending the run at the first one.
+/// inside the steps, optionally ending the run at the first one. With the dimension named,
+/// `Event::<N>::new`, the closure's argument types are inferred.
 ///
 /// ```
 /// use dirac_runtime::{DiracSystem, Event, Quadrature, Run, Scalar, Status, Stepper};
@@ -44,9 +45,7 @@ type EventFunction<'a, const N: usize, M> = Box<
 /// }
 /// let mut stepper = Stepper::new(Ball, Quadrature::midpoint(), 0.01)?;
 /// stepper.start_from_velocity(vector![1.0], vector![5.0])?;
-/// let floor = Event::new("floor", |_t, q: &SVector<f64, 1>, _v: &SVector<f64, 1>| q[0])
-///     .falling()
-///     .terminal();
+/// let floor = Event::<1>::new("floor", |_t, q, _v| q[0]).falling().terminal();
 /// let solution = stepper.solve(Run::until(10.0).event(floor))?;
 /// assert_eq!(solution.status, Status::Event(0));
 /// // 1 + 5t − 9.81 t²/2 = 0: the midpoint rule is exact for a constant force.
