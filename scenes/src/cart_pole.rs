@@ -33,15 +33,7 @@ pub const SCENE: CartPole = CartPole {
     g: 9.81,
 };
 
-/// The step's derivatives at the upright equilibrium and the LQR gain.
-pub struct Lqr {
-    /// `∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)`.
-    pub a: DMatrix<f64>,
-    /// `∂(q_{k+1}, p_{k+1})/∂u`.
-    pub b: DMatrix<f64>,
-    /// The feedback gain: `u = −K (q, p)`.
-    pub k: DMatrix<f64>,
-}
+pub use crate::lqr::Lqr;
 
 /// One sample of the closed loop.
 #[derive(Debug, Clone, Copy)]
@@ -53,37 +45,14 @@ pub struct Sample {
 }
 
 /// `A`, `B` of one step at the upright equilibrium, and the LQR gain `K` for the cost
-/// `Σ zᵀQz + r u²` with `Q = I`, by the Riccati recursion to a fixed point.
+/// `Σ zᵀz + r u²` ([`lqr::gain`](crate::lqr::gain)).
 pub fn linearisation_and_gain(h: f64, r: f64) -> Result<Lqr, DiracError> {
     let mut stepper = Stepper::from_system(SCENE, h)?;
     stepper.start_from_momentum(SVector::zeros(), SVector::zeros())?;
     let derivatives = stepper.step_linearised()?;
     let (a, b) = (derivatives.matrix(), derivatives.input_matrix());
-    let q = DMatrix::<f64>::identity(4, 4);
-    let mut p = q.clone();
-    let gain = |p: &DMatrix<f64>| -> DMatrix<f64> {
-        let scale = r + (b.transpose() * p * &b)[(0, 0)];
-        (b.transpose() * p * &a) / scale
-    };
-    for _ in 0..100_000 {
-        let k = gain(&p);
-        let next = &q + a.transpose() * &p * &a - a.transpose() * &p * &b * &k;
-        let change = (&next - &p).amax();
-        p = next;
-        if change <= 1e-13 * p.amax() {
-            let k = gain(&p);
-            return Ok(Lqr { a, b, k });
-        }
-    }
-    Err(DiracError::NoConvergence {
-        problem: "the Riccati recursion",
-        step: 0,
-        residual: f64::NAN,
-        update: f64::NAN,
-        iterations: 100_000,
-        tolerance: 1e-13,
-        step_tolerance: 1e-13,
-    })
+    let k = crate::lqr::gain(&a, &b, r)?;
+    Ok(Lqr { a, b, k })
 }
 
 /// Closed loop from the cart at rest with the pole tilted by `theta0`, one sample per step: the

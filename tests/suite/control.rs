@@ -165,3 +165,39 @@ fn the_controller_sees_the_last_steps_multipliers() {
     assert_eq!(seen, expected);
     assert!(seen[1][0] != 0.0, "the blade pushes sideways as it turns");
 }
+
+#[test]
+fn a_furuta_pendulum_is_balanced_with_its_torque_saturated() {
+    use scenes::furuta;
+    let h = 0.005;
+    let scenes::lqr::Lqr { a, b, k } = furuta::linearisation_and_gain(h, 10.0).unwrap();
+    let radius = |m: &dirac::nalgebra::DMatrix<f64>| {
+        m.complex_eigenvalues()
+            .iter()
+            .map(|e| e.norm())
+            .fold(0.0, f64::max)
+    };
+    assert!(radius(&a) > 1.0, "upright is unstable: {}", radius(&a));
+    let closed = &a - &b * &k;
+    assert!(
+        radius(&closed) < 1.0,
+        "the gain stabilises it: {}",
+        radius(&closed)
+    );
+    let (samples, solution) = furuta::closed_loop(h, 0.2, furuta::TAU_MAX, 2000, 200).unwrap();
+    assert_eq!((samples.len(), solution.trajectory.len()), (2000, 11));
+    let limit = furuta::TAU_MAX;
+    assert!(samples.iter().all(|s| s.tau.abs() <= limit));
+    let saturated = samples.iter().filter(|s| s.tau.abs() == limit).count();
+    assert!(saturated > 0, "the torque limit is reached");
+    let last = samples.last().unwrap();
+    assert!(
+        last.theta.abs() < 1e-3 && last.tau.abs() < 1e-2,
+        "θ = {}, τ = {}",
+        last.theta,
+        last.tau
+    );
+    // The limit is applied: with 0.2 N m the motor cannot catch the same tilt, and it falls.
+    let (weak, _) = furuta::closed_loop(h, 0.2, 0.2, 2000, 200).unwrap();
+    assert!(weak.last().unwrap().theta.abs() > 1.0);
+}
