@@ -5,6 +5,7 @@ use dirac::nalgebra::DMatrix;
 use dirac::prelude::*;
 
 /// One step's derivatives at an equilibrium and the LQR gain.
+#[derive(Debug, Clone)]
 pub struct Lqr {
     /// `∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)`.
     pub a: DMatrix<f64>,

@@ -30,8 +30,8 @@ type EventFunction<'a, const N: usize, M> = Box<
 >;
 
 /// An event of a [`Run`](crate::Run): a function `g(t, q, v)` whose sign changes are located
-/// inside the steps, optionally ending the run at the first one. With the dimension named,
-/// `Event::<N>::new`, the closure's argument types are inferred.
+/// inside the steps, optionally ending the run at the first one. On Rⁿ, with the dimension
+/// named, `Event::<N>::new`, the closure's argument types are inferred.
 ///
 /// ```
 /// use dirac_runtime::{DiracSystem, Event, Quadrature, Run, Scalar, Status, Stepper};

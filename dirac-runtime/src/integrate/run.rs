@@ -9,8 +9,8 @@
 //! A [controller](Run::control) closes a loop inside the run: before each step it reads the
 //! state the step starts from and sets the inputs, which are then held over the step (a
 //! zero-order hold). The step's discrete forces are the quadrature of `F(q, q̇, t, u)` along
-//! the step with `u` constant; for the midpoint rule `f⁻ = f⁺ = (h/2) F(q_{k+½}, (q_{k+1} −
-//! q_k)/h, t_{k+½}, u_k)`.
+//! the step with `u` constant; on Rⁿ, for the midpoint rule, `f⁻ = f⁺ = (h/2) F(q_{k+½},
+//! (q_{k+1} − q_k)/h, t_{k+½}, u_k)`.
 
 use std::ops::ControlFlow;
 
@@ -145,9 +145,9 @@ impl<'a, const N: usize, M: Manifold<N>> Run<'a, N, M> {
     /// [module](self)) and stay set after the run. The velocity it sees is solved, not
     /// estimated, so a controlled run solves it at every step. Events, save times, recording
     /// and partial results are as without a controller. A value that is not finite ends the run
-    /// with an error before that step is taken. The closure's argument types are inferred once
-    /// the run's dimension is known: name it, `Run::<N>::steps(..)`, when the closure reads the
-    /// state.
+    /// with an error before that step is taken, the inputs unchanged; a step that fails ends it
+    /// with the controller's inputs set. On Rⁿ the closure's argument types are inferred once
+    /// the run's dimension is named: `Run::<N>::steps(..)`.
     ///
     /// ```
     /// use dirac_runtime::{DiracSystem, Quadrature, Run, Scalar, Stepper};

@@ -46,7 +46,7 @@ use crate::space::manifold::{Manifold, Vectors};
 #[diagnostic::on_unimplemented(
     message = "`{Self}` is not a model on the configuration space `{M}`",
     label = "not a `DiracSystem<{N}, {M}>`",
-    note = "a model with rotations (`SO3`) or directions (`S2`) among its coordinates is stepped by `Stepper::on_manifold(model, quadrature, h)`; `Stepper::new` and `Stepper::from_system` take models on Rⁿ",
+    note = "`Stepper::new` and `Stepper::from_system` take models given by a Lagrangian on Rⁿ; a model with rotations (`SO3`) or directions (`S2`) among its coordinates is stepped by `Stepper::on_manifold(model, space, quadrature, h)`, and one given by a Hamiltonian by `Stepper::hamiltonian(model, quadrature, h)`",
     note = "a model is a struct under `#[dirac_system(...)]`, or implements `DiracSystem<N>` by hand"
 )]
 pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {

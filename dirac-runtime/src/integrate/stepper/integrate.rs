@@ -72,8 +72,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             .map(|solution| solution.trajectory)
     }
 
-    /// Carries out `run` from the current state: its steps, saved samples, events and observer
-    /// (see [`Run`]). A failing step ends it with [`Interrupted`], which keeps the samples and
+    /// Carries out `run` from the current state: its steps, saved samples, events, observer and
+    /// controller (see [`Run`]). A failing step ends it with [`Interrupted`], which keeps the samples and
     /// events up to the last good step, where the stepper stays; a sampled step is made
     /// current only once its energy could be computed. An invalid run (a span that ends
     /// before the current time, save times outside it) is refused before the first step.
@@ -249,6 +249,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         for k in 1..=total {
             let last = k == total;
             if let Some(controller) = &mut run.controller {
+                // What the controller sees: the inputs held over the last step.
                 inputs.copy_from_slice(self.inputs());
                 let feedback = Feedback {
                     steps: k - 1,
