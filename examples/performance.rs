@@ -226,28 +226,25 @@ fn write(groups: &BTreeMap<String, Vec<Result>>, study: Option<String>) -> Strin
             .iter()
             .find(|(g, _)| g == name)
             .and_then(|(_, id)| sorted.iter().find(|r| r.id == *id));
+        let mut row = |r: &Result, d: &Result| {
+            let _ = writeln!(
+                ratios,
+                "| {} / {} | {:.2} |",
+                r.id,
+                d.id,
+                r.median / d.median
+            );
+        };
         for r in &sorted {
             if let Some(d) = baseline.filter(|d| d.id != r.id) {
-                let _ = writeln!(
-                    ratios,
-                    "| {} / {} | {:.2} |",
-                    r.id,
-                    d.id,
-                    r.median / d.median
-                );
+                row(r, d);
             }
             for (from, to) in PAIRS {
                 let Some(other) = twin(&r.id, from, to) else {
                     continue;
                 };
                 if let Some(d) = sorted.iter().find(|d| d.id == other) {
-                    let _ = writeln!(
-                        ratios,
-                        "| {} / {} | {:.2} |",
-                        r.id,
-                        d.id,
-                        r.median / d.median
-                    );
+                    row(r, d);
                 }
             }
         }

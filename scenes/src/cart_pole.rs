@@ -4,7 +4,6 @@
 //! feedback `u_k = −K (q_k, p_k)` applied as the model's input at every step of the variational
 //! integrator itself (not of a linear model).
 
-use dirac::nalgebra::DMatrix;
 use dirac::prelude::*;
 
 /// `θ` from the upright vertical; a force `u` pushes the cart.
@@ -47,12 +46,7 @@ pub struct Sample {
 /// `A`, `B` of one step at the upright equilibrium, and the LQR gain `K` for the cost
 /// `Σ zᵀz + r u²` ([`lqr::gain`](crate::lqr::gain)).
 pub fn linearisation_and_gain(h: f64, r: f64) -> Result<Lqr, DiracError> {
-    let mut stepper = Stepper::from_system(SCENE, h)?;
-    stepper.start_from_momentum(SVector::zeros(), SVector::zeros())?;
-    let derivatives = stepper.step_linearised()?;
-    let (a, b) = (derivatives.matrix(), derivatives.input_matrix());
-    let k = crate::lqr::gain(&a, &b, r)?;
-    Ok(Lqr { a, b, k })
+    Lqr::at_origin(SCENE, h, r)
 }
 
 /// Closed loop from the cart at rest with the pole tilted by `theta0`, one sample per step: the
@@ -67,7 +61,7 @@ pub fn closed_loop(h: f64, theta0: f64, steps: usize) -> Result<Vec<Sample>, Dir
         .every(steps + 1)
         .control(|now, inputs| {
             let (q, p) = (now.sample.q, now.sample.p);
-            let u = -(&k * DMatrix::from_column_slice(4, 1, &[q[0], q[1], p[0], p[1]]))[(0, 0)];
+            let u = crate::lqr::feedback(&k, &q, &p);
             inputs[force] = u;
             samples.push(Sample {
                 t: now.sample.t,

@@ -8,7 +8,6 @@
 //! `|ẋ|² = r² φ̇² + 2 r l cos θ φ̇ θ̇ + l² θ̇² + l² sin²θ φ̇²`, so
 //! `L = ½ J φ̇² + ½ m |ẋ|² − m g l cos θ`, and the torque does work `τ dφ`.
 
-use dirac::nalgebra::DMatrix;
 use dirac::prelude::*;
 
 use crate::lqr::Lqr;
@@ -49,12 +48,7 @@ pub const TAU_MAX: f64 = 0.5;
 /// `A = ∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)` and `B = ∂(q_{k+1}, p_{k+1})/∂τ` of one step at the
 /// upright equilibrium, and the LQR gain for the cost `Σ zᵀz + r τ²`.
 pub fn linearisation_and_gain(h: f64, r: f64) -> Result<Lqr, DiracError> {
-    let mut stepper = Stepper::from_system(SCENE, h)?;
-    stepper.start_from_momentum(SVector::zeros(), SVector::zeros())?;
-    let derivatives = stepper.step_linearised()?;
-    let (a, b) = (derivatives.matrix(), derivatives.input_matrix());
-    let k = crate::lqr::gain(&a, &b, r)?;
-    Ok(Lqr { a, b, k })
+    Lqr::at_origin(SCENE, h, r)
 }
 
 /// One sample of the closed loop: the state a step starts from and the torque held over it.
@@ -83,8 +77,7 @@ pub fn closed_loop(
     let mut samples = Vec::new();
     let run = Run::<2>::steps(steps).every(every).control(|now, inputs| {
         let (q, p) = (now.sample.q, now.sample.p);
-        let z = DMatrix::from_column_slice(4, 1, &[q[0], q[1], p[0], p[1]]);
-        let torque = (-(&k * z)[(0, 0)]).clamp(-tau_max, tau_max);
+        let torque = crate::lqr::feedback(&k, &q, &p).clamp(-tau_max, tau_max);
         inputs[tau] = torque;
         samples.push(Sample {
             t: now.sample.t,

@@ -15,6 +15,30 @@ pub struct Lqr {
     pub k: DMatrix<f64>,
 }
 
+impl Lqr {
+    /// `A`, `B` of one step of `system` (its own quadrature, step `h`) from rest at the origin,
+    /// and the gain for the cost `Σ zᵀz + r |u|²`.
+    pub fn at_origin<S: DiracSystem<N>, const N: usize>(
+        system: S,
+        h: f64,
+        r: f64,
+    ) -> Result<Self, DiracError> {
+        let mut stepper = Stepper::from_system(system, h)?;
+        stepper.start_from_momentum(SVector::zeros(), SVector::zeros())?;
+        let derivatives = stepper.step_linearised()?;
+        let (a, b) = (derivatives.matrix(), derivatives.input_matrix());
+        let k = gain(&a, &b, r)?;
+        Ok(Self { a, b, k })
+    }
+}
+
+/// The first input of the feedback `u = −K z` at `z = (q, p)`, without allocating.
+pub fn feedback<const N: usize>(k: &DMatrix<f64>, q: &SVector<f64, N>, p: &SVector<f64, N>) -> f64 {
+    -(0..N)
+        .map(|i| k[(0, i)] * q[i] + k[(0, N + i)] * p[i])
+        .sum::<f64>()
+}
+
 /// The gain `K` of the feedback `u = −K z`, with `Q = I` and the input weight `r`; an error if
 /// the recursion has not settled to 1e-13 (relative) in 100 000 iterations.
 pub fn gain(a: &DMatrix<f64>, b: &DMatrix<f64>, r: f64) -> Result<DMatrix<f64>, DiracError> {

@@ -244,20 +244,18 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             .iter_mut()
             .map(|event| event.value(&current))
             .collect::<Result<Vec<f64>, _>>()?;
-        // The controller's inputs, copied in and out without allocating per step.
-        let mut inputs = self.inputs().to_vec();
+        // The controller's buffer: the inputs held over the last step, set from it after each call.
+        let mut inputs = run.controller.as_ref().map(|_| self.inputs().to_vec());
         for k in 1..=total {
             let last = k == total;
-            if let Some(controller) = &mut run.controller {
-                // What the controller sees: the inputs held over the last step.
-                inputs.copy_from_slice(self.inputs());
+            if let (Some(controller), Some(inputs)) = (&mut run.controller, &mut inputs) {
                 let feedback = Feedback {
                     steps: k - 1,
                     sample: &current,
                     multipliers: &self.multipliers,
                 };
-                controller(&feedback, &mut inputs);
-                self.set_inputs(&inputs)?;
+                controller(&feedback, inputs);
+                self.set_inputs(inputs)?;
             }
             let proposal = self.solve_step()?;
             let sampled = saveat.is_none() && (k % every == 0 || last);
