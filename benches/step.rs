@@ -594,8 +594,78 @@ fn modular(c: &mut Criterion) {
     group.finish();
 }
 
+/// One step of models driven by forces and inputs, each step's work booked for the energy
+/// balance (`Stepper::work`): the cart-pole pushed by a constant force (midpoint), the RLC
+/// circuit with its source on (midpoint) and the satellite under a constant body torque on SO(3)
+/// (midpoint, Cayley). Each is started over every 10⁴ steps.
+fn forced(c: &mut Criterion) {
+    let mut group = c.benchmark_group("forced_step");
+    let h = 0.01;
+    let mut cart_pole = Stepper::from_system(scenes::cart_pole::SCENE, h).expect("valid scene");
+    let start_cart = |stepper: &mut Stepper<scenes::cart_pole::CartPole, 2>| {
+        stepper
+            .start_from_velocity(vector![0.0, 0.2], vector![0.0, 0.0])
+            .expect("finite start");
+        stepper.set_input("u", 0.5).expect("input u");
+    };
+    start_cart(&mut cart_pole);
+    group.bench_function("cart_pole_midpoint", |b| {
+        b.iter(|| {
+            if cart_pole.steps() >= 10_000 {
+                start_cart(&mut cart_pole);
+            }
+            black_box(cart_pole.step()).expect("step")
+        })
+    });
+    let rlc = scenes::circuit::rlc(scenes::circuit::LC, 0.5).expect("valid scene");
+    let mut circuit = Stepper::new(rlc, Quadrature::midpoint(), h).expect("valid scene");
+    let start_circuit = |stepper: &mut Stepper<scenes::circuit::Rlc, 6>| {
+        stepper
+            .start_from_velocity(scenes::circuit::rlc_q0(), SVector::zeros())
+            .expect("finite start");
+        stepper.set_inputs(&[1.0]).expect("the source");
+    };
+    start_circuit(&mut circuit);
+    group.bench_function("rlc_midpoint", |b| {
+        b.iter(|| {
+            if circuit.steps() >= 10_000 {
+                start_circuit(&mut circuit);
+            }
+            black_box(circuit.step()).expect("step")
+        })
+    });
+    let mut satellite = Stepper::on_manifold(
+        scenes::satellite::SCENE,
+        Product::cayley(),
+        Quadrature::midpoint(),
+        h,
+    )
+    .expect("valid scene");
+    let start_satellite =
+        |stepper: &mut ManifoldStepper<scenes::satellite::Satellite, 3, Product<0, 1, 0>>| {
+            stepper
+                .start_from_velocity(
+                    Configuration::of_rotation(Matrix3::identity()),
+                    Rates::of_rotation(Vector3::new(0.3, 1.0, -0.5)),
+                )
+                .expect("finite start");
+            stepper.set_inputs(&[0.01, -0.02, 0.03]).expect("torques");
+        };
+    start_satellite(&mut satellite);
+    group.bench_function("satellite_midpoint", |b| {
+        b.iter(|| {
+            if satellite.steps() >= 10_000 {
+                start_satellite(&mut satellite);
+            }
+            black_box(satellite.step()).expect("step")
+        })
+    });
+    group.finish();
+}
+
 criterion_group!(
     benches,
+    forced,
     modular,
     interconnection,
     routes,

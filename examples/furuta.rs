@@ -22,6 +22,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (t, q) in solution.trajectory.t().iter().zip(solution.trajectory.q()) {
         println!("t = {t:4.1} s   φ = {:+.3e}   θ = {:+.3e}", q[0], q[1]);
     }
+    // The motor's work against the pendulum's energy, booked by the library step by step (the
+    // defect is the midpoint rule's energy error on this nonlinear model, O(h²)).
+    println!("{}", solution.trajectory.energy_balance()?);
     let (weak, _) = furuta::closed_loop(h, 0.2, 0.2, 2000, 200)?;
     let fallen = weak.last().expect("samples");
     println!(

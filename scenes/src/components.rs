@@ -21,14 +21,14 @@ pub struct Capacitor {
 }
 
 /// A resistor: no energy, the force −r q̇ dq.
-#[dirac_system(coordinates(q), lagrangian = 0.0 * q, forces(-r * dot(q) * dq))]
+#[dirac_system(coordinates(q), forces(-r * dot(q) * dq))]
 #[derive(Debug, Clone, Copy)]
 pub struct Resistor {
     pub r: f64,
 }
 
 /// A voltage source: no energy, the force u dq of its input voltage `u`.
-#[dirac_system(coordinates(q), lagrangian = 0.0 * q, forces(u * dq), inputs(u))]
+#[dirac_system(coordinates(q), forces(u * dq), inputs(u))]
 #[derive(Debug, Clone, Copy)]
 pub struct Source;
 
@@ -48,7 +48,7 @@ pub struct Spring {
 }
 
 /// A damper, its coordinate its elongation: no energy, the force −c ẋ dx (as a resistor).
-#[dirac_system(coordinates(x), lagrangian = 0.0 * x, forces(-c * dot(x) * dx))]
+#[dirac_system(coordinates(x), forces(-c * dot(x) * dx))]
 #[derive(Debug, Clone, Copy)]
 pub struct Damper {
     pub c: f64,

@@ -29,6 +29,7 @@ pub mod ports;
 pub mod progress;
 pub mod rigid_body;
 pub mod rigid_chain;
+pub mod rlc_ladder;
 pub mod rolling_ball;
 pub mod rolling_disk;
 pub mod satellite;

@@ -83,3 +83,32 @@ pub fn report() -> Result<Report, DiracError> {
 pub fn target() -> Matrix3<f64> {
     Retraction::Exp.map(&Vector3::new(0.5, -0.8, 1.2))
 }
+
+/// The torque limit of the detumbling law, per axis.
+pub const DETUMBLE_TORQUE: f64 = 0.05;
+
+/// The satellite tumbling at body rate `omega0` and detumbled by the rate-damping torque
+/// `τ = −k Ω`, saturated at [`DETUMBLE_TORQUE`] per axis and held over each step: one controlled
+/// run to `t_end` (midpoint, Cayley, step `h`, every `every`-th step saved).
+pub fn detumbled(
+    omega0: Vector3<f64>,
+    k: f64,
+    h: f64,
+    t_end: f64,
+    every: usize,
+) -> Result<Solution<3, Product<0, 1, 0>>, DiracError> {
+    let mut stepper = Stepper::on_manifold(SCENE, Product::cayley(), Quadrature::midpoint(), h)?;
+    stepper.start_from_velocity(
+        Configuration::of_rotation(Matrix3::identity()),
+        Rates::of_rotation(omega0),
+    )?;
+    let run = Run::until(t_end).every(every).control(
+        |now: &Feedback<3, Product<0, 1, 0>>, torque: &mut [f64]| {
+            let omega = now.sample.v.rotation[0];
+            for (tau, w) in torque.iter_mut().zip(omega.iter()) {
+                *tau = (-k * w).clamp(-DETUMBLE_TORQUE, DETUMBLE_TORQUE);
+            }
+        },
+    );
+    Ok(stepper.solve(run)?)
+}

@@ -915,3 +915,46 @@ fn a_chain_of_rigid_bodies_keeps_its_momentum_and_decouples_into_tops() {
         );
     }
 }
+
+/// The attitude views: the quaternion of a rotation by `θ` about `a` is `[cos(θ/2), sin(θ/2) a]`
+/// and rebuilds `R = (w² − |v|²) I + 2 v vᵀ + 2 w v̂`; the Euler angles of
+/// `R_z(yaw) R_y(pitch) R_x(roll)`, built here from the three elementary matrices, are
+/// `[roll, pitch, yaw]`.
+#[test]
+fn attitudes_read_as_quaternions_and_euler_angles() {
+    let elementary = |axis: usize, angle: f64| {
+        let (c, s) = (angle.cos(), angle.sin());
+        match axis {
+            0 => Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c),
+            1 => Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c),
+            _ => Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0),
+        }
+    };
+    for (roll, pitch, yaw) in [(0.1, -0.2, 0.3), (-2.5, 1.2, 3.0), (0.0, -1.5, -0.7)] {
+        let r = elementary(2, yaw) * elementary(1, pitch) * elementary(0, roll);
+        let q = Configuration::of_rotation(r);
+        let [a, b, c] = q.euler_angles(0).unwrap();
+        assert!((a - roll).abs() < 1e-14 && (b - pitch).abs() < 1e-14 && (c - yaw).abs() < 1e-14);
+        let [w, x, y, z] = q.quaternion(0).unwrap();
+        let v = Vector3::new(x, y, z);
+        let rebuilt = Matrix3::identity() * (w * w - v.norm_squared())
+            + v * v.transpose() * 2.0
+            + dirac::rotation::hat(&v) * (2.0 * w);
+        assert!((rebuilt - r).amax() < 1e-14 && w >= 0.0);
+        assert!((w * w + v.norm_squared() - 1.0).abs() < 1e-15);
+    }
+    for (theta, axis) in [
+        (0.3, Vector3::new(1.0, 2.0, -2.0) / 3.0),
+        (3.0, Vector3::z()),
+    ] {
+        let r = Retraction::Exp.map(&(axis * theta));
+        let [w, x, y, z] = dirac::rotation::quaternion(&r);
+        let expected = [(theta / 2.0).cos(), 0.0, 0.0, 0.0];
+        assert!((w - expected[0]).abs() < 1e-15);
+        assert!((Vector3::new(x, y, z) - axis * (theta / 2.0).sin()).amax() < 1e-15);
+    }
+    assert_eq!(
+        Configuration::of_rotation(Matrix3::identity()).quaternion(1),
+        None
+    );
+}

@@ -11,6 +11,7 @@ mod constrained;
 mod control;
 mod convergence;
 mod discrete_dirac;
+mod energy_balance;
 mod ensemble;
 mod errors;
 mod extremes;

@@ -5,17 +5,25 @@
 //! implements `DiracSystem` through each subsystem's `Slot` (the runtime's place of a part among
 //! the whole's coordinates), and exposes the model as a subsystem in turn (a hierarchy).
 //!
+//! A field that is an array of models, `sections: [Section; 3]`, is that many subsystems,
+//! `sections[0]`, `sections[1]`, …; a junction may be written once over an index,
+//! `for i in 0..2 { node = s[i].l.dq - s[i + 1].l.dq }`, which is one junction per index
+//! (`node[0]`, `node[1]`), the index read in `+` and `-` of integers.
+//!
 //! Checked here, on the user's tokens: subsystems that are not fields (or fields that are not
-//! subsystems), junction terms naming an unknown instance, terms that are not `c * a.dx` with a
+//! subsystems), arrays of subsystems without a literal length, junction terms naming an unknown
+//! instance (an element past an array's end), an index loop that is not over a range of
+//! integer literals, terms that are not `c * a.dx` with a
 //! number literal `c`, zero coefficients, a coordinate twice in one junction, two junctions of
 //! one name, and junctions that combine others (over-determined). A coordinate unknown to its
 //! subsystem is reported when the program compiles, on the term, by a constant evaluation that
 //! names it.
 
 use proc_macro2::{Span, TokenStream};
+use quote::quote;
 
 use syn::spanned::Spanned;
-use syn::{BinOp, Expr, Fields, Ident, Lit, Member, Type, UnOp};
+use syn::{BinOp, Expr, Fields, Ident, Lit, Member, Pat, RangeLimits, Stmt, Type, UnOp};
 
 use crate::internals::errors::Errors;
 
@@ -36,11 +44,42 @@ pub struct Junction {
     pub terms: Vec<Term>,
 }
 
+/// One subsystem: a field, or an element of a field that is an array of models.
+pub struct Subsystem {
+    pub field: Ident,
+    /// The element, for a field that is an array.
+    pub index: Option<usize>,
+    /// The model's type.
+    pub ty: Type,
+}
+
+impl Subsystem {
+    /// Its instance name: `field` or `field[index]`.
+    pub fn label(&self) -> String {
+        match self.index {
+            None => self.field.to_string(),
+            Some(i) => format!("{}[{i}]", self.field),
+        }
+    }
+
+    /// The expression that reads it from `self`.
+    pub fn access(&self) -> TokenStream {
+        let field = &self.field;
+        match self.index {
+            None => quote!(self.#field),
+            Some(i) => quote!(self.#field[#i]),
+        }
+    }
+}
+
+/// The most elements an array of subsystems may have (each is expanded into the model's code).
+const MAX_ELEMENTS: usize = 1000;
+
 /// A validated model made of subsystems.
 pub struct Composite {
     pub item: syn::ItemStruct,
-    /// The subsystems' fields and types, in the order of `subsystems(...)`.
-    pub subsystems: Vec<(Ident, Type)>,
+    /// The subsystems, in the order of `subsystems(...)` (an array's elements in order).
+    pub subsystems: Vec<Subsystem>,
     pub junctions: Vec<Junction>,
     /// The default quadrature's expression, when the attribute names one.
     pub quadrature: Option<TokenStream>,
@@ -78,18 +117,34 @@ pub fn model(
             Vec::new()
         }
     };
-    let mut subsystems = Vec::new();
+    let mut subsystems: Vec<Subsystem> = Vec::new();
     for name in names {
-        if subsystems.iter().any(|(n, _): &(Ident, Type)| n == name) {
+        if subsystems.iter().any(|s| &s.field == name) {
             errors.push(name.span(), format!("`{name}` is listed twice"));
             continue;
         }
         match fields.iter().find(|(field, _)| field == name) {
-            Some((_, ty @ Type::Array(_))) => errors.push(
-                ty.span(),
-                "arrays of subsystems are not supported yet: name each subsystem as a field",
-            ),
-            Some((_, ty)) => subsystems.push((name.clone(), ty.clone())),
+            Some((_, Type::Array(array))) => match literal(&array.len) {
+                Some(n) if n.fract() == 0.0 && (1.0..=MAX_ELEMENTS as f64).contains(&n) => {
+                    subsystems.extend((0..n as usize).map(|i| Subsystem {
+                        field: name.clone(),
+                        index: Some(i),
+                        ty: (*array.elem).clone(),
+                    }))
+                }
+                _ => errors.push(
+                    array.len.span(),
+                    format!(
+                        "an array of subsystems needs a literal length from 1 to {MAX_ELEMENTS}, \
+                         e.g. `[Section; 3]`"
+                    ),
+                ),
+            },
+            Some((_, ty)) => subsystems.push(Subsystem {
+                field: name.clone(),
+                index: None,
+                ty: ty.clone(),
+            }),
             None => errors.push(
                 name.span(),
                 format!("`{name}` is not a field of the struct: a subsystem is a field whose type is a model"),
@@ -104,12 +159,18 @@ pub fn model(
             );
         }
     }
-    let instances: Vec<&Ident> = subsystems.iter().map(|(name, _)| name).collect();
-    let junctions: Vec<Junction> = junctions
-        .iter()
-        .enumerate()
-        .filter_map(|(j, expr)| junction(expr, j, &instances, errors))
-        .collect();
+    let instances: Vec<String> = subsystems.iter().map(Subsystem::label).collect();
+    let mut numbered = 0;
+    let mut found = Vec::new();
+    for expr in junctions {
+        for (form, index) in unrolled(expr, errors) {
+            if let Some(junction) = junction(&form, numbered, index, &instances, errors) {
+                found.push(junction);
+            }
+            numbered += 1;
+        }
+    }
+    let junctions = found;
     for (j, junction) in junctions.iter().enumerate() {
         if junctions[..j]
             .iter()
@@ -149,12 +210,86 @@ pub fn model(
     })
 }
 
-/// `name = form` or `form` (named `junction_j`), its terms read.
-fn junction(expr: &Expr, j: usize, instances: &[&Ident], errors: &mut Errors) -> Option<Junction> {
+/// An index of an unrolled junction: the loop variable and its value.
+type Index<'a> = Option<(&'a Ident, i64)>;
+
+/// The junctions `expr` stands for: itself, or for `for i in a..b { … }` each junction of its
+/// body at each `i` (its expressions, separated by `;` or `,`).
+fn unrolled<'a>(expr: &'a Expr, errors: &mut Errors) -> Vec<(Expr, Index<'a>)> {
+    let Expr::ForLoop(for_loop) = expr else {
+        return vec![(expr.clone(), None)];
+    };
+    let Pat::Ident(variable) = &*for_loop.pat else {
+        errors.push(
+            for_loop.pat.span(),
+            "the index of a junction loop is a name: `for i in 0..3 { ... }`",
+        );
+        return Vec::new();
+    };
+    let range = match &*for_loop.expr {
+        Expr::Range(range) => {
+            let end = |e: &Option<Box<Expr>>| e.as_deref().and_then(literal);
+            match (end(&range.start), end(&range.end)) {
+                (Some(a), Some(b)) if a.fract() == 0.0 && b.fract() == 0.0 => {
+                    let b = match range.limits {
+                        RangeLimits::HalfOpen(_) => b as i64,
+                        RangeLimits::Closed(_) => b as i64 + 1,
+                    };
+                    Some((a as i64, b))
+                }
+                _ => None,
+            }
+        }
+        _ => None,
+    };
+    let Some((start, end)) = range.filter(|(a, b)| b - a <= MAX_ELEMENTS as i64) else {
+        errors.push(
+            for_loop.expr.span(),
+            format!(
+                "a junction loop runs over a range of integer literals of at most \
+                 {MAX_ELEMENTS} values, e.g. `0..3`"
+            ),
+        );
+        return Vec::new();
+    };
+    let mut forms = Vec::new();
+    for statement in &for_loop.body.stmts {
+        match statement {
+            Stmt::Expr(form, _) => forms.push(form.clone()),
+            other => errors.push(
+                other.span(),
+                "the body of a junction loop holds junctions: `name = a[i].dq - b[i].dx`",
+            ),
+        }
+    }
+    let variable = &variable.ident;
+    (start..end)
+        .flat_map(|i| {
+            forms
+                .iter()
+                .map(move |form| (form.clone(), Some((variable, i))))
+        })
+        .collect()
+}
+
+/// `name = form` or `form` (named `junction_j`), its terms read at `index` (a loop's junction is
+/// named `name[i]`).
+fn junction(
+    expr: &Expr,
+    j: usize,
+    index: Index<'_>,
+    instances: &[String],
+    errors: &mut Errors,
+) -> Option<Junction> {
     let (name, form) = match expr {
         Expr::Assign(assign) => match &*assign.left {
             Expr::Path(p) if p.path.get_ident().is_some() => {
-                (p.path.get_ident()?.to_string(), &*assign.right)
+                let name = p.path.get_ident()?.to_string();
+                let name = match index {
+                    Some((_, i)) => format!("{name}[{i}]"),
+                    None => name,
+                };
+                (name, &*assign.right)
             }
             other => {
                 errors.push(
@@ -168,7 +303,7 @@ fn junction(expr: &Expr, j: usize, instances: &[&Ident], errors: &mut Errors) ->
     };
     let before = errors.len();
     let mut terms = Vec::new();
-    collect(form, 1.0, instances, &mut terms, errors);
+    collect(form, 1.0, index, instances, &mut terms, errors);
     for (k, term) in terms.iter().enumerate() {
         let seen = terms[..k]
             .iter()
@@ -194,28 +329,29 @@ const FORM: &str = "a junction is a sum of terms `c * instance.dx` (a number lit
                     differential `dx` of the subsystem's coordinate `x`, e.g. \
                     `loop.dq - pair.c1.dq`)";
 
-/// The terms of `form` with their signs.
+/// The terms of `form` with their signs, at `index`.
 fn collect(
     form: &Expr,
     sign: f64,
-    instances: &[&Ident],
+    index: Index<'_>,
+    instances: &[String],
     terms: &mut Vec<Term>,
     errors: &mut Errors,
 ) {
     match form {
-        Expr::Paren(p) => collect(&p.expr, sign, instances, terms, errors),
-        Expr::Group(g) => collect(&g.expr, sign, instances, terms, errors),
+        Expr::Paren(p) => collect(&p.expr, sign, index, instances, terms, errors),
+        Expr::Group(g) => collect(&g.expr, sign, index, instances, terms, errors),
         Expr::Unary(u) if matches!(u.op, UnOp::Neg(_)) => {
-            collect(&u.expr, -sign, instances, terms, errors)
+            collect(&u.expr, -sign, index, instances, terms, errors)
         }
         Expr::Binary(b) if matches!(b.op, BinOp::Add(_) | BinOp::Sub(_)) => {
-            collect(&b.left, sign, instances, terms, errors);
+            collect(&b.left, sign, index, instances, terms, errors);
             let right = if matches!(b.op, BinOp::Sub(_)) {
                 -sign
             } else {
                 sign
             };
-            collect(&b.right, right, instances, terms, errors);
+            collect(&b.right, right, index, instances, terms, errors);
         }
         Expr::Binary(b) if matches!(b.op, BinOp::Mul(_)) => {
             let (number, differential) = match (literal(&b.left), literal(&b.right)) {
@@ -229,18 +365,18 @@ fn collect(
                     "a junction's coefficient must be finite and nonzero",
                 );
             }
-            collect(differential, sign * number, instances, terms, errors);
+            collect(differential, sign * number, index, instances, terms, errors);
         }
-        other => match differential(other) {
-            Some((instance, path)) => match instances.iter().position(|i| **i == instance) {
-                Some(index) => terms.push(Term {
-                    instance: index,
+        other => match differential(other, index) {
+            Some((instance, span, path)) => match instances.iter().position(|i| *i == instance) {
+                Some(position) => terms.push(Term {
+                    instance: position,
                     path,
                     coefficient: sign,
                     span: other.span(),
                 }),
                 None => errors.push(
-                    instance.span(),
+                    span,
                     format!(
                         "unknown subsystem `{instance}`; the subsystems are {}",
                         instances
@@ -270,12 +406,34 @@ fn literal(expr: &Expr) -> Option<f64> {
     }
 }
 
-/// `instance.(path.)dx` or `instance.(path.)dx[i]`: the instance and the coordinate's path
-/// inside it (`x`, `path.x`, `x[i]`).
-fn differential(expr: &Expr) -> Option<(Ident, String)> {
+/// The value of an index: an integer literal, the loop's variable, or their sums and
+/// differences.
+fn index_value(expr: &Expr, index: Index<'_>) -> Option<i64> {
+    match expr {
+        Expr::Path(p) => {
+            let (variable, value) = index?;
+            p.path.is_ident(variable).then_some(value)
+        }
+        Expr::Paren(p) => index_value(&p.expr, index),
+        Expr::Binary(b) if matches!(b.op, BinOp::Add(_)) => {
+            Some(index_value(&b.left, index)? + index_value(&b.right, index)?)
+        }
+        Expr::Binary(b) if matches!(b.op, BinOp::Sub(_)) => {
+            Some(index_value(&b.left, index)? - index_value(&b.right, index)?)
+        }
+        other => literal(other)
+            .filter(|k| k.fract() == 0.0)
+            .map(|k| k as i64),
+    }
+}
+
+/// `instance.(path.)dx` or `instance.(path.)dx[i]`, the instance possibly an array's element
+/// `a[k]`: the instance's name, its span and the coordinate's path inside it (`x`, `path.x`,
+/// `x[i]`), the indices read at `index`.
+fn differential(expr: &Expr, at: Index<'_>) -> Option<(String, Span, String)> {
     let (field, index) = match expr {
-        Expr::Index(i) => match (&*i.expr, literal(&i.index)) {
-            (Expr::Field(f), Some(k)) if k >= 0.0 && k.fract() == 0.0 => (f, Some(k as usize)),
+        Expr::Index(i) => match (&*i.expr, index_value(&i.index, at)) {
+            (Expr::Field(f), Some(k)) if k >= 0 => (f, Some(k as usize)),
             _ => return None,
         },
         Expr::Field(f) => (f, None),
@@ -299,7 +457,17 @@ fn differential(expr: &Expr) -> Option<(Ident, String)> {
                 }
                 Member::Unnamed(_) => return None,
             },
-            Expr::Path(p) => break p.path.get_ident()?.clone(),
+            Expr::Path(p) => {
+                let name = p.path.get_ident()?;
+                break (name.to_string(), name.span());
+            }
+            Expr::Index(i) => match (&*i.expr, index_value(&i.index, at)) {
+                (Expr::Path(p), Some(k)) => {
+                    let name = p.path.get_ident()?;
+                    break (format!("{name}[{k}]"), base.span());
+                }
+                _ => return None,
+            },
             _ => return None,
         }
     };
@@ -308,7 +476,8 @@ fn differential(expr: &Expr) -> Option<(Ident, String)> {
         Some(k) => format!("{coordinate}[{k}]"),
         None => coordinate,
     });
-    Some((instance, segments.join(".")))
+    let (instance, span) = instance;
+    Some((instance, span, segments.join(".")))
 }
 
 /// The first junction that combines the ones before it (Gram–Schmidt over the coordinates'

@@ -54,10 +54,35 @@ struct Entries {
     holonomic: Option<Vec<Expr>>,
     forces: Option<Vec<Expr>>,
     inputs: Option<Vec<Ident>>,
+    /// An input was written as an array (reported): the forces, which would read it as one,
+    /// are not lowered, so that no error follows from the first.
+    input_array: bool,
     constraint_at: Option<Expr>,
     krate: Option<Expr>,
     subsystems: Option<Vec<Ident>>,
     junctions: Option<Vec<Expr>>,
+}
+
+/// An entry of `inputs(...)`: a name, and the brackets of `u[3]` where one is written as an
+/// array (refused with the fix, the name kept so that the forces reading it raise nothing more).
+struct InputName {
+    name: Ident,
+    brackets: Option<Span>,
+}
+
+impl syn::parse::Parse for InputName {
+    fn parse(input: syn::parse::ParseStream) -> syn::Result<Self> {
+        let name: Ident = input.parse()?;
+        let brackets = if input.peek(syn::token::Bracket) {
+            let content;
+            let bracket = syn::bracketed!(content in input);
+            let _: proc_macro2::TokenStream = content.parse()?;
+            Some(bracket.span.join())
+        } else {
+            None
+        };
+        Ok(Self { name, brackets })
+    }
 }
 
 /// The items of `key(a, b, ...)`; `empty` is the message for an empty list.
@@ -104,7 +129,29 @@ fn entries(arguments: Arguments, errors: &mut Errors) -> Entries {
             ("constraints", Meta::List(l)) => e.constraints = list(&l, LEAVE_OUT, errors),
             ("holonomic", Meta::List(l)) => e.holonomic = list(&l, LEAVE_OUT, errors),
             ("forces", Meta::List(l)) => e.forces = list(&l, LEAVE_OUT, errors),
-            ("inputs", Meta::List(l)) => e.inputs = list(&l, LEAVE_OUT, errors),
+            ("inputs", Meta::List(l)) => {
+                e.inputs = list::<InputName>(&l, LEAVE_OUT, errors).map(|names| {
+                    names
+                        .into_iter()
+                        .map(|input| {
+                            if let Some(span) = input.brackets {
+                                e.input_array = true;
+                                let u = &input.name;
+                                errors.push(
+                                    span,
+                                    format!(
+                                        "an input is one number: name each one, e.g. \
+                                         `inputs({u}_x, {u}_y, {u}_z)`, and read them in the \
+                                         forces as `[{u}_x, {u}_y, {u}_z]` (arrays of inputs \
+                                         are not supported yet)"
+                                    ),
+                                );
+                            }
+                            input.name
+                        })
+                        .collect()
+                })
+            }
             ("subsystems", Meta::List(l)) => {
                 let empty = "a model made of subsystems needs at least one, e.g. subsystems(a, b)";
                 e.subsystems = list(&l, empty, errors).or(Some(Vec::new()));
@@ -299,9 +346,25 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     // The rate of a coordinate: its velocity dot(x), or for a Hamiltonian its momentum p(x).
     let rate = if hamiltonian { "p" } else { "dot" };
     let mut closed_form = None;
-    let lagrangian = match (e.hamiltonian.take().or(e.lagrangian.take()), &coordinates) {
+    // A component without energy (a resistor, a source, a damper) gives only its forces: its
+    // Lagrangian is zero, written in its first coordinate.
+    let energy_less = match (&e.forces, &coordinates) {
+        (Some(_), Some(coordinates)) if e.lagrangian.is_none() && !is_product(coordinates) => {
+            coordinates.first().map(|c| {
+                let name = &c.name;
+                let expr: Expr = match c.length {
+                    None => syn::parse_quote!(0.0 * #name),
+                    Some(_) => syn::parse_quote!(0.0 * #name[0]),
+                };
+                expr
+            })
+        }
+        _ => None,
+    };
+    let written = e.hamiltonian.take().or(e.lagrangian.take());
+    let lagrangian = match (written.or(energy_less), &coordinates) {
         (None, _) => {
-            errors.push(Span::call_site(), "missing `lagrangian = ...`: an expression in the coordinates, dot(coordinate) and the parameters, or the path of a generic function (or `hamiltonian = ...`, in the coordinates and their momenta p(coordinate))");
+            errors.push(Span::call_site(), "missing `lagrangian = ...`: an expression in the coordinates, dot(coordinate) and the parameters, or the path of a generic function (or `hamiltonian = ...`, in the coordinates and their momenta p(coordinate)); a component without energy gives only `forces(...)`");
             None
         }
         // Refused in `hamiltonian_route`; its expression is not read.
@@ -437,6 +500,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
             };
             let forces = e
                 .forces
+                .filter(|_| !e.input_array)
                 .unwrap_or_default()
                 .iter()
                 .flat_map(

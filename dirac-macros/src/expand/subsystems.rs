@@ -7,7 +7,7 @@ use quote::{format_ident, quote, quote_spanned};
 use syn::spanned::Spanned;
 use syn::{Ident, Type};
 
-use crate::check::subsystems::Composite;
+use crate::check::subsystems::{Composite, Subsystem};
 
 /// The struct and its `impl DiracSystem`, in a block where `__dirac` names the runtime.
 pub fn expand(model: &Composite) -> TokenStream {
@@ -15,9 +15,10 @@ pub fn expand(model: &Composite) -> TokenStream {
     let name = &item.ident;
     let krate = &model.krate;
     let k = model.subsystems.len();
-    let fields: Vec<&Ident> = model.subsystems.iter().map(|(f, _)| f).collect();
-    let types: Vec<&Type> = model.subsystems.iter().map(|(_, t)| t).collect();
-    let labels: Vec<String> = fields.iter().map(|f| f.to_string()).collect();
+    // How each subsystem is read from `self` (`self.a`, `self.cells[2]`) and its name.
+    let fields: Vec<TokenStream> = model.subsystems.iter().map(Subsystem::access).collect();
+    let types: Vec<&Type> = model.subsystems.iter().map(|s| &s.ty).collect();
+    let labels: Vec<String> = model.subsystems.iter().map(Subsystem::label).collect();
     let sizes: Vec<Ident> = (0..k).map(|i| format_ident!("__N_{}", i)).collect();
     let slots: Vec<Ident> = (0..k).map(|i| format_ident!("__SLOT_{}", i)).collect();
     let size_items = types
@@ -79,12 +80,11 @@ pub fn expand(model: &Composite) -> TokenStream {
         Some(q) => q.clone(),
         None => quote! {
             __dirac::interconnection::common_quadrature(&[
-                #((#labels, self.#fields.quadrature()?)),*
+                #((#labels, #fields.quadrature()?)),*
             ])
         },
     };
-    let lookups = fields.iter().zip(&types).zip(&slots).map(|((field, ty), slot)| {
-        let label = field.to_string();
+    let lookups = labels.iter().zip(&types).zip(&slots).map(|((label, ty), slot)| {
         quote! {
             if let ::core::option::Option::Some(__rest) = __dirac::slot::descend(__path, #label) {
                 return match <#ty>::__dirac_coordinate(__rest) {
@@ -99,7 +99,8 @@ pub fn expand(model: &Composite) -> TokenStream {
             "subsystem `{label}` holds its one-forms at another constraint point than the \
              constrained subsystems before it: give them one `constraint_at`"
         );
-        quote_spanned!(fields[i].span()=> if __i == #i { ::core::panic!(#message) })
+        let span = model.subsystems[i].field.span();
+        quote_spanned!(span=> if __i == #i { ::core::panic!(#message) })
     });
     let own_point = match junction_count {
         0 => quote!(__POINT),
@@ -151,7 +152,7 @@ pub fn expand(model: &Composite) -> TokenStream {
 
             fn lagrangian<__D: __dirac::Scalar>(&self, __q: &#dual, __v: &#dual) -> __D {
                 let mut __l = #zero;
-                #(__l = __l + #slots.lagrangian(&self.#fields, __q, __v);)*
+                #(__l = __l + #slots.lagrangian(&#fields, __q, __v);)*
                 __l
             }
 
@@ -161,7 +162,7 @@ pub fn expand(model: &Composite) -> TokenStream {
                 __v: &#real,
             ) -> ::core::option::Option<__dirac::LagrangianGradient<{ __N }>> {
                 let mut __g = __dirac::LagrangianGradient::zero();
-                #(#slots.add_gradient(&self.#fields, __q, __v, &mut __g)?;)*
+                #(#slots.add_gradient(&#fields, __q, __v, &mut __g)?;)*
                 ::core::option::Option::Some(__g)
             }
 
@@ -171,13 +172,13 @@ pub fn expand(model: &Composite) -> TokenStream {
                 __v: &#real,
             ) -> ::core::option::Option<__dirac::LagrangianHessian<{ __N }>> {
                 let mut __h = __dirac::LagrangianHessian::zero();
-                #(#slots.add_hessian(&self.#fields, __q, __v, &mut __h)?;)*
+                #(#slots.add_hessian(&#fields, __q, __v, &mut __h)?;)*
                 ::core::option::Option::Some(__h)
             }
 
             fn one_form<__D: __dirac::Scalar>(&self, __q: &#dual, __a: usize) -> #dual {
                 #(
-                    if let ::core::option::Option::Some(__w) = #slots.one_form(&self.#fields, __q, __a) {
+                    if let ::core::option::Option::Some(__w) = #slots.one_form(&#fields, __q, __a) {
                         return __w;
                     }
                 )*
@@ -193,7 +194,7 @@ pub fn expand(model: &Composite) -> TokenStream {
 
             fn one_form_name(&self, __a: usize) -> ::std::string::String {
                 #(
-                    if let ::core::option::Option::Some(__name) = #slots.one_form_name(&self.#fields, #labels, __a) {
+                    if let ::core::option::Option::Some(__name) = #slots.one_form_name(&#fields, #labels, __a) {
                         return __name;
                     }
                 )*
@@ -206,7 +207,7 @@ pub fn expand(model: &Composite) -> TokenStream {
 
             fn one_form_is_constant(&self, __a: usize) -> bool {
                 #(
-                    if let ::core::option::Option::Some(__c) = #slots.one_form_is_constant(&self.#fields, __a) {
+                    if let ::core::option::Option::Some(__c) = #slots.one_form_is_constant(&#fields, __a) {
                         return __c;
                     }
                 )*
@@ -215,7 +216,7 @@ pub fn expand(model: &Composite) -> TokenStream {
 
             fn holonomic<__D: __dirac::Scalar>(&self, __q: &#dual, __b: usize) -> __D {
                 #(
-                    if let ::core::option::Option::Some(__g) = #slots.holonomic(&self.#fields, __q, __b) {
+                    if let ::core::option::Option::Some(__g) = #slots.holonomic(&#fields, __q, __b) {
                         return __g;
                     }
                 )*
@@ -230,13 +231,13 @@ pub fn expand(model: &Composite) -> TokenStream {
                 __u: &[__D],
             ) -> #dual {
                 let mut __f = <#dual>::from_element(#zero);
-                #(#slots.place_force(&self.#fields, __q, __v, __t, __u, &mut __f);)*
+                #(#slots.place_force(&#fields, __q, __v, __t, __u, &mut __f);)*
                 __f
             }
 
             fn input_name(&self, __i: usize) -> ::std::string::String {
                 #(
-                    if let ::core::option::Option::Some(__name) = #slots.input_name(&self.#fields, #labels, __i) {
+                    if let ::core::option::Option::Some(__name) = #slots.input_name(&#fields, #labels, __i) {
                         return __name;
                     }
                 )*
@@ -245,7 +246,7 @@ pub fn expand(model: &Composite) -> TokenStream {
 
             fn coordinate_name(&self, __i: usize) -> ::std::string::String {
                 #(
-                    if let ::core::option::Option::Some(__name) = #slots.coordinate_name(&self.#fields, #labels, __i) {
+                    if let ::core::option::Option::Some(__name) = #slots.coordinate_name(&#fields, #labels, __i) {
                         return __name;
                     }
                 )*
@@ -261,7 +262,7 @@ pub fn expand(model: &Composite) -> TokenStream {
 
             fn parameters(&self) -> ::std::vec::Vec<(::std::string::String, f64)> {
                 let mut __p = ::std::vec::Vec::new();
-                #(__dirac::slot::Slot::parameters(&self.#fields, #labels, &mut __p);)*
+                #(__dirac::slot::Slot::parameters(&#fields, #labels, &mut __p);)*
                 __p
             }
 
@@ -287,7 +288,7 @@ pub fn expand(model: &Composite) -> TokenStream {
             }
 
             fn energies(&self, __q: &#real, __v: &#real) -> [f64; #k] {
-                [#(#slots.energy(&self.#fields, __q, __v)),*]
+                [#(#slots.energy(&#fields, __q, __v)),*]
             }
 
             fn component_of(&self, __i: usize) -> usize {
@@ -298,6 +299,14 @@ pub fn expand(model: &Composite) -> TokenStream {
                     }
                 )*
                 __c
+            }
+
+            fn component_name(&self, __c: usize) -> ::std::string::String {
+                const __NAMES: [&str; #k] = [#(#labels),*];
+                __NAMES.get(__c).map_or_else(
+                    || ::std::format!("component {}", __c),
+                    |__n| ::std::string::String::from(*__n),
+                )
             }
         }
     };

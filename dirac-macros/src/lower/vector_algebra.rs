@@ -631,9 +631,12 @@ impl Lowering<'_, '_> {
                 }
                 (Matrix(m), Vector(v)) => Vector(matrix_vector(&m, &v, span)),
                 (Matrix(m), Matrix(n)) => Matrix(matrix_matrix(&m, &n, span)),
-                (Vector(_), Vector(_)) => {
-                    self.error(span, "`*` of two vectors: write dot(u, v) or cross(u, v)")
-                }
+                (Vector(_), Vector(_)) => self.error(
+                    span,
+                    "`*` of two vectors: write dot(u, v) or cross(u, v); to scale each \
+                         component (a diagonal inertia `j`), declare the parameter as a matrix, \
+                         `j: [[f64; 3]; 3]`, and `j * omega(R)` is its product with the vector",
+                ),
                 (Vector(_), Matrix(_)) => {
                     self.error(span, "a vector times a matrix: write transpose(M) * v")
                 }

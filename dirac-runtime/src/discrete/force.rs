@@ -66,6 +66,30 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         }
         (StepCovectors { impulse, end }, scale)
     }
+
+    /// The forces' work over the step on each chart coordinate `r`,
+    /// `h Σ_i b_i F̃(q_i, v_i, t_i, u)_r ξ̇_{i,r}`: the work `∫ ⟨F, q̇⟩ dt` along the step's path
+    /// by the quadrature, split by coordinate, at the increments `ξ_1..ξ_s` from `base`; `t` is
+    /// the time at the start of the step.
+    pub(crate) fn force_work(
+        &self,
+        base: &Point<C, N, f64>,
+        increments: &[SVector<f64, N>],
+        t: f64,
+        inputs: &[f64],
+    ) -> SVector<f64, N> {
+        let quad = self.quadrature();
+        let (h, space) = (self.h(), self.space());
+        let mut work = SVector::zeros();
+        for (i, (&b, &c)) in quad.weights().iter().zip(quad.nodes()).enumerate() {
+            let (xi, xi_dot) = self.node(i, increments);
+            let q = space.retract(base, &xi);
+            let v = space.push_forward(base, &xi, &xi_dot);
+            let f = space.pull_back(base, &xi, &self.system().force(&q, &v, t + c * h, inputs));
+            work += f.component_mul(&xi_dot) * (h * b);
+        }
+        work
+    }
 }
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>

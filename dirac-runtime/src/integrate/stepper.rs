@@ -12,6 +12,7 @@
 
 use std::marker::PhantomData;
 
+mod balance;
 mod integrate;
 
 use nalgebra::{DVector, SVector};
@@ -35,7 +36,7 @@ use crate::step::euler_lagrange::{EulerLagrange, check_finite};
 use crate::step::group_euler_lagrange::GroupEulerLagrange;
 use crate::step::hamilton::Hamilton;
 use crate::step::step_derivatives::{StepDerivatives, StepHessians};
-use crate::step::step_equations::{Point, State, StepEquations, Tangent};
+use crate::step::step_equations::{Point, State, StepEquations, StepWork, Tangent};
 
 /// The relative consistency an initial state must have with the model's constraints, at the
 /// default solver tolerance.
@@ -55,6 +56,8 @@ enum Problem {
 struct Proposal<const N: usize, M: Manifold<N>> {
     next: State<N, M>,
     report: NewtonReport,
+    /// The step's work, where the equations know it.
+    work: Option<StepWork<N>>,
 }
 
 /// A variational integrator for one system, one quadrature and one step size: Newton's method on
@@ -113,6 +116,9 @@ pub struct Stepper<S, const N: usize, E: StepEquations<N> = EulerLagrange<S, N, 
     violation: Option<f64>,
     /// Multipliers of the last step (zeros before the first).
     multipliers: Vec<f64>,
+    /// The work done since the start by the forces and inputs and by the constraints, summed
+    /// over the steps ([`StepWork`]); `None` once a step's work is unknown.
+    work: Option<StepWork<N>>,
     system: PhantomData<fn() -> S>,
 }
 
@@ -204,6 +210,63 @@ impl<S: HamiltonianSystem<N>, const N: usize> Stepper<S, N, Hamilton<S, N>> {
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
     Stepper<S, N, EulerLagrange<S, N, C>>
 {
+    /// [`step_linearised`](Self::step_linearised) in positions and velocities: advances one
+    /// step and returns `A = ∂(q_{k+1}, v_{k+1})/∂(q_k, v_k)` and `B = ∂(q_{k+1}, v_{k+1})/∂u`
+    /// (the blocks named `p` read `v`; see [`StepDerivatives::in_velocities`]), for a feedback on
+    /// the velocities without rescaling momentum weights. Refused with `Unsupported`, the state
+    /// unchanged, where `∂²L/∂v²` is singular at the step's end (a degenerate Lagrangian), and
+    /// on configuration spaces other than `Rⁿ` and its charts.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// A mass 2 on a unit spring: p = 2v.
+    /// #[derive(Clone)]
+    /// struct Heavy;
+    /// impl DiracSystem<1> for Heavy {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] - q[0] * q[0] * 0.5
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Heavy, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// let in_momenta = stepper.clone().step_linearised()?;
+    /// let in_velocities = stepper.step_linearised_in_velocities()?;
+    /// // ∂q_{k+1}/∂v_k = ∂q_{k+1}/∂p_k · ∂p/∂v = 2 ∂q_{k+1}/∂p_k.
+    /// assert!((in_velocities.q_p[(0, 0)] - 2.0 * in_momenta.q_p[(0, 0)]).abs() < 1e-15);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn step_linearised_in_velocities(&mut self) -> Result<StepDerivatives<N>, DiracError> {
+        let Some(state) = self.state else {
+            return Err(DiracError::NotStarted);
+        };
+        let legendre = |system: &S, q: &SVector<f64, N>, v: &SVector<f64, N>| {
+            let h = crate::model::derivatives::hessian(system, q, v);
+            (h.qv.transpose(), h.vv)
+        };
+        let v = self.v()?;
+        let start = legendre(self.equations.system(), &state.q, &v);
+        let proposal = self.solve_step_at_root()?;
+        let at = self.factorise_at_root()?;
+        let derivatives = self
+            .equations
+            .linearise(&at, &self.unknowns, &self.newton)?;
+        let next = proposal.next;
+        let v_next = self.velocity_at(next.t, &next.q, &next.p, &next.velocity, true)?;
+        let end = legendre(self.equations.system(), &next.q, &v_next);
+        let in_velocities = derivatives
+            .in_velocities((&start.0, &start.1), (&end.0, &end.1))
+            .ok_or_else(|| {
+                DiracError::Unsupported(
+                    "derivatives of the step map in (q, v) where ∂²L/∂v² is singular (a \
+                     degenerate Lagrangian): take them in (q, p) with step_linearised"
+                        .into(),
+                )
+            })?;
+        self.accept(proposal);
+        Ok(in_velocities)
+    }
+
     /// A stepper for `system` whose steps work in the charts of `space` (see
     /// [`configuration_space`](crate::space::configuration_space)); otherwise as [`Stepper::new`].
     ///
@@ -579,6 +642,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             predictor: Predictor::new(unknowns),
             report: None,
             violation: Some(0.0),
+            work: Some(StepWork::zero()),
             system: PhantomData,
         })
     }
@@ -1082,6 +1146,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         self.steps = 0;
         self.predictor.clear(self.unknowns.len());
         self.report = None;
+        self.work = Some(StepWork::zero());
     }
 
     /// Advances one step. On error the state is unchanged.
@@ -1181,7 +1246,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let report = result.map_err(|f| self.failure(Problem::Step, f))?;
         let mut next = self.equations.advance(state, &self.unknowns, self.steps)?;
         next.t = self.start + (self.steps + 1) as f64 * self.equations.h();
-        Ok(Proposal { next, report })
+        let work = self.equations.work(state, &self.unknowns);
+        Ok(Proposal { next, report, work })
     }
 
     /// Makes a solved step current; its solution is still in `unknowns`.
@@ -1198,6 +1264,10 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             self.predictor.detach();
         }
         self.violation = None;
+        self.work = self
+            .work
+            .zip(proposal.work)
+            .map(|(total, step)| total + step);
         self.steps += 1;
         self.before = self.state;
         self.state = Some(proposal.next);
@@ -1447,6 +1517,68 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             return Err(DiracError::NotStarted);
         };
         self.energy_of(&state, self.steps)
+    }
+
+    /// The work `Σ_k W_k` done on the model since the start by its forces and inputs, each
+    /// step's in the discrete form the scheme uses (see [`StepWork`]): with the energy,
+    /// `E − E_0 − Σ_k W_k` is the energy balance's defect
+    /// ([`energy_balance_error`](Self::energy_balance_error)). `Unsupported` for equations that
+    /// do not report their work (first-order Lagrangians, projected steps).
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// /// An oscillator pushed by a constant force u: L = (v² − q²)/2, F = u dq.
+    /// struct Pushed;
+    /// impl DiracSystem<1> for Pushed {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Pushed, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![0.0], vector![0.0])?;
+    /// stepper.set_inputs(&[0.5])?;
+    /// stepper.run(100)?;
+    /// // The work of a constant force is u Δq, and the midpoint rule balances it exactly.
+    /// assert!((stepper.work()? - 0.5 * stepper.q()[0]).abs() < 1e-14);
+    /// assert!(stepper.energy_balance_error()?.abs() < 1e-14);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn work(&self) -> Result<f64, DiracError> {
+        self.work_by_coordinate().map(|work| work.total())
+    }
+
+    /// The work since the start on each chart coordinate, of the forces and inputs and of the
+    /// constraint forces (see [`StepWork`]; on a group, each step's in its own chart at `q_k`).
+    /// `NotStarted` before a start; `Unsupported` as for [`work`](Self::work).
+    pub fn work_by_coordinate(&self) -> Result<StepWork<N>, DiracError> {
+        if self.state.is_none() {
+            return Err(DiracError::NotStarted);
+        }
+        self.work.ok_or_else(|| {
+            DiracError::Unsupported(format!(
+                "the work of forces and inputs on a step of {}",
+                E::NAME
+            ))
+        })
+    }
+
+    /// The energy balance's defect since the start, `E − E_0 − Σ_k W_k` (see
+    /// [`work`](Self::work)): zero to round-off where the unforced scheme keeps the energy
+    /// exactly (the midpoint rule and Gauss–Galerkin steps on a quadratic energy, with any
+    /// forces and inputs), and of the order of the scheme's energy error otherwise.
+    pub fn energy_balance_error(&self) -> Result<f64, DiracError> {
+        let work = self.work()?;
+        let Some(origin) = self.origin else {
+            return Err(DiracError::NotStarted);
+        };
+        Ok(self.energy()? - self.energy_of(&origin, 0)? - work)
     }
 
     /// The energy of `state`, reached after `steps` steps (for the error message).

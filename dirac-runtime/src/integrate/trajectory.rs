@@ -1,5 +1,5 @@
-//! Recorded trajectories: time, positions, velocities, momenta and energy, with the run's
-//! metadata, columns by name and CSV output.
+//! Recorded trajectories: time, positions, velocities, momenta, energy and the work done on the
+//! model, with the run's metadata, the energy balance, columns by name and CSV output.
 
 use std::io::Write;
 use std::path::Path;
@@ -66,6 +66,9 @@ pub struct Trajectory<const N: usize, M: Manifold<N> = Vectors> {
     v: Vec<M::Tangent<f64>>,
     p: Vec<M::Tangent<f64>>,
     energy: Vec<f64>,
+    /// The work done by the forces and inputs from the stepper's start to each sample (see
+    /// [`Stepper::work`](crate::Stepper::work)); `None` once a sample came without it.
+    work: Option<Vec<f64>>,
     /// Names of the multipliers (empty for an unconstrained system).
     multiplier_names: Vec<String>,
     /// The multipliers of every sample in one buffer, `multiplier_names.len()` per sample (one
@@ -103,6 +106,7 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
             v: Vec::new(),
             p: Vec::new(),
             energy: Vec::new(),
+            work: Some(Vec::new()),
             multiplier_names,
             multipliers: Vec::new(),
             violation: Vec::new(),
@@ -137,9 +141,42 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
                 multipliers.len()
             )));
         }
-        self.append(sample, energy);
-        self.violation.push(violation);
-        self.multipliers.extend_from_slice(multipliers);
+        self.record(sample, energy, None, Some((violation, multipliers)))
+    }
+
+    /// Appends a sample with the work done up to it (`None`: unknown, which drops the work
+    /// column) and, for a constrained system, its violation and multipliers.
+    pub(crate) fn record(
+        &mut self,
+        sample: &Sample<N, M>,
+        energy: f64,
+        work: Option<f64>,
+        constraint: Option<(f64, &[f64])>,
+    ) -> Result<(), DiracError> {
+        let expected = self.multiplier_names.len();
+        let given = constraint.map_or(0, |(_, m)| m.len());
+        if constraint.is_some() != (expected > 0) || given != expected {
+            return Err(DiracError::Dimension(
+                if expected > 0 && constraint.is_none() {
+                    format!("the trajectory records {expected} multipliers: use push_constrained")
+                } else {
+                    format!("the trajectory records {expected} multipliers, got {given}")
+                },
+            ));
+        }
+        self.t.push(sample.t);
+        self.q.push(sample.q);
+        self.v.push(sample.v);
+        self.p.push(sample.p);
+        self.energy.push(energy);
+        match (&mut self.work, work) {
+            (Some(column), Some(work)) => column.push(work),
+            _ => self.work = None,
+        }
+        if let Some((violation, multipliers)) = constraint {
+            self.violation.push(violation);
+            self.multipliers.extend_from_slice(multipliers);
+        }
         Ok(())
     }
 
@@ -157,6 +194,9 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
         self.v.reserve(additional);
         self.p.reserve(additional);
         self.energy.reserve(additional);
+        if let Some(work) = &mut self.work {
+            work.reserve(additional);
+        }
         if !self.multiplier_names.is_empty() {
             self.violation.reserve(additional);
             self.multipliers
@@ -194,24 +234,10 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
     }
 
     /// Appends a sample of an unconstrained system; a trajectory that records multipliers takes
-    /// [`push_constrained`](Self::push_constrained) instead (an error here).
+    /// [`push_constrained`](Self::push_constrained) instead (an error here). A sample pushed by
+    /// hand carries no work: the trajectory then has no work column.
     pub fn push(&mut self, sample: &Sample<N, M>, energy: f64) -> Result<(), DiracError> {
-        if !self.multiplier_names.is_empty() {
-            return Err(DiracError::Dimension(format!(
-                "the trajectory records {} multipliers: use push_constrained",
-                self.multiplier_names.len()
-            )));
-        }
-        self.append(sample, energy);
-        Ok(())
-    }
-
-    fn append(&mut self, sample: &Sample<N, M>, energy: f64) {
-        self.t.push(sample.t);
-        self.q.push(sample.q);
-        self.v.push(sample.v);
-        self.p.push(sample.p);
-        self.energy.push(energy);
+        self.record(sample, energy, None, None)
     }
 
     /// Number of samples.
@@ -254,6 +280,14 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
         &self.energy
     }
 
+    /// The work done on the model by its forces and inputs from the stepper's start to each
+    /// sample ([`Stepper::work`](crate::Stepper::work)); `None` where some sample came without
+    /// it: pushed by hand, interpolated between steps (`saveat`), or stepped by equations that
+    /// do not report their work.
+    pub fn work(&self) -> Option<&[f64]> {
+        self.work.as_deref()
+    }
+
     /// Sample `k`.
     pub fn sample(&self, k: usize) -> Option<Sample<N, M>> {
         (k < self.len()).then(|| Sample {
@@ -272,8 +306,75 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
         self.energy.iter().fold(0.0, |m, e| m.max((e - e0).abs()))
     }
 
+    /// The energy balance over the trajectory: the energy's change from the first sample to the
+    /// last against the work done on the model by its forces and inputs, and the largest
+    /// defect `|E_k − E_0 − (W_k − W_0)|` over the samples (see [`EnergyBalance`]).
+    /// `Unsupported` without a work column ([`work`](Self::work)), `NotStarted` when empty.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Quadrature, Run, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// /// A damped oscillator: L = (v² − q²)/2, F = −0.1 v dq.
+    /// struct Damped;
+    /// impl DiracSystem<1> for Damped {
+    ///     const FORCES: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>, _t: f64, _u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         v * -0.1
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Damped, Quadrature::midpoint(), 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// let trajectory = stepper.solve(Run::until(20.0))?.trajectory;
+    /// let balance = trajectory.energy_balance()?;
+    /// assert!(balance.work < -0.4); // the damper took most of the energy 0.5
+    /// assert!(balance.max_defect < 1e-14); // and the midpoint rule books every bit of it
+    /// println!("{balance}");
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn energy_balance(&self) -> Result<EnergyBalance, DiracError> {
+        let work = self.work.as_deref().ok_or_else(|| {
+            DiracError::Unsupported(
+                "the energy balance of a trajectory without a work column (a sample pushed by \
+                 hand, interpolated between steps by saveat, or stepped by equations that do \
+                 not report their work)"
+                    .into(),
+            )
+        })?;
+        let (Some(&e0), Some(&w0)) = (self.energy.first(), work.first()) else {
+            return Err(DiracError::NotStarted);
+        };
+        let defect = |(e, w): (&f64, &f64)| (e - e0) - (w - w0);
+        let max_defect = self
+            .energy
+            .iter()
+            .zip(work)
+            .fold(0.0_f64, |m, ew| m.max(defect(ew).abs()));
+        let scale = self
+            .energy
+            .iter()
+            .chain(work)
+            .fold(0.0_f64, |m, x| m.max(x.abs()));
+        Ok(EnergyBalance {
+            initial: e0,
+            last: self.energy[self.len() - 1],
+            work: work[self.len() - 1] - w0,
+            max_defect,
+            scale,
+        })
+    }
+
+    /// The largest defect of the energy balance over the samples,
+    /// `max_k |E_k − E_0 − (W_k − W_0)|` (see [`energy_balance`](Self::energy_balance)).
+    pub fn max_energy_balance_error(&self) -> Result<f64, DiracError> {
+        self.energy_balance().map(|balance| balance.max_defect)
+    }
+
     /// The names of the columns, in the CSV's order: `t`, the coordinates, `v_<coordinate>`,
-    /// `p_<coordinate>`, `energy`, and for a constrained system `constraint_violation` and the
+    /// `p_<coordinate>`, `energy`, `work` (where it is known, see [`work`](Self::work)), and for a constrained system `constraint_violation` and the
     /// multipliers. On a product manifold a rotation `R` has the columns `R_11` … `R_33`, its
     /// body angular velocity `v_R_x` … and momentum `p_R_x` …; a unit vector `n` has `n_x` …,
     /// `v_n_x` … and `p_n_x` … (see [`Manifold::point_names`]).
@@ -285,6 +386,7 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
             .chain(tangent.iter().map(|n| format!("v_{n}")))
             .chain(tangent.iter().map(|n| format!("p_{n}")))
             .chain(std::iter::once("energy".to_string()))
+            .chain(self.work.is_some().then(|| "work".to_string()))
             .chain(constrained.then(|| "constraint_violation".to_string()))
             .chain(self.multiplier_names.iter().cloned())
             .collect()
@@ -305,6 +407,9 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
         row.extend(M::tangent_components(&self.v[k]));
         row.extend(M::tangent_components(&self.p[k]));
         row.push(self.energy[k]);
+        if let Some(work) = &self.work {
+            row.push(work[k]);
+        }
         if let (Some(v), Some(m)) = (self.violation.get(k), self.multipliers_at(k)) {
             row.push(*v);
             row.extend(m.iter());
@@ -327,6 +432,46 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
     /// Writes the CSV to a file, creating its directory if needed.
     pub fn save_csv(&self, path: impl AsRef<Path>) -> Result<(), DiracError> {
         self.write_csv(create(path.as_ref())?)
+    }
+}
+
+/// The energy balance of a trajectory ([`Trajectory::energy_balance`]): how much the energy
+/// changed, how much work the forces and inputs did, and how well the two agree.
+///
+/// Each step's work is the one the scheme uses ([`StepWork`](crate::StepWork)), so that for
+/// the midpoint rule and Gauss–Galerkin steps on a model with a quadratic energy
+/// (oscillators, circuits, linear mechanisms) `E_{k+1} − E_k = W_k` holds to round-off
+/// whatever the forces and inputs are; elsewhere the defect is the scheme's energy error,
+/// which falls with the step at the scheme's order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct EnergyBalance {
+    /// The energy at the first sample.
+    pub initial: f64,
+    /// The energy at the last sample.
+    pub last: f64,
+    /// The work done by the forces and inputs from the first sample to the last.
+    pub work: f64,
+    /// The largest defect `|E_k − E_0 − (W_k − W_0)|` over the samples.
+    pub max_defect: f64,
+    /// The largest energy or work in the balance: the defect's round-off floor is a few ulps
+    /// of it.
+    pub scale: f64,
+}
+
+impl std::fmt::Display for EnergyBalance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "energy {:.6e} -> {:.6e}: change {:+.6e}, work of forces and inputs {:+.6e}, \
+             largest balance defect {:.1e} ({:.1e} of the largest term)",
+            self.initial,
+            self.last,
+            self.last - self.initial,
+            self.work,
+            self.max_defect,
+            self.max_defect / self.scale.max(f64::MIN_POSITIVE)
+        )
     }
 }
 

@@ -194,6 +194,11 @@ pub trait Interconnected<const N: usize, const K: usize, const C: usize>: DiracS
     /// The component of coordinate `i`.
     fn component_of(&self, i: usize) -> usize;
 
+    /// The name of component `c` (`0 <= c < K`), for reports: its instance's name.
+    fn component_name(&self, c: usize) -> String {
+        format!("component {c}")
+    }
+
     /// What crossed the ports over the step of size `h` from `q_k` to `q_{k+1}` whose
     /// multipliers are `multipliers` ([`Stepper::multipliers`](crate::Stepper::multipliers) after
     /// the step): the efforts and each component's port work. An `Err(Unsupported)` for a
@@ -475,6 +480,13 @@ where
 
     fn component_of(&self, i: usize) -> usize {
         usize::from(i >= NA)
+    }
+
+    fn component_name(&self, c: usize) -> String {
+        self.instances
+            .get(c)
+            .cloned()
+            .unwrap_or_else(|| format!("component {c}"))
     }
 }
 

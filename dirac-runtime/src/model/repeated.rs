@@ -120,6 +120,13 @@ impl<S: DiracSystem<M>, const K: usize, const M: usize, const N: usize, const C:
     fn component_of(&self, i: usize) -> usize {
         i / M
     }
+
+    fn component_name(&self, c: usize) -> String {
+        self.instances
+            .get(c)
+            .cloned()
+            .unwrap_or_else(|| format!("component {c}"))
+    }
 }
 
 impl<S: DiracSystem<M>, const K: usize, const M: usize, const N: usize, const C: usize>

@@ -135,6 +135,29 @@ impl<D: Scalar, const K: usize, const A: usize, const B: usize> Configuration<D,
     }
 }
 
+impl<const K: usize, const A: usize, const B: usize> Configuration<f64, K, A, B> {
+    /// Rotation `i`'s attitude as a unit quaternion `[w, x, y, z]`, `w ≥ 0` (see
+    /// [`rotation::quaternion`]); `None` past the last rotation.
+    ///
+    /// ```
+    /// use dirac_runtime::product::Configuration;
+    /// use nalgebra::Matrix3;
+    /// let at_rest = Configuration::of_rotation(Matrix3::identity());
+    /// assert_eq!(at_rest.quaternion(0), Some([1.0, 0.0, 0.0, 0.0]));
+    /// assert_eq!(at_rest.euler_angles(0), Some([0.0, 0.0, 0.0]));
+    /// assert_eq!(at_rest.quaternion(1), None);
+    /// ```
+    pub fn quaternion(&self, i: usize) -> Option<[f64; 4]> {
+        self.rotation.get(i).map(rotation::quaternion)
+    }
+
+    /// Rotation `i`'s attitude as Euler angles `[roll, pitch, yaw]` (z-y-x, see
+    /// [`rotation::euler_angles`]); `None` past the last rotation.
+    pub fn euler_angles(&self, i: usize) -> Option<[f64; 3]> {
+        self.rotation.get(i).map(rotation::euler_angles)
+    }
+}
+
 impl<D: Scalar> Configuration<D, 0, 1, 0> {
     /// A rigid body's attitude `R` as a point of `SO(3)`.
     ///

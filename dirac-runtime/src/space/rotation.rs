@@ -168,6 +168,40 @@ pub fn vee<D: Scalar>(m: &Matrix3<D>) -> Vector3<D> {
     )
 }
 
+/// The attitude `R` (body to space) as a unit quaternion `[w, x, y, z]` with `w ≥ 0`:
+/// `R = (w² − |v|²) I + 2 v vᵀ + 2 w v̂`, `v = (x, y, z)`; a rotation by `θ` about the unit axis
+/// `a` is `[cos(θ/2), sin(θ/2) a]`.
+///
+/// ```
+/// use dirac_runtime::rotation::{Retraction, quaternion};
+/// use nalgebra::Vector3;
+/// let r = Retraction::Exp.map(&Vector3::new(0.0, 0.0, 1.0)); // 1 rad about z
+/// let q = quaternion(&r);
+/// assert!((q[0] - 0.5_f64.cos()).abs() < 1e-15 && (q[3] - 0.5_f64.sin()).abs() < 1e-15);
+/// ```
+pub fn quaternion(r: &Matrix3<f64>) -> [f64; 4] {
+    let rotation = nalgebra::Rotation3::from_matrix_unchecked(*r);
+    let q = nalgebra::UnitQuaternion::from_rotation_matrix(&rotation);
+    let sign = if q.w < 0.0 { -1.0 } else { 1.0 };
+    [q.w, q.i, q.j, q.k].map(|c| c * sign)
+}
+
+/// The attitude `R` (body to space) as Euler angles `[roll, pitch, yaw]` about the body's
+/// `x`, `y` and `z` axes in that order of rotation (`R = R_z(yaw) R_y(pitch) R_x(roll)`, the
+/// aerospace z-y-x convention), with `pitch ∈ [−π/2, π/2]`.
+///
+/// ```
+/// use dirac_runtime::rotation::euler_angles;
+/// use nalgebra::{Rotation3, Vector3};
+/// let r = Rotation3::from_euler_angles(0.1, -0.2, 0.3).into_inner();
+/// let [roll, pitch, yaw] = euler_angles(&r);
+/// assert!((roll - 0.1).abs() < 1e-15 && (pitch + 0.2).abs() < 1e-15 && (yaw - 0.3).abs() < 1e-15);
+/// ```
+pub fn euler_angles(r: &Matrix3<f64>) -> [f64; 3] {
+    let (roll, pitch, yaw) = nalgebra::Rotation3::from_matrix_unchecked(*r).euler_angles();
+    [roll, pitch, yaw]
+}
+
 /// `R (3I − RᵀR)/2`: one Newton step of the polar decomposition, which takes a matrix within
 /// `ε` of a rotation to within `O(ε²)`; the stepper applies it after every step so that `RᵀR = I`
 /// holds to round-off however long the run.

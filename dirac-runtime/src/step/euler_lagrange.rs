@@ -37,7 +37,7 @@ use crate::space::configuration_space::{ConfigurationSpace, StepCovectors};
 use crate::space::manifold::Vectors;
 use crate::step::dense_output::{ChartPath, Sample, chart_path};
 use crate::step::step_derivatives::{StepDerivatives, StepHessians};
-use crate::step::step_equations::{State, StepEquations};
+use crate::step::step_equations::{State, StepEquations, StepWork};
 
 /// The discrete Euler–Lagrange equations of a [`DiracSystem`] under a quadrature, on the
 /// configuration space `C`, with the system's forces, inputs and constraints: the
@@ -94,6 +94,9 @@ pub struct EulerLagrange<S, const N: usize, C> {
     increments: Vec<SVector<f64, N>>,
     /// The step's covectors at the point assembled last.
     covectors: StepCovectors<N>,
+    /// The constraint and coupling impulse in `covectors` (its part `μ̃` from the multipliers
+    /// and the junctions), for the constraints' work.
+    constraint_impulse: SVector<f64, N>,
     /// `covectors` lacks the discrete Lagrangian's part, which `advance` then computes (an
     /// assembly without a Jacobian leaves it out where the residual does not need it).
     covectors_pending: bool,
@@ -156,6 +159,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             holonomic_forms: vec![SVector::zeros(); S::HOLONOMIC],
             increments: vec![SVector::zeros(); s],
             covectors: StepCovectors::zero(),
+            constraint_impulse: SVector::zeros(),
             covectors_pending: false,
             scratch: DMatrix::zeros(0, 0),
             coupling: None,
@@ -856,6 +860,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             jacobian.as_deref_mut(),
             true,
         )?;
+        let mut constraint_impulse = SVector::zeros();
         if S::ONE_FORMS > 0 {
             let (impulse, size) = constraint::closed_one_forms(
                 discrete.system(),
@@ -866,6 +871,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 residual,
                 jacobian,
             );
+            constraint_impulse = impulse;
             covectors += StepCovectors {
                 impulse,
                 end: impulse * (1.0 - self.point.share()),
@@ -873,6 +879,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             scale = scale.max(size);
         }
         self.covectors = covectors;
+        self.constraint_impulse = constraint_impulse;
         self.covectors_pending = false;
         Some(scale)
     }
@@ -978,6 +985,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         mut scale: f64,
     ) -> f64 {
         let discrete = &self.discrete;
+        let mut constraint_impulse = SVector::zeros();
         if Self::constrained() {
             let constraints = StepConstraints {
                 system: discrete.system(),
@@ -991,6 +999,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 h: discrete.h(),
             };
             let (impulses, size) = constraints.add(x, residual, jacobian);
+            constraint_impulse += impulses.impulse;
             covectors += impulses;
             scale = scale.max(size);
         }
@@ -998,12 +1007,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             for i in 0..N {
                 residual[i] += share * impulse[i];
             }
+            constraint_impulse += impulse;
             covectors += StepCovectors {
                 impulse,
                 end: impulse * (1.0 - share),
             };
         }
         self.covectors = covectors;
+        self.constraint_impulse = constraint_impulse;
         scale
     }
 }
@@ -1452,6 +1463,32 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         }
         self.velocity_with_multipliers(newton, t, q, p, guess, self.hidden.as_ref())
             .map(|solved| (solved.velocity, solved.energy))
+    }
+
+    /// The forces' work along the step's path; the constraints' from their impulse on a
+    /// degree-1 step that no projection follows (see [`StepWork`]). `None` for first-order and
+    /// projected steps, whose rows are collocated rather than variational.
+    fn work(&self, state: &State<N>, x: &DVector<f64>) -> Option<StepWork<N>> {
+        if self.projected() || self.first_order() {
+            return None;
+        }
+        let forces = if S::FORCES {
+            self.discrete
+                .force_work(&state.q, &self.increments, state.t, &self.inputs)
+        } else {
+            SVector::zeros()
+        };
+        let single = self.discrete.quadrature().degree() == 1
+            && self.hidden().count() == 0
+            && !(S::HOLONOMIC > 0 && self.holonomic_scheme == HolonomicScheme::Rattle);
+        let constraints = single.then(|| {
+            let xi = self.end_increment(x);
+            self.constraint_impulse.component_mul(&xi) / self.discrete.h()
+        });
+        Some(StepWork {
+            forces,
+            constraints,
+        })
     }
 
     fn energy(&self, q: &SVector<f64, N>, _p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64 {

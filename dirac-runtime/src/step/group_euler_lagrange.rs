@@ -38,7 +38,7 @@ use crate::solve::newton::{Newton, NewtonFailure};
 use crate::space::configuration_space::{ConfigurationSpace, Point, StepCovectors, Tangent};
 use crate::space::manifold::Manifold;
 use crate::step::dense_output::{ChartPath, Sample, chart_path};
-use crate::step::step_equations::{State, StepEquations};
+use crate::step::step_equations::{State, StepEquations, StepWork};
 
 /// The discrete Euler–Lagrange equations of a [`DiracSystem`] on a configuration space `C` whose
 /// step differentiates the discrete Lagrangian through the moving chart (see the
@@ -83,6 +83,8 @@ pub struct GroupEulerLagrange<S, const N: usize, C: ConfigurationSpace<N>> {
     increments: Vec<SVector<f64, N>>,
     /// The step's end covector at the point assembled last.
     covectors: StepCovectors<N>,
+    /// The one-forms' and the junctions' impulse at the point assembled last (for their work).
+    constraint_impulse: SVector<f64, N>,
     /// `covectors` lacks the discrete Lagrangian's part (an assembly without a Jacobian leaves it
     /// to `advance`).
     covectors_pending: bool,
@@ -128,6 +130,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             momentum: SVector::zeros(),
             increments: vec![SVector::zeros(); s],
             covectors: StepCovectors::zero(),
+            constraint_impulse: SVector::zeros(),
             covectors_pending: false,
             scratch: DMatrix::zeros(0, 0),
             coupling: None,
@@ -411,12 +414,14 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
         );
         self.covectors_pending = lagrangian.is_none();
         let mut covectors = lagrangian.unwrap_or_else(StepCovectors::zero);
+        self.constraint_impulse = SVector::zeros();
         if let Some((impulse, share)) = self.coupling {
             // The end's share is added to `p_{k+1}` in its own chart (`advance`).
             for i in 0..N {
                 residual[i] += share * impulse[i];
             }
             covectors.impulse += impulse * share;
+            self.constraint_impulse = impulse;
         }
         if !S::FORCES && S::ONE_FORMS == 0 {
             self.covectors = covectors;
@@ -460,6 +465,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
                 h: discrete.h(),
             };
             let (impulse, size) = constraints.add_one_forms(x, residual, jacobian);
+            self.constraint_impulse += impulse;
             covectors.impulse += impulse;
             covectors.end += impulse * (1.0 - self.point.share());
             scale = scale.max(size);
@@ -613,6 +619,25 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
 
     fn input_name(&self, i: usize) -> String {
         self.discrete.system().input_name(i)
+    }
+
+    /// The forces' work along the step's path in the chart at `q_k`; the one-forms' and
+    /// junctions' from their impulse on a degree-1 step (see [`StepWork`]).
+    fn work(&self, state: &State<N, C::Manifold>, x: &DVector<f64>) -> Option<StepWork<N>> {
+        let forces = if S::FORCES {
+            self.discrete
+                .force_work(&state.q, &self.increments, state.t, &self.inputs)
+        } else {
+            SVector::zeros()
+        };
+        let constraints = (self.discrete.quadrature().degree() == 1).then(|| {
+            let xi = x.fixed_rows::<N>(self.layout.end_point()).into_owned();
+            self.constraint_impulse.component_mul(&xi) / self.discrete.h()
+        });
+        Some(StepWork {
+            forces,
+            constraints,
+        })
     }
 
     /// `⟨∂L/∂v, v⟩ − L(q, v)`, read in the chart at `q`.

@@ -74,7 +74,7 @@ use crate::solve::newton::{Newton, NewtonFailure};
 use crate::space::configuration_space::compensated_add;
 use crate::space::manifold::Vectors;
 use crate::step::step_derivatives::StepDerivatives;
-use crate::step::step_equations::{State, StepEquations};
+use crate::step::step_equations::{State, StepEquations, StepWork};
 
 /// Where a step holds the constraint one-forms: the point `Q_c = Σ_j position_j Q_j`, the
 /// velocity `Q̇_c = Σ_j rate_j Q_j / h` and the weights `w_j` of the constraint's force on the
@@ -903,6 +903,30 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
 
     /// `H(q, p̃)` at the momentum `p̃ = p + C(q)ᵀν` whose velocity the constraints allow
     /// (`C ∂H/∂p(q, p̃) = 0`, `C` the rows `dg_b` and `A_a`; `H(q, p)` without constraints).
+    /// The forces' work along the step's path, `h Σ_i b_i F(Q(c_i), P_i, t_i, u) ∘ Q̇(c_i)`
+    /// (see [`StepWork`]); the constraints' only where there are none.
+    fn work(&self, state: &State<N>, x: &DVector<f64>) -> Option<StepWork<N>> {
+        let (s, h) = (self.degree(), self.h);
+        let mut forces = SVector::zeros();
+        if S::FORCES {
+            for i in 0..self.nodes() {
+                let (c, b) = (self.quadrature.nodes()[i], self.quadrature.weights()[i]);
+                let position: Vec<f64> = (0..=s).map(|j| self.quadrature.ell(i, j)).collect();
+                let velocity: Vec<f64> = (0..=s).map(|j| self.quadrature.ell_prime(i, j)).collect();
+                let q = state.q + self.combination(x, &position);
+                let v = self.combination(x, &velocity) / h;
+                let p = x.fixed_rows::<N>(self.node_momentum(i)).into_owned();
+                let (f, _, _) = self.force(&q, &p, state.t + c * h, false);
+                forces += f.component_mul(&v) * (h * b);
+            }
+        }
+        let unconstrained = S::ONE_FORMS == 0 && S::HOLONOMIC == 0;
+        Some(StepWork {
+            forces,
+            constraints: unconstrained.then(SVector::zeros),
+        })
+    }
+
     fn energy(&self, q: &SVector<f64, N>, p: &SVector<f64, N>, _v: &SVector<f64, N>) -> f64 {
         self.system.hamiltonian(q, &self.allowed_momentum(q, p))
     }

@@ -72,6 +72,7 @@ use crate::space::configuration_space::ConfigurationSpace;
 use crate::space::manifold::Manifold;
 use crate::step::euler_lagrange::EulerLagrange;
 use crate::step::group_euler_lagrange::GroupEulerLagrange;
+use crate::step::ledger::{ComponentBalance, Ledger};
 use component::{Model, Part};
 use hidden::Hidden;
 
@@ -151,6 +152,8 @@ struct Running {
     report: Option<NewtonReport>,
     /// The hidden constraints across the components, held at every step's end.
     hidden: Option<Hidden>,
+    /// Each component's energy at the start.
+    initial: Vec<f64>,
 }
 
 /// The flows and work through the junctions over the last step of a [`Modular`]
@@ -692,6 +695,11 @@ impl Modular {
         for (component, state) in self.components.iter_mut().zip(started) {
             component.part.begin(state);
         }
+        let initial = self
+            .components
+            .iter()
+            .map(|c| c.part.energy(&v[c.first..c.first + c.part.coordinates()]))
+            .collect();
         // The layout of a step: each component's unknowns, then the junctions' multipliers.
         let mut offset = 0;
         for component in &mut self.components {
@@ -734,6 +742,7 @@ impl Modular {
             violation: 0.0,
             report: None,
             hidden,
+            initial,
         });
         let multipliers = unknowns - self.junctions.len()..unknowns;
         let share = self.junction_point().share();
@@ -1137,6 +1146,73 @@ impl Modular {
                 c.part.energy(&v.as_slice()[c.first..c.first + n])
             })
             .collect())
+    }
+
+    /// Each component's energy balance since the start (see [`Ledger`]): its stored energy,
+    /// the work of its own forces and inputs, and the work through its ports, summed over the
+    /// steps. `NotStarted` before a start; `Unsupported` where a component's steps do not
+    /// report their work.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Junction, Modular, Quadrature, Scalar};
+    /// use nalgebra::SVector;
+    /// /// A capacitor, L = −q²/2.
+    /// struct Capacitor;
+    /// impl DiracSystem<1> for Capacitor {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, _v: &SVector<D, 1>) -> D {
+    ///         -q[0] * q[0] * 0.5
+    ///     }
+    ///     fn coordinate_name(&self, _i: usize) -> String { "q".into() }
+    /// }
+    /// /// An inductor with a series resistance 0.2: L = q̇²/2, F = −0.2 q̇ dq.
+    /// struct Coil;
+    /// impl DiracSystem<1> for Coil {
+    ///     const FORCES: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>, _t: f64, _u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         v * -0.2
+    ///     }
+    ///     fn coordinate_name(&self, _i: usize) -> String { "q".into() }
+    /// }
+    /// let mut circuit = Modular::new(Quadrature::midpoint(), 0.01)?;
+    /// circuit.add("c", Capacitor)?;
+    /// circuit.add("coil", Coil)?;
+    /// circuit.join(Junction::new("kcl").flow("c.q", 1.0).flow("coil.q", 1.0))?;
+    /// circuit.start_from_velocity(&[1.0, -1.0], &[0.0, 0.0])?;
+    /// circuit.run(1000)?;
+    /// let ledger = circuit.ledger()?;
+    /// assert!(ledger.components[1].forces < -0.2); // the resistance took most of the 0.5
+    /// assert!(ledger.max_defect() < 1e-14 && ledger.net_port_work().abs() < 1e-14);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn ledger(&self) -> Result<Ledger, DiracError> {
+        let run = self.running()?;
+        let energies = self.energies()?;
+        let components = self
+            .components
+            .iter()
+            .zip(run.initial.iter().zip(energies))
+            .map(|(c, (&initial, energy))| {
+                let unknown = || {
+                    DiracError::Unsupported(format!(
+                        "the work of component {}: its steps do not report it",
+                        c.name
+                    ))
+                };
+                let (forces, ports) = c.part.work().ok_or_else(unknown)?;
+                Ok(ComponentBalance {
+                    name: c.name.clone(),
+                    initial,
+                    energy,
+                    forces,
+                    ports: ports.ok_or_else(unknown)?,
+                })
+            })
+            .collect::<Result<Vec<_>, DiracError>>()?;
+        Ok(Ledger { components })
     }
 
     /// The junctions' efforts and each component's port work over the last step (see

@@ -73,6 +73,42 @@ impl<const N: usize> StepDerivatives<N> {
         b
     }
 
+    /// The same derivatives in positions and velocities, `∂(q_{k+1}, v_{k+1})/∂(q_k, v_k)` and
+    /// `∂(q_{k+1}, v_{k+1})/∂u` (the `p` blocks then read `v`), by the chain rule through the
+    /// Legendre map `p = ∂L/∂v(q, v)`: `start` and `end` are its derivatives
+    /// `(∂p/∂q, ∂p/∂v) = ((∂²L/∂v∂q), ∂²L/∂v²)` at the step's two states. With
+    /// `J = [[I, 0], [∂p/∂q, ∂p/∂v]]`, `A_v = J_{k+1}⁻¹ A J_k` and `B_v = J_{k+1}⁻¹ B`. `None`
+    /// where `∂²L/∂v²` is singular at the end (a degenerate Lagrangian).
+    pub fn in_velocities(
+        &self,
+        start: (&SMatrix<f64, N, N>, &SMatrix<f64, N, N>),
+        end: (&SMatrix<f64, N, N>, &SMatrix<f64, N, N>),
+    ) -> Option<Self> {
+        let ((p_q0, p_v0), (p_q1, p_v1)) = (start, end);
+        let dynamic = |m: &SMatrix<f64, N, N>| DMatrix::from_fn(N, N, |i, j| m[(i, j)]);
+        let inverse = dynamic(p_v1).lu().try_inverse()?;
+        // Singular to working precision: a Lagrangian degenerate at the end.
+        let condition = inverse.amax() * p_v1.amax() * N as f64;
+        if !condition.is_finite() || condition > 1e13 {
+            return None;
+        }
+        let fixed = |m: &DMatrix<f64>| SMatrix::<f64, N, N>::from_fn(|i, j| m[(i, j)]);
+        let q_q = self.q_q + self.q_p * p_q0;
+        let q_v = self.q_p * p_v0;
+        let v_q = fixed(&(&inverse * dynamic(&(self.p_q + self.p_p * p_q0 - p_q1 * q_q))));
+        let v_v = fixed(&(&inverse * dynamic(&(self.p_p * p_v0 - p_q1 * q_v))));
+        let v_u = &inverse * (&self.p_u - dynamic(p_q1) * &self.q_u);
+        Some(Self {
+            q_q,
+            q_p: q_v,
+            p_q: v_q,
+            p_p: v_v,
+            q_u: self.q_u.clone(),
+            p_u: v_u,
+            pivot_ratio: self.pivot_ratio,
+        })
+    }
+
     /// `‖AᵀJA − J‖∞` with `J = [[0, I], [−I, 0]]`: zero to round-off for a symplectic step (a
     /// conservative model without constraints).
     pub fn symplecticity_defect(&self) -> f64 {

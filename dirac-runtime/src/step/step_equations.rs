@@ -8,7 +8,7 @@
 //! the discrete Euler–Lagrange equations ([`EulerLagrange`](crate::step::euler_lagrange::EulerLagrange))
 //! are one implementation; the discrete Hamiltonian route and interconnected systems are others.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, SVector};
 
 use crate::base::error::DiracError;
 use crate::solve::newton::{Newton, NewtonFailure};
@@ -24,6 +24,54 @@ pub type Point<E, const N: usize> = <<E as StepEquations<N>>::Manifold as Manifo
 /// The tangent vector (and covector) type of the step equations `E`.
 pub type Tangent<E, const N: usize> =
     <<E as StepEquations<N>>::Manifold as Manifold<N>>::Tangent<f64>;
+
+/// The work done on each coordinate over one step, in the discrete form the step equations use.
+///
+/// `forces` is the work of the forces and inputs along the step's path by the quadrature,
+/// `h Σ_i b_i F̃(q_i, v_i, t_i, u)_r ξ̇_{i,r}` for each chart coordinate `r` (the force read in
+/// the chart at `q_k` times the node's chart velocity; on `Rⁿ`, `F_r q̇_r`; for the midpoint rule
+/// `F(q̄, Δq/h)_r Δq_r`). Its sum is the work `W_k` for which the energy balance
+/// `E_{k+1} − E_k = W_k` holds wherever the unforced scheme keeps the energy exactly.
+/// `constraints` is the work of the constraint forces, `μ̃_r ξ_r / h` for the constraint impulse
+/// `μ̃` (junctions included), where the step holds its constraints with one impulse (degree-1
+/// steps without a projection); `None` otherwise. Its sum is zero wherever the constraints are
+/// one-forms held at the step's constraint point; its parts on a component are the work
+/// through that component's ports.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepWork<const N: usize> {
+    /// The work of the forces and inputs on each chart coordinate.
+    pub forces: SVector<f64, N>,
+    /// The work of the constraint forces on each chart coordinate, where it is known.
+    pub constraints: Option<SVector<f64, N>>,
+}
+
+impl<const N: usize> StepWork<N> {
+    /// No work (the constraints' known to be zero).
+    pub fn zero() -> Self {
+        Self {
+            forces: SVector::zeros(),
+            constraints: Some(SVector::zeros()),
+        }
+    }
+
+    /// The work of the forces and inputs, summed over the coordinates: `W_k`.
+    pub fn total(&self) -> f64 {
+        self.forces.sum()
+    }
+}
+
+impl<const N: usize> std::ops::Add for StepWork<N> {
+    type Output = Self;
+
+    /// The work of two stretches of steps, one after the other (the constraints' known only
+    /// where both know it).
+    fn add(self, other: Self) -> Self {
+        Self {
+            forces: self.forces + other.forces,
+            constraints: self.constraints.zip(other.constraints).map(|(a, b)| a + b),
+        }
+    }
+}
 
 /// The equations of one step of an integrator on a state of `N` coordinates.
 ///
@@ -266,6 +314,14 @@ pub trait StepEquations<const N: usize> {
         theta: f64,
     ) -> Option<Sample<N, Self::Manifold>> {
         let _ = (ends, x, theta);
+        None
+    }
+
+    /// The work done over the step from `state` solved by `x` (the point assembled last) by the
+    /// forces, inputs and constraints ([`StepWork`]). `None` where the equations do not know it
+    /// (the default): the stepper then refuses the energy balance with `Unsupported`.
+    fn work(&self, state: &State<N, Self::Manifold>, x: &DVector<f64>) -> Option<StepWork<N>> {
+        let _ = (state, x);
         None
     }
 

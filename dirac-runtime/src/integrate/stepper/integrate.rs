@@ -369,12 +369,14 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             Some(energy) => energy,
             None => self.energy_at(&state, &sample.v, self.steps)?,
         };
-        if self.multipliers.is_empty() {
-            trajectory.push(sample, energy)
-        } else {
-            let violation = self.constraint_violation();
-            trajectory.push_constrained(sample, energy, violation, self.multipliers())
-        }
+        // A sample between steps (saveat) has no work of its own: the column is dropped.
+        let work = self
+            .work
+            .filter(|_| self.state.map(|s| s.t) == Some(sample.t))
+            .map(|work| work.total());
+        let constraint = (!self.multipliers.is_empty())
+            .then(|| (self.constraint_violation(), self.multipliers()));
+        trajectory.record(sample, energy, work, constraint)
     }
 }
 

@@ -22,7 +22,7 @@ use crate::space::configuration_space::{ConfigurationSpace, Euclidean, Point, Ta
 use crate::space::manifold::Manifold;
 use crate::step::euler_lagrange::EulerLagrange;
 use crate::step::group_euler_lagrange::GroupEulerLagrange;
-use crate::step::step_equations::{State, StepEquations};
+use crate::step::step_equations::{State, StepEquations, StepWork};
 
 /// A component's Legendre rows at its position: `∂L/∂v`, `∂²L/∂v²` and its own constraint
 /// forms (one-forms, then holonomic differentials; rows over its coordinates), in its chart.
@@ -97,6 +97,10 @@ pub(super) trait Part: Send + std::fmt::Debug {
     fn discard(&mut self);
     /// Coordinate `i` of the last step taken (0 before one).
     fn last_step(&self, i: usize) -> f64;
+    /// The work done on it since the run began by its own forces and inputs, and by the
+    /// constraint forces (its own and the junctions') where that is known (see [`StepWork`]);
+    /// `None` where its steps do not report their work.
+    fn work(&self) -> Option<(f64, Option<f64>)>;
     /// Its positions (its point's numbers; the origin before a start).
     fn q(&self) -> Vec<f64>;
     /// Its momenta, read in the chart.
@@ -418,6 +422,9 @@ pub(super) struct Model<E: ComponentEquations<N>, const N: usize> {
     position_names: Vec<String>,
     state: Option<State<N, E::Manifold>>,
     proposed: Option<State<N, E::Manifold>>,
+    /// The work of the proposed step, and of the steps taken since the run began.
+    proposed_work: Option<StepWork<N>>,
+    work: Option<StepWork<N>>,
     /// The proposed step and the last one taken, in the chart at their start.
     step: SVector<f64, N>,
     last: SVector<f64, N>,
@@ -447,6 +454,8 @@ impl<E: ComponentEquations<N>, const N: usize> Model<E, N> {
             equations,
             state: None,
             proposed: None,
+            proposed_work: None,
+            work: None,
             step: SVector::zeros(),
             last: SVector::zeros(),
             x: DVector::zeros(n),
@@ -567,6 +576,7 @@ impl<E: ComponentEquations<N> + 'static, const N: usize> Part for Model<E, N> {
             (DVector::zeros(n), DVector::zeros(n), DVector::zeros(n));
         self.state = Some(state);
         self.proposed = None;
+        self.work = Some(StepWork::zero());
         (self.step, self.last) = (SVector::zeros(), SVector::zeros());
     }
 
@@ -611,6 +621,7 @@ impl<E: ComponentEquations<N> + 'static, const N: usize> Part for Model<E, N> {
         self.x.copy_from_slice(x);
         let next = self.equations.advance(&state, &self.x, step)?;
         let violation = self.equations.violation(&state, &next, &self.x);
+        self.proposed_work = self.equations.work(&state, &self.x);
         self.proposed = Some(next);
         // The step's end point is the first unknowns (degree 1).
         self.step = self.measured_step(SVector::from_column_slice(&x[..N]));
@@ -630,6 +641,7 @@ impl<E: ComponentEquations<N> + 'static, const N: usize> Part for Model<E, N> {
             next.t = t;
             self.state = Some(next);
             self.last = self.step;
+            self.work = self.work.zip(self.proposed_work).map(|(a, b)| a + b);
         }
     }
 
@@ -639,6 +651,11 @@ impl<E: ComponentEquations<N> + 'static, const N: usize> Part for Model<E, N> {
 
     fn last_step(&self, i: usize) -> f64 {
         self.last[i]
+    }
+
+    fn work(&self) -> Option<(f64, Option<f64>)> {
+        self.work
+            .map(|w| (w.total(), w.constraints.map(|c| c.sum())))
     }
 
     fn q(&self) -> Vec<f64> {
