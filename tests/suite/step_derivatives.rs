@@ -623,3 +623,65 @@ fn the_pivot_ratio_reports_an_ill_conditioned_step() {
         "{stiff} vs {expected}"
     );
 }
+
+/// One step of the cart-pole (mass matrix depending on θ, an input force) from `(q, v)` with the
+/// push `u`: the end's position and velocity.
+fn cart_pole_step(q: SVector<f64, 2>, v: SVector<f64, 2>, u: f64, h: f64) -> [f64; 4] {
+    let mut stepper = Stepper::new(scenes::cart_pole::SCENE, Quadrature::galerkin(2).unwrap(), h)
+        .expect("valid scene");
+    stepper.start_from_velocity(q, v).expect("a valid state");
+    stepper.set_input("u", u).expect("input u");
+    stepper.step().expect("a step");
+    let (q, v) = (stepper.q(), stepper.v().expect("velocity"));
+    [q[0], q[1], v[0], v[1]]
+}
+
+/// The derivatives in `(q, v)` are those of the step map read in positions and velocities:
+/// against central differences of the step started from nudged `(q, v)` and `u`, on a model
+/// whose Legendre map depends on the position.
+#[test]
+fn derivatives_in_velocities_match_central_differences() {
+    let (q, v, u, h) = (vector![0.1, 0.4], vector![-0.3, 0.7], 0.25, 0.05);
+    let mut stepper =
+        Stepper::new(scenes::cart_pole::SCENE, Quadrature::galerkin(2).unwrap(), h).unwrap();
+    stepper.start_from_velocity(q, v).unwrap();
+    stepper.set_input("u", u).unwrap();
+    let found = stepper.step_linearised_in_velocities().unwrap();
+    let (a, b) = (found.matrix(), found.input_matrix());
+    let delta = 1e-5;
+    let mut worst: f64 = 0.0;
+    for column in 0..5 {
+        let nudge = |sign: f64| {
+            let mut z = [q[0], q[1], v[0], v[1], u];
+            z[column] += sign * delta;
+            cart_pole_step(vector![z[0], z[1]], vector![z[2], z[3]], z[4], h)
+        };
+        let (plus, minus) = (nudge(1.0), nudge(-1.0));
+        for row in 0..4 {
+            let difference = (plus[row] - minus[row]) / (2.0 * delta);
+            let exact = if column < 4 { a[(row, column)] } else { b[(row, 0)] };
+            worst = worst.max((difference - exact).abs() / exact.abs().max(1.0));
+        }
+    }
+    assert!(worst < 1e-8, "(q, v) derivatives off central differences by {worst:e}");
+    // The same step as without derivatives.
+    let end = cart_pole_step(q, v, u, h);
+    assert_eq!([stepper.q()[0], stepper.q()[1]], [end[0], end[1]]);
+}
+
+/// A degenerate Lagrangian (capacitor charges without kinetic energy) has no derivatives in
+/// `(q, v)`: refused, the state as it was.
+#[test]
+fn derivatives_in_velocities_are_refused_where_the_legendre_map_is_singular() {
+    let mut stepper = Stepper::new(scenes::circuit::LC, Quadrature::midpoint(), 0.01).unwrap();
+    stepper
+        .start_from_velocity(scenes::circuit::q0(), SVector::zeros())
+        .unwrap();
+    let before = (stepper.q(), stepper.p(), stepper.steps());
+    assert!(matches!(
+        stepper.step_linearised_in_velocities(),
+        Err(DiracError::Unsupported(_))
+    ));
+    assert_eq!((stepper.q(), stepper.p(), stepper.steps()), before);
+    assert!(stepper.step_linearised().is_ok());
+}
