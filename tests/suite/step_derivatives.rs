@@ -627,8 +627,12 @@ fn the_pivot_ratio_reports_an_ill_conditioned_step() {
 /// One step of the cart-pole (mass matrix depending on θ, an input force) from `(q, v)` with the
 /// push `u`: the end's position and velocity.
 fn cart_pole_step(q: SVector<f64, 2>, v: SVector<f64, 2>, u: f64, h: f64) -> [f64; 4] {
-    let mut stepper = Stepper::new(scenes::cart_pole::SCENE, Quadrature::galerkin(2).unwrap(), h)
-        .expect("valid scene");
+    let mut stepper = Stepper::new(
+        scenes::cart_pole::SCENE,
+        Quadrature::galerkin(2).unwrap(),
+        h,
+    )
+    .expect("valid scene");
     stepper.start_from_velocity(q, v).expect("a valid state");
     stepper.set_input("u", u).expect("input u");
     stepper.step().expect("a step");
@@ -642,8 +646,12 @@ fn cart_pole_step(q: SVector<f64, 2>, v: SVector<f64, 2>, u: f64, h: f64) -> [f6
 #[test]
 fn derivatives_in_velocities_match_central_differences() {
     let (q, v, u, h) = (vector![0.1, 0.4], vector![-0.3, 0.7], 0.25, 0.05);
-    let mut stepper =
-        Stepper::new(scenes::cart_pole::SCENE, Quadrature::galerkin(2).unwrap(), h).unwrap();
+    let mut stepper = Stepper::new(
+        scenes::cart_pole::SCENE,
+        Quadrature::galerkin(2).unwrap(),
+        h,
+    )
+    .unwrap();
     stepper.start_from_velocity(q, v).unwrap();
     stepper.set_input("u", u).unwrap();
     let found = stepper.step_linearised_in_velocities().unwrap();
@@ -659,11 +667,18 @@ fn derivatives_in_velocities_match_central_differences() {
         let (plus, minus) = (nudge(1.0), nudge(-1.0));
         for row in 0..4 {
             let difference = (plus[row] - minus[row]) / (2.0 * delta);
-            let exact = if column < 4 { a[(row, column)] } else { b[(row, 0)] };
+            let exact = if column < 4 {
+                a[(row, column)]
+            } else {
+                b[(row, 0)]
+            };
             worst = worst.max((difference - exact).abs() / exact.abs().max(1.0));
         }
     }
-    assert!(worst < 1e-8, "(q, v) derivatives off central differences by {worst:e}");
+    assert!(
+        worst < 1e-8,
+        "(q, v) derivatives off central differences by {worst:e}"
+    );
     // The same step as without derivatives.
     let end = cart_pole_step(q, v, u, h);
     assert_eq!([stepper.q()[0], stepper.q()[1]], [end[0], end[1]]);

@@ -7,6 +7,9 @@
 //! dense output, not the step. Two crossings inside one step cancel and are not seen; a step
 //! shorter than the time between crossings sees every one.
 
+use std::cell::RefCell;
+use std::rc::Rc;
+
 use crate::base::error::DiracError;
 use crate::space::manifold::{Manifold, Vectors};
 use crate::step::dense_output::Sample;
@@ -24,9 +27,12 @@ pub enum Direction {
     Falling,
 }
 
-/// The user function of an event.
-type EventFunction<'a, const N: usize, M> = Box<
-    dyn FnMut(f64, &<M as Manifold<N>>::Point<f64>, &<M as Manifold<N>>::Tangent<f64>) -> f64 + 'a,
+/// The user function of an event, shared by the event's clones.
+type EventFunction<'a, const N: usize, M> = Rc<
+    RefCell<
+        dyn FnMut(f64, &<M as Manifold<N>>::Point<f64>, &<M as Manifold<N>>::Tangent<f64>) -> f64
+            + 'a,
+    >,
 >;
 
 /// An event of a [`Run`](crate::Run): a function `g(t, q, v)` whose sign changes are located
@@ -46,11 +52,15 @@ type EventFunction<'a, const N: usize, M> = Box<
 /// let mut stepper = Stepper::new(Ball, Quadrature::midpoint(), 0.01)?;
 /// stepper.start_from_velocity(vector![1.0], vector![5.0])?;
 /// let floor = Event::<1>::new("floor", |_t, q, _v| q[0]).falling().terminal();
-/// let solution = stepper.solve(Run::until(10.0).event(floor))?;
+/// let solution = stepper.solve(Run::until(10.0).event(floor.clone()))?;
 /// assert_eq!(solution.status, Status::Event(0));
 /// // 1 + 5t − 9.81 t²/2 = 0: the midpoint rule is exact for a constant force.
 /// let exact = (5.0 + (25.0_f64 + 2.0 * 9.81).sqrt()) / 9.81;
 /// assert!((solution.events[0].sample.t - exact).abs() < 1e-12);
+/// // An event is cloned into each run that looks for it (the clones share its function).
+/// stepper.start_from_velocity(vector![1.0], vector![5.0])?;
+/// let again = stepper.solve(Run::until(10.0).event(floor.clone()))?;
+/// assert_eq!(again.events[0].sample.t, solution.events[0].sample.t);
 /// # Ok::<(), dirac_runtime::DiracError>(())
 /// ```
 pub struct Event<'a, const N: usize, M: Manifold<N> = Vectors> {
@@ -58,6 +68,19 @@ pub struct Event<'a, const N: usize, M: Manifold<N> = Vectors> {
     function: EventFunction<'a, N, M>,
     direction: Direction,
     terminal: bool,
+}
+
+/// A clone looks for the same sign changes with the same function, which it shares: a closure
+/// that keeps state keeps one state for the event and its clones.
+impl<const N: usize, M: Manifold<N>> Clone for Event<'_, N, M> {
+    fn clone(&self) -> Self {
+        Self {
+            name: self.name.clone(),
+            function: Rc::clone(&self.function),
+            direction: self.direction,
+            terminal: self.terminal,
+        }
+    }
 }
 
 impl<const N: usize, M: Manifold<N>> std::fmt::Debug for Event<'_, N, M> {
@@ -79,7 +102,7 @@ impl<'a, const N: usize, M: Manifold<N>> Event<'a, N, M> {
     ) -> Self {
         Self {
             name: name.into(),
-            function: Box::new(function),
+            function: Rc::new(RefCell::new(function)),
             direction: Direction::Either,
             terminal: false,
         }
@@ -121,7 +144,7 @@ impl<'a, const N: usize, M: Manifold<N>> Event<'a, N, M> {
 
     /// `g` at `sample`; an error when it is not finite.
     pub(crate) fn value(&mut self, sample: &Sample<N, M>) -> Result<f64, DiracError> {
-        let g = (self.function)(sample.t, &sample.q, &sample.v);
+        let g = (self.function.borrow_mut())(sample.t, &sample.q, &sample.v);
         if g.is_finite() {
             Ok(g)
         } else {
