@@ -72,7 +72,7 @@ pub use space::rotation::Retraction;
 pub use step::dense_output::Sample;
 pub use step::hamilton::Hamilton;
 pub use step::ledger::{ComponentBalance, Ledger};
-pub use step::modular::{Modular, PortWork};
+pub use step::modular::{Modular, ModularFeedback, PortWork};
 pub use step::step_derivatives::{StepDerivatives, StepHessians};
 pub use step::step_equations::{State, StepEquations, StepWork};
 pub use study::work_precision::{Measurement, Study, WorkPrecision};

@@ -1663,6 +1663,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         }
         .expect("one name per coordinate, from coordinate_names")
         .with_metadata(metadata)
+        .with_forces(E::FORCED)
     }
 
     /// Coordinate names, from the system.

@@ -69,6 +69,8 @@ pub struct Trajectory<const N: usize, M: Manifold<N> = Vectors> {
     /// The work done by the forces and inputs from the stepper's start to each sample (see
     /// [`Stepper::work`](crate::Stepper::work)); `None` once a sample came without it.
     work: Option<Vec<f64>>,
+    /// Whether the model has forces that can do work: the `work` column is shown only then.
+    forced: bool,
     /// Names of the multipliers (empty for an unconstrained system).
     multiplier_names: Vec<String>,
     /// The multipliers of every sample in one buffer, `multiplier_names.len()` per sample (one
@@ -107,6 +109,7 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
             p: Vec::new(),
             energy: Vec::new(),
             work: Some(Vec::new()),
+            forced: true,
             multiplier_names,
             multipliers: Vec::new(),
             violation: Vec::new(),
@@ -119,6 +122,12 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
             metadata: Some(metadata),
             ..self
         }
+    }
+
+    /// The same trajectory of a model without forces (`forced` false): the work, zero, is kept
+    /// for the balance but not shown as a column.
+    pub(crate) fn with_forces(self, forced: bool) -> Self {
+        Self { forced, ..self }
     }
 
     /// What produced the trajectory (set by [`Stepper`](crate::Stepper)'s runs).
@@ -374,7 +383,8 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
     }
 
     /// The names of the columns, in the CSV's order: `t`, the coordinates, `v_<coordinate>`,
-    /// `p_<coordinate>`, `energy`, `work` (where it is known, see [`work`](Self::work)), and for a constrained system `constraint_violation` and the
+    /// `p_<coordinate>`, `energy`, `work` (for a model with forces, where it is known, see
+    /// [`work`](Self::work)), and for a constrained system `constraint_violation` and the
     /// multipliers. On a product manifold a rotation `R` has the columns `R_11` … `R_33`, its
     /// body angular velocity `v_R_x` … and momentum `p_R_x` …; a unit vector `n` has `n_x` …,
     /// `v_n_x` … and `p_n_x` … (see [`Manifold::point_names`]).
@@ -386,7 +396,7 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
             .chain(tangent.iter().map(|n| format!("v_{n}")))
             .chain(tangent.iter().map(|n| format!("p_{n}")))
             .chain(std::iter::once("energy".to_string()))
-            .chain(self.work.is_some().then(|| "work".to_string()))
+            .chain((self.work.is_some() && self.forced).then(|| "work".to_string()))
             .chain(constrained.then(|| "constraint_violation".to_string()))
             .chain(self.multiplier_names.iter().cloned())
             .collect()
@@ -407,7 +417,7 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
         row.extend(M::tangent_components(&self.v[k]));
         row.extend(M::tangent_components(&self.p[k]));
         row.push(self.energy[k]);
-        if let Some(work) = &self.work {
+        if let Some(work) = self.work.as_ref().filter(|_| self.forced) {
             row.push(work[k]);
         }
         if let (Some(v), Some(m)) = (self.violation.get(k), self.multipliers_at(k)) {

@@ -1031,6 +1031,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
 
     const NAME: &'static str = "the discrete Euler–Lagrange equations";
     const VELOCITY: &'static str = "the Legendre transform (velocity from momentum)";
+    const FORCED: bool = S::FORCES;
 
     fn h(&self) -> f64 {
         self.discrete.h()

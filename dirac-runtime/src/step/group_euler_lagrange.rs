@@ -289,6 +289,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
 
     const NAME: &'static str = "the discrete Euler–Lagrange equations in the moving chart";
     const VELOCITY: &'static str = "the Legendre transform (velocity from momentum)";
+    const FORCED: bool = S::FORCES;
 
     fn h(&self) -> f64 {
         self.discrete.h()

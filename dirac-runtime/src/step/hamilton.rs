@@ -546,6 +546,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
     type Manifold = Vectors;
     const NAME: &'static str = "the discrete Hamilton's equations";
     const VELOCITY: &'static str = "the velocity v = ∂H/∂p";
+    const FORCED: bool = S::FORCES;
 
     fn system(&self) -> &S {
         &self.system

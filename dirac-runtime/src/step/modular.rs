@@ -156,6 +156,23 @@ struct Running {
     initial: Vec<f64>,
 }
 
+/// What the controller of [`Modular::run_controlled`] reads before each step: the state the
+/// step starts from.
+#[derive(Debug, Clone, Copy)]
+pub struct ModularFeedback<'s> {
+    /// The steps taken since the start, before this one.
+    pub steps: u64,
+    /// The time the step starts from.
+    pub t: f64,
+    /// Every position number, in the order of [`Modular::position_names`].
+    pub q: &'s DVector<f64>,
+    /// Every coordinate's velocity, in the order of [`Modular::coordinate_names`] (see
+    /// [`Modular::velocities`]).
+    pub v: &'s DVector<f64>,
+    /// The junctions' multipliers of the last step (zeros before the first).
+    pub multipliers: &'s [f64],
+}
+
 /// The flows and work through the junctions over the last step of a [`Modular`]
 /// interconnection: efforts `e_j = μ_j / h` and each component's port work
 /// `W_c = Σ_j e_j ⟨a_j^c, ξ^c⟩`, `ξ^c` the component's step in its chart (`q_{k+1}^c − q_k^c` on
@@ -637,11 +654,119 @@ impl Modular {
                 value,
             });
         }
+        self.set_input_at(c, i, value);
+        Ok(())
+    }
+
+    /// Sets input `i` of component `c` to the finite `value`.
+    fn set_input_at(&mut self, c: usize, i: usize, value: f64) {
         if self.components[c].part.set_input(i, value)
             && let Some(run) = self.run.as_mut()
         {
             // A step after a change of inputs is predicted from the last one alone.
             run.predictor.restart();
+        }
+    }
+
+    /// Every component's inputs, `instance.input`, in the order of [`inputs`](Self::inputs).
+    pub fn input_names(&self) -> Vec<String> {
+        self.components
+            .iter()
+            .flat_map(|c| {
+                (0..c.part.inputs()).map(|i| format!("{}.{}", c.name, c.part.input_name(i)))
+            })
+            .collect()
+    }
+
+    /// The inputs' current values, in the order of [`input_names`](Self::input_names).
+    pub fn inputs(&self) -> Vec<f64> {
+        self.components
+            .iter()
+            .flat_map(|c| (0..c.part.inputs()).map(|i| c.part.input(i)))
+            .collect()
+    }
+
+    /// Sets every input, in the order of [`input_names`](Self::input_names). A wrong count or a
+    /// value that is not finite is refused and sets none.
+    pub fn set_inputs(&mut self, values: &[f64]) -> Result<(), DiracError> {
+        let names = self.input_names();
+        if values.len() != names.len() {
+            return Err(DiracError::Dimension(format!(
+                "{} input values for the {} inputs {}",
+                values.len(),
+                names.len(),
+                names.join(", ")
+            )));
+        }
+        if let Some((name, &value)) = names.iter().zip(values).find(|(_, v)| !v.is_finite()) {
+            return Err(DiracError::NonFinite {
+                what: format!("input {name}"),
+                value,
+            });
+        }
+        let mut k = 0;
+        for c in 0..self.components.len() {
+            for i in 0..self.components[c].part.inputs() {
+                self.set_input_at(c, i, values[k]);
+                k += 1;
+            }
+        }
+        Ok(())
+    }
+
+    /// Advances `steps` steps with a feedback inside the run: before each step `controller`
+    /// reads the state the step starts from ([`ModularFeedback`]: the time, the positions, the
+    /// velocities and the last step's junction multipliers) and sets the inputs (in the order of
+    /// [`input_names`](Self::input_names)), which are held over the step as
+    /// [`Run::control`](crate::Run::control)'s are. Stops at the first error with the state of
+    /// the step before it; a value that is not finite is refused before its step.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Modular, Quadrature, Scalar};
+    /// use nalgebra::SVector;
+    /// /// A unit mass on a unit spring pushed by u: L = (ẋ² − x²)/2, F = u dx.
+    /// struct Pushed;
+    /// impl DiracSystem<1> for Pushed {
+    ///     const FORCES: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, _v: &SVector<D, 1>, _t: f64, u: &[D])
+    ///         -> SVector<D, 1> {
+    ///         SVector::from([u[0]])
+    ///     }
+    ///     fn coordinate_name(&self, _i: usize) -> String { "x".into() }
+    ///     fn input_name(&self, _i: usize) -> String { "u".into() }
+    /// }
+    /// let mut parts = Modular::new(Quadrature::midpoint(), 0.05)?;
+    /// parts.add("mass", Pushed)?;
+    /// parts.start_from_velocity(&[1.0], &[0.0])?;
+    /// assert_eq!(parts.input_names(), ["mass.u"]);
+    /// // A damper by feedback, u = −ẋ: the oscillation dies out.
+    /// parts.run_controlled(2000, |now, u| u[0] = -now.v[0])?;
+    /// assert!(parts.q()[0].abs() < 1e-10 && parts.ledger()?.components[0].forces < -0.49);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn run_controlled(
+        &mut self,
+        steps: u64,
+        mut controller: impl FnMut(&ModularFeedback<'_>, &mut [f64]),
+    ) -> Result<(), DiracError> {
+        let mut inputs = self.inputs();
+        for _ in 0..steps {
+            let (q, v) = (self.q(), self.velocities()?);
+            let run = self.running()?;
+            let feedback = ModularFeedback {
+                steps: run.steps,
+                t: self.t(),
+                q: &q,
+                v: &v,
+                multipliers: &run.multipliers,
+            };
+            controller(&feedback, &mut inputs);
+            self.set_inputs(&inputs)?;
+            self.step()?;
         }
         Ok(())
     }

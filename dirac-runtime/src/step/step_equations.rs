@@ -97,6 +97,9 @@ pub trait StepEquations<const N: usize> {
     const NAME: &'static str;
     /// What the velocity solve is, for error messages.
     const VELOCITY: &'static str;
+    /// Whether the model has forces (and inputs) that can do work: a trajectory shows its
+    /// `work` column only then (by default, yes).
+    const FORCED: bool = true;
 
     /// The step size.
     fn h(&self) -> f64;

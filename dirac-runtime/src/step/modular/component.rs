@@ -59,6 +59,8 @@ pub(super) trait Part: Send + std::fmt::Debug {
     fn input_name(&self, i: usize) -> String;
     /// Sets input `i` (finite); whether it changed.
     fn set_input(&mut self, i: usize, value: f64) -> bool;
+    /// The value of input `i`.
+    fn input(&self, i: usize) -> f64;
     /// The number of unknowns of a step (after [`begin`](Self::begin)).
     fn unknowns(&self) -> usize;
     fn unknown_name(&self, column: usize) -> String;
@@ -534,6 +536,10 @@ impl<E: ComponentEquations<N> + 'static, const N: usize> Part for Model<E, N> {
         let changed = self.equations.inputs()[i] != value;
         self.equations.inputs_mut()[i] = value;
         changed
+    }
+
+    fn input(&self, i: usize) -> f64 {
+        self.equations.inputs()[i]
     }
 
     fn unknowns(&self) -> usize {
