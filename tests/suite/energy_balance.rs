@@ -254,32 +254,39 @@ fn the_trapezoid_reports_its_defect_and_galerkin_junctions_are_refused() {
     assert!(stepper.energy_balance_error().unwrap().abs() < 1e-13);
 }
 
+/// `satellite` tumbling at `Ω = (0.3, 1, −0.5)` from the identity, with `retraction` and step
+/// `h`, detumbled by `τ = −k Ω` held over each step to `t_end`: its energy balance.
+fn detumbling(
+    satellite: satellite::Satellite,
+    retraction: Product<0, 1, 0>,
+    h: f64,
+    k: f64,
+    t_end: f64,
+) -> dirac::EnergyBalance {
+    let mut stepper =
+        Stepper::on_manifold(satellite, retraction, Quadrature::midpoint(), h).unwrap();
+    stepper
+        .start_from_velocity(
+            Configuration::of_rotation(Matrix3::identity()),
+            Rates::of_rotation(Vector3::new(0.3, 1.0, -0.5)),
+        )
+        .unwrap();
+    let run = Run::until(t_end).control(|now: &Feedback<3, Product<0, 1, 0>>, u: &mut [f64]| {
+        let omega = now.sample.v.rotation[0];
+        for (u, w) in u.iter_mut().zip(omega.iter()) {
+            *u = -k * w;
+        }
+    });
+    let trajectory = stepper.solve(run).unwrap().trajectory;
+    trajectory.energy_balance().unwrap()
+}
+
 #[test]
 fn a_satellites_detumbling_is_booked_on_so3() {
     // Body torques τ = −k Ω held over each step: the work takes the kinetic energy away. The
     // group step keeps this energy only to its order, so the defect falls as h².
     let defect = |h: f64| {
-        let mut stepper = Stepper::on_manifold(
-            satellite::SCENE,
-            Product::cayley(),
-            Quadrature::midpoint(),
-            h,
-        )
-        .unwrap();
-        stepper
-            .start_from_velocity(
-                Configuration::of_rotation(Matrix3::identity()),
-                Rates::of_rotation(Vector3::new(0.3, 1.0, -0.5)),
-            )
-            .unwrap();
-        let run = Run::until(5.0).control(|now: &Feedback<3, Product<0, 1, 0>>, u: &mut [f64]| {
-            let omega = now.sample.v.rotation[0];
-            for (u, w) in u.iter_mut().zip(omega.iter()) {
-                *u = -0.5 * w;
-            }
-        });
-        let trajectory = stepper.solve(run).unwrap().trajectory;
-        let balance = trajectory.energy_balance().unwrap();
+        let balance = detumbling(satellite::SCENE, Product::cayley(), h, 0.5, 5.0);
         assert!(balance.work < -0.5 * balance.initial, "{balance}");
         balance.max_defect
     };
@@ -295,45 +302,13 @@ fn a_satellites_detumbling_is_booked_on_so3() {
     // balance holds to round-off: the work on the group is booked exactly. (With the Cayley map
     // the chart bends the angle, `f⁻ ≠ f⁺`, and the defect is O(h²), as on the asymmetric body.)
     let sphere = satellite::Satellite { j: [3.0; 3] };
-    let mut stepper =
-        Stepper::on_manifold(sphere, Product::exp(), Quadrature::midpoint(), 0.02).unwrap();
-    stepper
-        .start_from_velocity(
-            Configuration::of_rotation(Matrix3::identity()),
-            Rates::of_rotation(Vector3::new(0.3, 1.0, -0.5)),
-        )
-        .unwrap();
-    let run = Run::until(20.0).control(|now: &Feedback<3, Product<0, 1, 0>>, u: &mut [f64]| {
-        let omega = now.sample.v.rotation[0];
-        for (u, w) in u.iter_mut().zip(omega.iter()) {
-            *u = -0.2 * w;
-        }
-    });
-    let balance = stepper
-        .solve(run)
-        .unwrap()
-        .trajectory
-        .energy_balance()
-        .unwrap();
+    let balance = detumbling(sphere, Product::exp(), 0.02, 0.2, 20.0);
     assert!(balance.work < -1.5, "{balance}");
     assert!(balance.max_defect < 1e-13, "{balance}");
 
     // Without torques no work is done at all.
-    let mut stepper = Stepper::on_manifold(
-        satellite::SCENE,
-        Product::cayley(),
-        Quadrature::midpoint(),
-        0.1,
-    )
-    .unwrap();
-    stepper
-        .start_from_velocity(
-            Configuration::of_rotation(Matrix3::identity()),
-            Rates::of_rotation(Vector3::new(0.3, 1.0, -0.5)),
-        )
-        .unwrap();
-    stepper.run(50).unwrap();
-    assert_eq!(stepper.work().unwrap(), 0.0);
+    let free = detumbling(satellite::SCENE, Product::cayley(), 0.1, 0.0, 5.0);
+    assert_eq!(free.work, 0.0);
 }
 
 #[test]

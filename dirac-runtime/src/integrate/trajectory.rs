@@ -332,7 +332,7 @@ impl<const N: usize, M: Manifold<N>> Trajectory<N, M> {
     ///     }
     ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>, _t: f64, _u: &[D])
     ///         -> SVector<D, 1> {
-    ///         v * -0.1
+    ///         SVector::from([v[0] * -0.1])
     ///     }
     /// }
     /// let mut stepper = Stepper::new(Damped, Quadrature::midpoint(), 0.1)?;

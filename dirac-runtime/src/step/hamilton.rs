@@ -230,6 +230,30 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         })
     }
 
+    /// Node `i` of the step from `state` solved by `x`: the path's weights `ℓ_j(c_i)` and
+    /// `ℓ'_j(c_i)`, its position `Q(c_i)` and rate `Q̇(c_i)` there, and the node's momentum `P_i`.
+    #[allow(clippy::type_complexity)]
+    fn node(
+        &self,
+        state: &State<N>,
+        x: &DVector<f64>,
+        i: usize,
+    ) -> (
+        Vec<f64>,
+        Vec<f64>,
+        SVector<f64, N>,
+        SVector<f64, N>,
+        SVector<f64, N>,
+    ) {
+        let s = self.degree();
+        let position: Vec<f64> = (0..=s).map(|j| self.quadrature.ell(i, j)).collect();
+        let velocity: Vec<f64> = (0..=s).map(|j| self.quadrature.ell_prime(i, j)).collect();
+        let q = state.q + self.combination(x, &position);
+        let v = self.combination(x, &velocity) / self.h;
+        let p = x.fixed_rows::<N>(self.node_momentum(i)).into_owned();
+        (position, velocity, q, v, p)
+    }
+
     /// The force at node values `(q, p)` at time `t`, with its Jacobians in `q` and `p` when
     /// `derivatives` (zeros otherwise).
     fn force(
@@ -288,12 +312,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         let identity = SMatrix::<f64, N, N>::identity();
         for i in 0..self.nodes() {
             let (c, b) = (self.quadrature.nodes()[i], self.quadrature.weights()[i]);
-            let position: Vec<f64> = (0..=s).map(|j| self.quadrature.ell(i, j)).collect();
-            let velocity: Vec<f64> = (0..=s).map(|j| self.quadrature.ell_prime(i, j)).collect();
-            let q = state.q + self.combination(x, &position);
-            let v = self.combination(x, &velocity) / h;
+            let (position, velocity, q, v, p) = self.node(state, x, i);
             let column = self.node_momentum(i);
-            let p = x.fixed_rows::<N>(column).into_owned();
             let t = state.t + c * h;
             let second = jacobian
                 .is_some()
@@ -902,21 +922,15 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         ))
     }
 
-    /// `H(q, p̃)` at the momentum `p̃ = p + C(q)ᵀν` whose velocity the constraints allow
-    /// (`C ∂H/∂p(q, p̃) = 0`, `C` the rows `dg_b` and `A_a`; `H(q, p)` without constraints).
     /// The forces' work along the step's path, `h Σ_i b_i F(Q(c_i), P_i, t_i, u) ∘ Q̇(c_i)`
     /// (see [`StepWork`]); the constraints' only where there are none.
     fn work(&self, state: &State<N>, x: &DVector<f64>) -> Option<StepWork<N>> {
-        let (s, h) = (self.degree(), self.h);
+        let h = self.h;
         let mut forces = SVector::zeros();
         if S::FORCES {
             for i in 0..self.nodes() {
                 let (c, b) = (self.quadrature.nodes()[i], self.quadrature.weights()[i]);
-                let position: Vec<f64> = (0..=s).map(|j| self.quadrature.ell(i, j)).collect();
-                let velocity: Vec<f64> = (0..=s).map(|j| self.quadrature.ell_prime(i, j)).collect();
-                let q = state.q + self.combination(x, &position);
-                let v = self.combination(x, &velocity) / h;
-                let p = x.fixed_rows::<N>(self.node_momentum(i)).into_owned();
+                let (_, _, q, v, p) = self.node(state, x, i);
                 let (f, _, _) = self.force(&q, &p, state.t + c * h, false);
                 forces += f.component_mul(&v) * (h * b);
             }
@@ -928,6 +942,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         })
     }
 
+    /// `H(q, p̃)` at the momentum `p̃ = p + C(q)ᵀν` whose velocity the constraints allow
+    /// (`C ∂H/∂p(q, p̃) = 0`, `C` the rows `dg_b` and `A_a`; `H(q, p)` without constraints).
     fn energy(&self, q: &SVector<f64, N>, p: &SVector<f64, N>, _v: &SVector<f64, N>) -> f64 {
         self.system.hamiltonian(q, &self.allowed_momentum(q, p))
     }

@@ -38,7 +38,7 @@ impl<E: StepEquations<N, Manifold = Vectors>, const N: usize> Stepper<E::System,
     ///     }
     ///     fn force<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>, _t: f64, _u: &[D])
     ///         -> SVector<D, 1> {
-    ///         v * -0.2
+    ///         SVector::from([v[0] * -0.2])
     ///     }
     ///     fn coordinate_name(&self, _i: usize) -> String { "q".into() }
     /// }
