@@ -355,20 +355,20 @@ fn the_work_column_is_recorded_at_steps_only() {
 }
 
 #[test]
-fn models_without_a_variational_work_refuse_the_balance() {
-    // A first-order Lagrangian's rows are collocated: its steps report no work.
+fn a_first_order_model_books_no_work_and_its_balance_is_its_energy_error() {
+    // A Lagrangian linear in the velocities takes no forces (refused when a run begins): its
+    // steps do no work, and its balance's defect is the drift of its energy H.
     let mut stepper =
         Stepper::new(scenes::lotka_volterra::SCENE, Quadrature::midpoint(), 0.01).unwrap();
     assert!(matches!(stepper.work(), Err(DiracError::NotStarted)));
     stepper
         .start_from_position(scenes::lotka_volterra::q0())
         .unwrap();
-    stepper.step().unwrap();
-    assert!(matches!(stepper.work(), Err(DiracError::Unsupported(_))));
-    assert!(matches!(
-        stepper.energy_balance_error(),
-        Err(DiracError::Unsupported(_))
-    ));
+    let trajectory = stepper.run(1000).unwrap();
+    assert_eq!(stepper.work().unwrap(), 0.0);
+    let balance = trajectory.energy_balance().unwrap();
+    assert_eq!(balance.max_defect, trajectory.max_energy_error());
+    assert!(balance.max_defect > 0.0);
 }
 
 /// An inductor with its series resistance and a voltage source in series: each component of

@@ -173,6 +173,14 @@ fn a_stepper_drives_equations_written_outside_the_library() {
     assert!((stepper.t() - (0.5 + n as f64 * h)).abs() < 1e-12);
     assert!(trajectory.max_energy_error() < 1e-14);
     assert!(stepper.last_report().expect("stepped").iterations <= 3);
+    // Equations that do not say what work their steps do get no energy balance, rather than
+    // one made up: no work column, and an error that says why.
+    assert!(matches!(stepper.work(), Err(DiracError::Unsupported(_))));
+    assert!(trajectory.work().is_none());
+    assert!(matches!(
+        trajectory.energy_balance(),
+        Err(DiracError::Unsupported(_))
+    ));
 }
 
 #[test]

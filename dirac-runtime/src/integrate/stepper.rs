@@ -1523,7 +1523,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// step's in the discrete form the scheme uses (see [`StepWork`]): with the energy,
     /// `E − E_0 − Σ_k W_k` is the energy balance's defect
     /// ([`energy_balance_error`](Self::energy_balance_error)). `Unsupported` for equations that
-    /// do not report their work (first-order Lagrangians, projected steps).
+    /// do not report their work (equations written outside the library that leave
+    /// [`StepEquations::work`] as it is).
     ///
     /// ```
     /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};

@@ -1467,11 +1467,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     }
 
     /// The forces' work along the step's path; the constraints' from their impulse on a
-    /// degree-1 step that no projection follows (see [`StepWork`]). `None` for first-order and
-    /// projected steps, whose rows are collocated rather than variational.
+    /// degree-1 step that no projection follows (see [`StepWork`]). First-order and projected
+    /// steps have no forces (refused when the run begins): no work, the constraints' unknown.
     fn work(&self, state: &State<N>, x: &DVector<f64>) -> Option<StepWork<N>> {
         if self.projected() || self.first_order() {
-            return None;
+            return (!S::FORCES).then(|| StepWork {
+                forces: SVector::zeros(),
+                constraints: None,
+            });
         }
         let forces = if S::FORCES {
             self.discrete
