@@ -684,10 +684,32 @@ fn derivatives_in_velocities_match_central_differences() {
     assert_eq!([stepper.q()[0], stepper.q()[1]], [end[0], end[1]]);
 }
 
-/// A degenerate Lagrangian (capacitor charges without kinetic energy) has no derivatives in
-/// `(q, v)`: refused, the state as it was.
+/// An oscillator beside a coordinate without kinetic energy: `L = ½ẋ² − ½x² − ½y²`, whose
+/// `∂²L/∂v²` is singular (and `y = 0` a hidden constraint).
+struct HalfDegenerate;
+
+impl DiracSystem<2> for HalfDegenerate {
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+        (v[0] * v[0] - q[0] * q[0] - q[1] * q[1]) * 0.5
+    }
+}
+
+/// A degenerate Lagrangian has no derivatives in `(q, v)`, nor has a constrained model (its
+/// velocity comes with multipliers; the LC circuit is both): refused, the state as it was.
 #[test]
 fn derivatives_in_velocities_are_refused_where_the_legendre_map_is_singular() {
+    let mut degenerate = Stepper::new(HalfDegenerate, Quadrature::midpoint(), 0.01).unwrap();
+    degenerate
+        .start_from_velocity(vector![1.0, 0.0], vector![0.0, 0.0])
+        .unwrap();
+    let before = (degenerate.q(), degenerate.p(), degenerate.steps());
+    assert!(matches!(
+        degenerate.step_linearised_in_velocities(),
+        Err(DiracError::Unsupported(_))
+    ));
+    assert_eq!((degenerate.q(), degenerate.p(), degenerate.steps()), before);
+    assert!(degenerate.step_linearised().is_ok());
+
     let mut stepper = Stepper::new(scenes::circuit::LC, Quadrature::midpoint(), 0.01).unwrap();
     stepper
         .start_from_velocity(scenes::circuit::q0(), SVector::zeros())

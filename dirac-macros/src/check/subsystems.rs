@@ -230,7 +230,9 @@ fn unrolled<'a>(expr: &'a Expr, errors: &mut Errors) -> Vec<(Expr, Index<'a>)> {
         Expr::Range(range) => {
             let end = |e: &Option<Box<Expr>>| e.as_deref().and_then(literal);
             match (end(&range.start), end(&range.end)) {
-                (Some(a), Some(b)) if a.fract() == 0.0 && b.fract() == 0.0 => {
+                (Some(a), Some(b))
+                    if a.fract() == 0.0 && b.fract() == 0.0 && a.abs().max(b.abs()) <= 1e9 =>
+                {
                     let b = match range.limits {
                         RangeLimits::HalfOpen(_) => b as i64,
                         RangeLimits::Closed(_) => b as i64 + 1,
@@ -416,13 +418,13 @@ fn index_value(expr: &Expr, index: Index<'_>) -> Option<i64> {
         }
         Expr::Paren(p) => index_value(&p.expr, index),
         Expr::Binary(b) if matches!(b.op, BinOp::Add(_)) => {
-            Some(index_value(&b.left, index)? + index_value(&b.right, index)?)
+            index_value(&b.left, index)?.checked_add(index_value(&b.right, index)?)
         }
         Expr::Binary(b) if matches!(b.op, BinOp::Sub(_)) => {
-            Some(index_value(&b.left, index)? - index_value(&b.right, index)?)
+            index_value(&b.left, index)?.checked_sub(index_value(&b.right, index)?)
         }
         other => literal(other)
-            .filter(|k| k.fract() == 0.0)
+            .filter(|k| k.fract() == 0.0 && k.abs() <= 1e15)
             .map(|k| k as i64),
     }
 }

@@ -214,8 +214,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// step and returns `A = ∂(q_{k+1}, v_{k+1})/∂(q_k, v_k)` and `B = ∂(q_{k+1}, v_{k+1})/∂u`
     /// (the blocks named `p` read `v`; see [`StepDerivatives::in_velocities`]), for a feedback on
     /// the velocities without rescaling momentum weights. Refused with `Unsupported`, the state
-    /// unchanged, where `∂²L/∂v²` is singular at the step's end (a degenerate Lagrangian), and
-    /// on configuration spaces other than `Rⁿ` and its charts.
+    /// unchanged, for a constrained model (its velocity is solved with the constraints'
+    /// multipliers, not from `p = ∂L/∂v` alone) and where `∂²L/∂v²` is singular at the step's
+    /// end (a degenerate Lagrangian); it exists on `Rⁿ` and its charts.
     ///
     /// ```
     /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Stepper};
@@ -240,6 +241,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let Some(state) = self.state else {
             return Err(DiracError::NotStarted);
         };
+        if !self.multipliers.is_empty() {
+            return Err(DiracError::Unsupported(
+                "derivatives of the step map in (q, v) of a constrained model (its velocity \
+                 comes with the constraints' multipliers): take them in (q, p) with \
+                 step_linearised"
+                    .into(),
+            ));
+        }
         let legendre = |system: &S, q: &SVector<f64, N>, v: &SVector<f64, N>| {
             let h = crate::model::derivatives::hessian(system, q, v);
             (h.qv.transpose(), h.vv)
