@@ -39,8 +39,8 @@ pub use model::{
 pub use solve::{jacobian, newton};
 pub use space::{configuration_space, manifold, product, rotation, sphere};
 pub use step::{
-    dense_output, euler_lagrange, group_euler_lagrange, hamilton, modular, step_derivatives,
-    step_equations,
+    composition, dense_output, euler_lagrange, group_euler_lagrange, hamilton, modular,
+    step_derivatives, step_equations, verlet,
 };
 #[cfg(feature = "plot")]
 pub use study::plot;
@@ -69,12 +69,14 @@ pub use space::configuration_space::{ConfigurationSpace, Euclidean, Positive};
 pub use space::manifold::{Manifold, Vectors};
 pub use space::product::{Configuration, Product, Rates};
 pub use space::rotation::Retraction;
+pub use step::composition::Composition;
 pub use step::dense_output::Sample;
 pub use step::hamilton::Hamilton;
 pub use step::ledger::{ComponentBalance, Ledger};
 pub use step::modular::{Modular, ModularFeedback, PortWork};
 pub use step::step_derivatives::{StepDerivatives, StepHessians};
 pub use step::step_equations::{State, StepEquations, StepWork};
+pub use step::verlet::Verlet;
 pub use study::work_precision::{Measurement, Study, WorkPrecision};
 
 pub use nalgebra;

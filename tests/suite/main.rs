@@ -14,6 +14,7 @@ mod discrete_dirac;
 mod energy_balance;
 mod ensemble;
 mod errors;
+mod explicit;
 mod extremes;
 mod first_order;
 mod golden;

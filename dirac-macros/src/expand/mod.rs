@@ -386,6 +386,11 @@ fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
             const LAGRANGIAN_ENTIRE: bool = true;
         )
     });
+    let separable = closed.separable.then(|| {
+        quote!(
+            const SEPARABLE: bool = true;
+        )
+    });
     let any = closed.zeros.iter().flatten().flatten().any(|&zero| zero);
     let zeros = (closed.hessian.is_some() && any).then(|| {
         let [qq, qv, vv] = closed.zeros.clone().map(|block| {
@@ -399,6 +404,7 @@ fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
     });
     quote! {
         #entire
+        #separable
         #zeros
         #one_forms
 

@@ -849,6 +849,9 @@ pub struct ClosedForm {
     /// Which entries of `∂²L/∂q²`, `∂²L/∂q∂v`, `∂²L/∂v²` vanish identically, each block by
     /// `[i][j]` (known with the Hessian; none otherwise).
     pub zeros: [Vec<Vec<bool>>; 3],
+    /// Whether `∂²L/∂q∂v` vanishes and `∂²L/∂v²` depends on nothing but numbers and parameters:
+    /// `L = ½ vᵀ M v + bᵀ v − V(q)` with constant `M` and `b` (known with the Hessian).
+    pub separable: bool,
 }
 
 /// Each coordinate's name, flat offset and literal length; `None` where a length is not a
@@ -921,6 +924,7 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
                     entire,
                     hessian: None,
                     zeros: Default::default(),
+                    separable: false,
                 });
             }
         }
@@ -960,6 +964,11 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
             _ => (zeros[2][i - n][j - n], zeros[2][j - n][i - n]) = (zero, zero),
         }
     }
+    let separable = second.iter().all(|&(i, j, id)| match (i < n, j < n) {
+        (true, false) => graph.is(id, 0.0),
+        (false, false) => !graph.state[id],
+        _ => true,
+    });
     let zero = quote!(__dirac::nalgebra::SMatrix::<f64, #n, #n>::zeros());
     let hessian = quote! {
         #statements
@@ -979,6 +988,7 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
         entire,
         hessian: Some(hessian),
         zeros,
+        separable,
     })
 }
 

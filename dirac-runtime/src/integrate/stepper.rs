@@ -32,11 +32,13 @@ use crate::solve::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 use crate::solve::predictor::Predictor;
 use crate::space::configuration_space::{ConfigurationSpace, Euclidean};
 use crate::space::manifold::{Manifold, Vectors};
+use crate::step::composition::Composition;
 use crate::step::euler_lagrange::{EulerLagrange, check_finite};
 use crate::step::group_euler_lagrange::GroupEulerLagrange;
 use crate::step::hamilton::Hamilton;
 use crate::step::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step::step_equations::{Point, State, StepEquations, StepWork, Tangent};
+use crate::step::verlet::Verlet;
 
 /// The relative consistency an initial state must have with the model's constraints, at the
 /// default solver tolerance.
@@ -204,6 +206,39 @@ impl<S: HamiltonianSystem<N>, const N: usize> Stepper<S, N, Hamilton<S, N>> {
     /// The quadrature of the phase-space action.
     pub fn quadrature(&self) -> &Quadrature {
         self.equations.quadrature()
+    }
+}
+
+impl<S: DiracSystem<N>, const N: usize> Stepper<S, N, Verlet<S, N>> {
+    /// An explicit stepper for a separable model ([`DiracSystem::SEPARABLE`]): Störmer–Verlet
+    /// or one of its symmetric compositions ([`Verlet`]), one gradient of the potential per
+    /// stage and no Newton iteration. Refused (`Unsupported`) for a model not known to be
+    /// separable, or with constraints or forces; a singular mass matrix is refused at the start.
+    ///
+    /// ```
+    /// use dirac_runtime::{Composition, DiracSystem, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// struct Pendulum;
+    /// impl DiracSystem<1> for Pendulum {
+    ///     const SEPARABLE: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] * 0.5 + q[0].cos()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::explicit(Pendulum, Composition::of_order(6)?, 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// let e0 = stepper.energy()?;
+    /// stepper.run(1000)?;
+    /// assert!((stepper.energy()? - e0).abs() < 1e-9);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn explicit(system: S, composition: Composition, h: f64) -> Result<Self, DiracError> {
+        Self::with_equations(Verlet::new(system, composition, h)?)
+    }
+
+    /// The composition the stepper takes.
+    pub fn composition(&self) -> &Composition {
+        self.equations.composition()
     }
 }
 
@@ -1113,6 +1148,11 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         // singular) is refused here, before the first step, naming the undetermined unknowns.
         let equations = &mut self.equations;
         equations.predict(&state, None, &mut self.unknowns);
+        if self.unknowns.is_empty() {
+            // An explicit step: nothing to solve.
+            self.reset(state);
+            return Ok(());
+        }
         // The start's own Jacobian decides, not one reused from another run.
         self.newton.forget_jacobian();
         let trial = self.newton.solve(&mut self.unknowns, |x, r, j| {
@@ -1230,6 +1270,10 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let Some(state) = self.state else {
             return Err(DiracError::NotStarted);
         };
+        if self.unknowns.is_empty() {
+            // An explicit step: no equations to factorise.
+            return Ok(state);
+        }
         let equations = &mut self.equations;
         self.newton
             .factorise_at(&self.unknowns, |x, r, j| {
@@ -1248,11 +1292,16 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let predictor = self.predictor.predict();
         let equations = &mut self.equations;
         equations.predict(state, predictor, &mut self.unknowns);
-        self.newton.set_jacobian_cost(equations.jacobian_cost());
-        let result = self.newton.solve(&mut self.unknowns, |x, r, j| {
-            equations.assemble(state, x, r, j)
-        });
-        let report = result.map_err(|f| self.failure(Problem::Step, f))?;
+        let report = if self.unknowns.is_empty() {
+            // An explicit step: `advance` takes it.
+            NewtonReport::default()
+        } else {
+            self.newton.set_jacobian_cost(equations.jacobian_cost());
+            let result = self.newton.solve(&mut self.unknowns, |x, r, j| {
+                equations.assemble(state, x, r, j)
+            });
+            result.map_err(|f| self.failure(Problem::Step, f))?
+        };
         let mut next = self.equations.advance(state, &self.unknowns, self.steps)?;
         next.t = self.start + (self.steps + 1) as f64 * self.equations.h();
         let work = self.equations.work(state, &self.unknowns);

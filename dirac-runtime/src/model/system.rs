@@ -92,6 +92,26 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     const LAGRANGIAN_HESSIAN_ZEROS: crate::model::closed_form::HessianZeros<N> =
         crate::model::closed_form::HessianZeros::NONE;
 
+    /// Whether `L = ½ vᵀ M v + bᵀ v − V(q)` with a constant mass matrix `M` and constant `b`
+    /// (`∂²L/∂q∂v = 0` and `∂²L/∂v²` constant): such a model admits the explicit variational
+    /// step of [`Stepper::explicit`](crate::Stepper::explicit). `false` by default;
+    /// `#[dirac_system]` derives it from a Lagrangian written as an expression, and the explicit
+    /// step checks the claim at the start of every run.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Scalar};
+    /// use nalgebra::SVector;
+    /// struct Pendulum;
+    /// impl DiracSystem<1> for Pendulum {
+    ///     const SEPARABLE: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] * 0.5 + q[0].cos()
+    ///     }
+    /// }
+    /// assert!(<Pendulum as DiracSystem<1>>::SEPARABLE);
+    /// ```
+    const SEPARABLE: bool = false;
+
     /// Whether [`one_form_with_derivative`](Self::one_form_with_derivative) gives the one-forms'
     /// derivatives in closed form (`false` by default: dual numbers take them).
     const ONE_FORM_DERIVATIVES: bool = false;

@@ -120,7 +120,7 @@ impl NewtonOptions {
 }
 
 /// How a successful solve went.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct NewtonReport {
     /// Residual evaluations performed.
     pub iterations: usize,

@@ -1,10 +1,12 @@
 //! One step: the [`StepEquations`](crate::StepEquations) seam and its implementations — the
 //! discrete Euler–Lagrange equations on vector spaces and on Lie groups, the discrete Hamiltonian
-//! route, the modular step of an interconnection — with the interpolant inside a step (dense
+//! route, the modular step of an interconnection, the explicit Störmer–Verlet step of a separable
+//! Lagrangian and its compositions — with the interpolant inside a step (dense
 //! output), the step map's derivatives and the work of the steps booked by component (ledger).
 //!
 //! Uses every layer below it, up to [`discrete`](crate::discrete). A new scheme goes here.
 
+pub mod composition;
 pub mod dense_output;
 pub mod euler_lagrange;
 pub mod group_euler_lagrange;
@@ -13,3 +15,4 @@ pub mod ledger;
 pub mod modular;
 pub mod step_derivatives;
 pub mod step_equations;
+pub mod verlet;

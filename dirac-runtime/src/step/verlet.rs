@@ -1,0 +1,484 @@
+//! The explicit variational step of a Lagrangian `L = ½ vᵀ M v + bᵀ v − V(q)` with constant `M`
+//! and `b` ([`DiracSystem::SEPARABLE`]), and its symmetric compositions.
+//!
+//! For such a Lagrangian the trapezoidal discrete Lagrangian
+//! `L_d(q_0, q_1) = (h/2) [L(q_0, v̄) + L(q_1, v̄)]`, `v̄ = (q_1 − q_0)/h`, has discrete
+//! Euler–Lagrange equations that are solved in closed form: with `g(q) = ∂L/∂q = −∇V(q)`,
+//!
+//! ```text
+//! p_{1/2} = p_0 + (h/2) g(q_0),   q_1 = q_0 + h M⁻¹ (p_{1/2} − b),   p_1 = p_{1/2} + (h/2) g(q_1),
+//! ```
+//!
+//! the Störmer–Verlet step: one gradient of the potential per step (the last of a step is the
+//! first of the next), no Newton iteration, no Jacobian. It is the same map as the implicit
+//! step of [`Quadrature::trapezoid`](crate::Quadrature::trapezoid), to round-off
+//! (`tests/suite/explicit.rs`). A [`Composition`] of such steps of sizes `γ_i h` keeps the
+//! discrete variational structure (each factor is the flow of a discrete Lagrangian) and raises
+//! the order to 4, 6, 8 or 10.
+//!
+//! `M` and `b` are read at the start of a run; the claim that they are constant (and that
+//! `∂²L/∂q∂v = 0`) is checked there at the start and at a second state, and `M` must be
+//! invertible. Positions and momenta are summed with compensation, as in the implicit steps.
+//! Models with constraints or forces are refused: their steps are not explicit here.
+
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+
+use crate::base::error::DiracError;
+use crate::discrete::discrete_lagrangian::DiscreteLagrangian;
+use crate::discrete::state::State;
+use crate::model::derivatives::{self, Seed};
+use crate::model::legendre;
+use crate::model::system::DiracSystem;
+use crate::quadrature::Quadrature;
+use crate::solve::newton::{Newton, NewtonFailure};
+use crate::space::configuration_space::compensated_add;
+use crate::space::manifold::Vectors;
+use crate::step::composition::Composition;
+use crate::step::dense_output::Sample;
+use crate::step::step_equations::{StepEquations, StepWork};
+
+/// Relative size of a disagreement between the two probes of the kinetic energy that refuses a
+/// model's claim to be separable.
+const PROBE_TOLERANCE: f64 = 1e-8;
+
+/// The explicit step of a separable Lagrangian: Störmer–Verlet or one of its compositions.
+///
+/// ```
+/// use dirac_runtime::{Composition, DiracSystem, Scalar, Stepper};
+/// use nalgebra::{SVector, vector};
+///
+/// /// L = v²/2 − q²/2: M = 1, V = q²/2.
+/// struct Oscillator;
+/// impl DiracSystem<1> for Oscillator {
+///     const SEPARABLE: bool = true;
+///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+///     }
+/// }
+/// let mut stepper = Stepper::explicit(Oscillator, Composition::kahan_li_8(), 0.1)?;
+/// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+/// stepper.run(10)?;
+/// assert!((stepper.q()[0] - 1f64.cos()).abs() < 1e-11);
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Verlet<S, const N: usize> {
+    /// The trapezoidal discrete Lagrangian whose flow each stage is (the model and `h`).
+    discrete: DiscreteLagrangian<S, N>,
+    composition: Composition,
+    /// `M⁻¹` and `b` of the run (read when it begins).
+    kinetic: Option<Kinetic<N>>,
+    /// The last gradient taken, with the position it was taken at: the next step's first.
+    memo: Option<(SVector<f64, N>, SVector<f64, N>)>,
+    /// The step [`predict`](StepEquations::predict) took, from the state it took it from.
+    proposal: Option<(State<N>, Result<State<N>, Blowup>)>,
+}
+
+/// The constant kinetic terms: `v = M⁻¹ (p − b)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Kinetic<const N: usize> {
+    mass: SMatrix<f64, N, N>,
+    inverse_mass: SMatrix<f64, N, N>,
+    offset: SVector<f64, N>,
+}
+
+/// A step whose momentum or position left the finite numbers: which, and where.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Blowup {
+    momentum: bool,
+    coordinate: usize,
+    value: f64,
+}
+
+impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
+    /// The explicit step of `system` by `composition` with step `h`. Refused (`Unsupported`)
+    /// for a model that does not declare [`DiracSystem::SEPARABLE`], or that has constraints
+    /// or forces; `InvalidStep` and `NonFinite` as for any stepper.
+    ///
+    /// ```
+    /// use dirac_runtime::{Composition, DiracError, DiracSystem, Scalar, Verlet};
+    /// use nalgebra::SVector;
+    ///
+    /// /// A pendulum on a cart: its mass matrix depends on the angle.
+    /// struct CartPendulum;
+    /// impl DiracSystem<2> for CartPendulum {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+    ///         v[0] * v[0] + v[0] * v[1] * q[1].cos() + v[1] * v[1] * 0.5 + q[1].cos()
+    ///     }
+    /// }
+    /// let refused = Verlet::new(CartPendulum, Composition::verlet(), 0.1);
+    /// assert!(matches!(refused, Err(DiracError::Unsupported(_))));
+    /// ```
+    pub fn new(system: S, composition: Composition, h: f64) -> Result<Self, DiracError> {
+        let discrete = DiscreteLagrangian::new(system, Quadrature::trapezoid(), h);
+        discrete.check()?;
+        let refuse = |why: &str| {
+            Err(DiracError::Unsupported(format!(
+                "the explicit step ({}) of a model {why}; Stepper::new steps it with a quadrature",
+                composition.name()
+            )))
+        };
+        if !S::SEPARABLE {
+            return refuse(
+                "not known to be separable: it needs L = ½ vᵀ M v + bᵀ v − V(q) with constant \
+                 M and b (DiracSystem::SEPARABLE, which #[dirac_system] derives from the \
+                 Lagrangian)",
+            );
+        }
+        if S::ONE_FORMS + S::HOLONOMIC > 0 {
+            return refuse("with constraints");
+        }
+        if S::FORCES {
+            return refuse("with forces");
+        }
+        Ok(Self {
+            discrete,
+            composition,
+            kinetic: None,
+            memo: None,
+            proposal: None,
+        })
+    }
+
+    /// The composition the step takes.
+    pub fn composition(&self) -> &Composition {
+        &self.composition
+    }
+
+    /// `g(q) = ∂L/∂q`, which does not depend on the velocity (taken at zero).
+    fn gradient(&self, q: &SVector<f64, N>) -> SVector<f64, N> {
+        derivatives::directional_gradient(
+            self.discrete.system(),
+            q,
+            &SVector::zeros(),
+            Seed::POSITION,
+        )
+    }
+
+    /// `M⁻¹` and `b` at `(q, v)`, checked against a second state: `∂²L/∂q∂v = 0` at both, the
+    /// same `∂²L/∂v² = M` and `∂L/∂v − M v = b` at both, `M` invertible.
+    fn kinetic(&self, q: &SVector<f64, N>, v: &SVector<f64, N>) -> Result<Kinetic<N>, DiracError> {
+        let system = self.discrete.system();
+        let at = |q: &SVector<f64, N>, v: &SVector<f64, N>| {
+            let h = derivatives::hessian(system, q, v);
+            (h.vv, h.gradient.v - h.vv * v, h.qv)
+        };
+        let (mass, offset, mixed) = at(q, v);
+        if !(mass.iter().chain(offset.iter()).all(|x| x.is_finite())) {
+            return Err(DiracError::NonFinite {
+                what: "∂²L/∂v² or ∂L/∂v at the start".into(),
+                value: mass
+                    .iter()
+                    .chain(offset.iter())
+                    .copied()
+                    .find(|x| !x.is_finite())
+                    .unwrap_or(f64::NAN),
+            });
+        }
+        // A second state, moved by uneven amounts (a term may vanish at one state).
+        let moved = |x: &SVector<f64, N>, shift: f64| {
+            SVector::<f64, N>::from_fn(|i, _| {
+                x[i] + shift * (1.0 + 0.1 * i as f64) * (1.0 + x[i].abs())
+            })
+        };
+        let (q2, v2) = (moved(q, 0.0137), moved(v, 0.291));
+        let (mass2, offset2, mixed2) = at(&q2, &v2);
+        let scale = 1.0 + mass.amax() + offset.amax();
+        let differs = |a: f64, b: f64| (a - b).abs() > PROBE_TOLERANCE * scale;
+        let probe_finite = mass2.iter().chain(offset2.iter()).all(|x| x.is_finite());
+        let inconsistent = mixed.iter().any(|&x| differs(x, 0.0))
+            || (probe_finite
+                && (mixed2.iter().any(|&x| differs(x, 0.0))
+                    || mass.iter().zip(mass2.iter()).any(|(&a, &b)| differs(a, b))
+                    || offset
+                        .iter()
+                        .zip(offset2.iter())
+                        .any(|(&a, &b)| differs(a, b))));
+        if inconsistent {
+            return Err(DiracError::InconsistentDerivatives(format!(
+                "the model declares SEPARABLE, but its ∂²L/∂q∂v is not zero or its ∂²L/∂v² or \
+                 ∂L/∂v − (∂²L/∂v²) v changes between (q, v) = ({q:?}, {v:?}) and ({q2:?}, \
+                 {v2:?})"
+            )));
+        }
+        let inverse_mass = mass
+            .try_inverse()
+            .filter(|inverse| inverse.iter().all(|x| x.is_finite()))
+            .ok_or_else(|| {
+                DiracError::Unsupported(format!(
+                    "the explicit step of a model whose mass matrix ∂²L/∂v² is singular ({} \
+                     carries no kinetic energy of its own); Stepper::new steps it with a \
+                     quadrature",
+                    (0..N)
+                        .find(|&i| mass.row(i).iter().all(|&x| x == 0.0))
+                        .map_or_else(
+                            || "some combination of the velocities".to_string(),
+                            |i| system.coordinate_name(i)
+                        )
+                ))
+            })?;
+        Ok(Kinetic {
+            mass,
+            inverse_mass,
+            offset,
+        })
+    }
+
+    /// The step from `state` with the run's kinetic terms, starting from the gradient `first`
+    /// at `state.q` where it is known; with the gradient at the step's end.
+    fn take_step(
+        &self,
+        state: &State<N>,
+        kinetic: &Kinetic<N>,
+        first: Option<SVector<f64, N>>,
+    ) -> (Result<State<N>, Blowup>, SVector<f64, N>) {
+        let h = self.discrete.h();
+        let mut next = *state;
+        let mut g = first.unwrap_or_else(|| self.gradient(&state.q));
+        for &gamma in self.composition.coefficients() {
+            let half = 0.5 * gamma * h;
+            compensated_add(&mut next.p, &mut next.p_carry, &(g * half));
+            let v = kinetic.inverse_mass * (next.p - kinetic.offset);
+            compensated_add(&mut next.q, &mut next.q_carry, &(v * (gamma * h)));
+            g = self.gradient(&next.q);
+            compensated_add(&mut next.p, &mut next.p_carry, &(g * half));
+        }
+        let blowup = |x: &SVector<f64, N>, momentum| {
+            x.iter()
+                .position(|v| !v.is_finite())
+                .map(|coordinate| Blowup {
+                    momentum,
+                    coordinate,
+                    value: x[coordinate],
+                })
+        };
+        if let Some(blowup) = blowup(&next.q, false).or_else(|| blowup(&next.p, true)) {
+            return (Err(blowup), g);
+        }
+        next.velocity = kinetic.inverse_mass * (next.p - kinetic.offset);
+        (Ok(next), g)
+    }
+
+    /// The run's kinetic terms, or those at `state` before a run.
+    fn kinetic_at(&self, state: &State<N>) -> Result<Kinetic<N>, DiracError> {
+        match self.kinetic {
+            Some(kinetic) => Ok(kinetic),
+            None => self.kinetic(&state.q, &state.velocity),
+        }
+    }
+}
+
+impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
+    type System = S;
+    type Manifold = Vectors;
+
+    fn system(&self) -> &S {
+        self.discrete.system()
+    }
+
+    const NAME: &'static str = "the explicit variational step";
+    const VELOCITY: &'static str = "the Legendre transform (velocity from momentum)";
+    const FORCED: bool = false;
+
+    fn h(&self) -> f64 {
+        self.discrete.h()
+    }
+
+    fn method(&self) -> String {
+        self.composition.name().to_string()
+    }
+
+    fn unknowns(&self) -> usize {
+        0
+    }
+
+    fn multipliers(&self) -> usize {
+        0
+    }
+
+    fn multiplier_names(&self) -> Vec<String> {
+        Vec::new()
+    }
+
+    fn coordinate_name(&self, i: usize) -> String {
+        self.discrete.system().coordinate_name(i)
+    }
+
+    /// A finite start at which `L` is finite and the kinetic terms are constant and invertible.
+    fn check_start(&self, state: &State<N>, _tolerance: f64) -> Result<(), DiracError> {
+        StepEquations::check_finite(self, &state.q, &state.p, &state.velocity)?;
+        let value = self.discrete.system().lagrangian(&state.q, &state.velocity);
+        if !value.is_finite() {
+            return Err(DiracError::NonFinite {
+                what: "the Lagrangian at the initial state".into(),
+                value,
+            });
+        }
+        self.kinetic(&state.q, &state.velocity).map(|_| ())
+    }
+
+    fn begin(&mut self, state: &State<N>) {
+        self.kinetic = self.kinetic(&state.q, &state.velocity).ok();
+        self.memo = None;
+        self.proposal = None;
+    }
+
+    /// Takes the step (there is nothing to predict): [`advance`](Self::advance) returns it.
+    fn predict(
+        &mut self,
+        state: &State<N>,
+        _previous: Option<&DVector<f64>>,
+        _x: &mut DVector<f64>,
+    ) {
+        // A state the run's check refused: advance reports it again.
+        let Ok(kinetic) = self.kinetic_at(state) else {
+            return;
+        };
+        let first = self.memo.filter(|(q, _)| *q == state.q).map(|(_, g)| g);
+        let (step, last) = self.take_step(state, &kinetic, first);
+        if let Ok(next) = &step {
+            self.memo = Some((next.q, last));
+        }
+        self.proposal = Some((*state, step));
+    }
+
+    fn assemble(
+        &mut self,
+        _state: &State<N>,
+        _x: &DVector<f64>,
+        _residual: &mut DVector<f64>,
+        _jacobian: Option<&mut DMatrix<f64>>,
+    ) -> f64 {
+        0.0
+    }
+
+    fn advance(
+        &self,
+        state: &State<N>,
+        _x: &DVector<f64>,
+        step: u64,
+    ) -> Result<State<N>, DiracError> {
+        let taken = match &self.proposal {
+            Some((from, taken)) if from == state => *taken,
+            _ => {
+                let kinetic = self.kinetic_at(state)?;
+                self.take_step(state, &kinetic, None).0
+            }
+        };
+        taken.map_err(|blowup| DiracError::NonFinite {
+            what: format!(
+                "the {} of {} after step {step}",
+                if blowup.momentum {
+                    "momentum"
+                } else {
+                    "position"
+                },
+                self.coordinate_name(blowup.coordinate)
+            ),
+            value: blowup.value,
+        })
+    }
+
+    fn violation(&self, _from: &State<N>, _to: &State<N>, _x: &DVector<f64>) -> f64 {
+        0.0
+    }
+
+    fn first_multiplier(&self) -> usize {
+        0
+    }
+
+    fn unknown_name(&self, column: usize) -> String {
+        format!("unknown {column} (an explicit step has none)")
+    }
+
+    /// `v = M⁻¹ (p − b)` with `M` and `b` at `(q, guess)`: one Newton step of the Legendre
+    /// inversion, exact for a Lagrangian quadratic in the velocity.
+    fn velocity(
+        &self,
+        _newton: &mut Newton,
+        _t: f64,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, NewtonFailure> {
+        let h = derivatives::hessian(self.discrete.system(), q, guess);
+        let v =
+            h.vv.try_inverse()
+                .map(|inverse| guess + inverse * (p - h.gradient.v))
+                .ok_or(NewtonFailure::NonFinite)?;
+        match v.iter().all(|x| x.is_finite()) {
+            true => Ok(v),
+            false => Err(NewtonFailure::NonFinite),
+        }
+    }
+
+    /// `v = M⁻¹ (p − b)` with the run's `M` and `b`.
+    fn velocity_in_run(
+        &self,
+        newton: &mut Newton,
+        t: f64,
+        q: &SVector<f64, N>,
+        p: &SVector<f64, N>,
+        guess: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, NewtonFailure> {
+        match &self.kinetic {
+            Some(kinetic) => Ok(kinetic.inverse_mass * (p - kinetic.offset)),
+            None => self.velocity(newton, t, q, p, guess),
+        }
+    }
+
+    fn momentum(
+        &self,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Result<SVector<f64, N>, DiracError> {
+        let system = self.discrete.system();
+        let p = legendre::momentum(system, q, v);
+        let first = [
+            ("initial position", q),
+            ("initial velocity", v),
+            ("initial momentum", &p),
+        ]
+        .into_iter()
+        .find_map(|(what, x)| {
+            let i = x.iter().position(|v| !v.is_finite())?;
+            Some(DiracError::NonFinite {
+                what: format!("{what} of {}", system.coordinate_name(i)),
+                value: x[i],
+            })
+        });
+        first.map_or(Ok(p), Err)
+    }
+
+    /// The cubic Hermite interpolant of the positions through the step's ends with their
+    /// velocities (positions of order 4, velocities and momenta of order 3, whatever the
+    /// composition's order).
+    fn dense(&self, ends: [&Sample<N>; 2], _x: &DVector<f64>, theta: f64) -> Option<Sample<N>> {
+        let [a, b] = ends;
+        let h = self.discrete.h();
+        let (t2, t3) = (theta * theta, theta * theta * theta);
+        let q = a.q * (2.0 * t3 - 3.0 * t2 + 1.0)
+            + a.v * (h * (t3 - 2.0 * t2 + theta))
+            + b.q * (-2.0 * t3 + 3.0 * t2)
+            + b.v * (h * (t3 - t2));
+        let v = (a.q - b.q) * ((6.0 * t2 - 6.0 * theta) / h)
+            + a.v * (3.0 * t2 - 4.0 * theta + 1.0)
+            + b.v * (3.0 * t2 - 2.0 * theta);
+        let kinetic = self.kinetic?;
+        Some(Sample {
+            t: a.t + theta * h,
+            q,
+            v,
+            p: kinetic.mass * v + kinetic.offset,
+        })
+    }
+
+    /// No forces and no constraints: no work.
+    fn work(&self, _state: &State<N>, _x: &DVector<f64>) -> Option<StepWork<N>> {
+        Some(StepWork::zero())
+    }
+
+    fn energy(&self, q: &SVector<f64, N>, _p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64 {
+        legendre::energy(self.discrete.system(), q, v)
+    }
+}

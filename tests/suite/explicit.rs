@@ -1,0 +1,320 @@
+//! The explicit variational step of a separable Lagrangian (Störmer–Verlet and its compositions):
+//! which models the attribute declares separable, the step against the implicit trapezoidal step
+//! it equals, each composition's order measured against Kepler's closed-form orbit, the
+//! invariants it keeps, dense output, and the refusals.
+
+use crate::support::assert_order;
+
+use dirac::prelude::*;
+use scenes::{cart_pole, double_pendulum, kepler, knife_edge, oscillator, pendulum};
+
+/// Kepler's orbit for μ = 1, e = 0.5 from perihelion (the scene's start): `x = cos E − e`,
+/// `y = √(1 − e²) sin E` with `E − e sin E = t` (a = 1, period 2π).
+fn kepler_exact(t: f64) -> SVector<f64, 2> {
+    let e = 0.5;
+    let mut anomaly = t;
+    for _ in 0..50 {
+        anomaly -= (anomaly - e * anomaly.sin() - t) / (1.0 - e * anomaly.cos());
+    }
+    vector![anomaly.cos() - e, (1.0 - e * e).sqrt() * anomaly.sin()]
+}
+
+/// The position error at `t = 3` (inside the first orbit, past perihelion's fast arc) of `n`
+/// steps of `composition`.
+fn kepler_error(composition: &Composition, n: usize) -> f64 {
+    let t = 3.0;
+    let mut stepper = Stepper::explicit(kepler::SCENE, composition.clone(), t / n as f64).unwrap();
+    stepper
+        .start_from_momentum(kepler::q0(), kepler::p0())
+        .unwrap();
+    stepper.run(n as u64).unwrap();
+    (stepper.q() - kepler_exact(t)).norm()
+}
+
+#[test]
+fn the_attribute_declares_the_separable_lagrangians() {
+    // ½ m l² θ̇² + m g l cos θ, ½ |v|² + μ/|q|, ½ m ẋ² − ½ k x²: constant mass matrices.
+    assert!(<pendulum::Pendulum as DiracSystem<1>>::SEPARABLE);
+    assert!(<kepler::Kepler as DiracSystem<2>>::SEPARABLE);
+    assert!(<oscillator::Oscillator as DiracSystem<1>>::SEPARABLE);
+    // The knife edge's Lagrangian is separable too (its constraint is refused elsewhere).
+    assert!(<knife_edge::KnifeEdge as DiracSystem<3>>::SEPARABLE);
+    // cos(θ₁ − θ₂) θ̇₁ θ̇₂ and the cart-pole's cos θ ẋ θ̇: mass matrices that move.
+    assert!(!<double_pendulum::DoublePendulum as DiracSystem<2>>::SEPARABLE);
+    assert!(!<cart_pole::CartPole as DiracSystem<2>>::SEPARABLE);
+}
+
+/// `½ m (ẋ² + ẏ²) + B (x ẏ − y ẋ)/2 − k (x² + y²)/2`: a charge in a uniform magnetic field.
+/// Quadratic in the velocity with a constant mass, but its `∂²L/∂q∂v` does not vanish.
+#[dirac_system(
+    coordinates(x, y),
+    lagrangian = 0.5 * m * (dot(x).powi(2) + dot(y).powi(2)) + 0.5 * b * (x * dot(y) - y * dot(x))
+        - 0.5 * k * (x * x + y * y),
+)]
+#[derive(Debug, Clone, Copy)]
+struct Charge {
+    m: f64,
+    b: f64,
+    k: f64,
+}
+
+/// `½ (ẋ + c)² − cos x`: a constant `b = c` in the momentum, `p = ẋ + c`.
+#[dirac_system(coordinates(x), lagrangian = 0.5 * (dot(x) + c).powi(2) + cos(x))]
+#[derive(Debug, Clone, Copy)]
+struct Shifted {
+    c: f64,
+}
+
+#[test]
+fn a_velocity_coupled_to_the_position_is_not_separable_a_constant_offset_is() {
+    assert!(!<Charge as DiracSystem<2>>::SEPARABLE);
+    let charge = Charge {
+        m: 1.0,
+        b: 0.5,
+        k: 1.0,
+    };
+    assert!(matches!(
+        Stepper::explicit(charge, Composition::verlet(), 0.1),
+        Err(DiracError::Unsupported(_))
+    ));
+    // The offset is read at the start: the step equals the implicit trapezoidal one.
+    assert!(<Shifted as DiracSystem<1>>::SEPARABLE);
+    let shifted = Shifted { c: 0.7 };
+    let h = 0.05;
+    let mut explicit = Stepper::explicit(shifted, Composition::verlet(), h).unwrap();
+    let mut implicit = Stepper::new(shifted, Quadrature::trapezoid(), h).unwrap();
+    for stepper_start in [
+        explicit.start_from_velocity(vector![1.0], vector![0.3]),
+        implicit.start_from_velocity(vector![1.0], vector![0.3]),
+    ] {
+        stepper_start.unwrap();
+    }
+    explicit.run(400).unwrap();
+    implicit.run(400).unwrap();
+    assert!((explicit.q()[0] - implicit.q()[0]).abs() < 1e-12);
+    assert!((explicit.p()[0] - implicit.p()[0]).abs() < 1e-12);
+    assert!((explicit.v().unwrap()[0] - implicit.v().unwrap()[0]).abs() < 1e-12);
+}
+
+#[test]
+fn verlet_is_the_implicit_trapezoidal_step() {
+    // The trapezoidal discrete Lagrangian of a separable L has the Störmer–Verlet map as its
+    // discrete flow; Newton solves it to its tolerance, the explicit step takes it directly.
+    let h = 0.01;
+    let mut explicit = Stepper::explicit(kepler::SCENE, Composition::verlet(), h).unwrap();
+    let mut implicit = Stepper::new(kepler::SCENE, Quadrature::trapezoid(), h).unwrap();
+    explicit
+        .start_from_momentum(kepler::q0(), kepler::p0())
+        .unwrap();
+    implicit
+        .start_from_momentum(kepler::q0(), kepler::p0())
+        .unwrap();
+    let mut largest: f64 = 0.0;
+    for _ in 0..1000 {
+        explicit.step().unwrap();
+        implicit.step().unwrap();
+        largest = largest
+            .max((explicit.q() - implicit.q()).amax())
+            .max((explicit.p() - implicit.p()).amax());
+    }
+    println!("explicit against implicit trapezoid, 1000 Kepler steps: {largest:.1e}");
+    assert!(largest < 1e-12, "{largest:e}");
+    assert_eq!(explicit.composition().name(), "Störmer–Verlet");
+}
+
+#[test]
+fn each_composition_has_its_order_on_kepler() {
+    // Step counts over t = 3 (from perihelion past the fast arc), growing geometrically inside
+    // the range where each method's error is above round-off (1e-12 and up) and its leading
+    // term dominates.
+    let cases = [
+        (Composition::verlet(), [200, 400, 800, 1600]),
+        (Composition::triple_jump(), [100, 200, 400, 800]),
+        (Composition::suzuki(), [60, 120, 240, 480]),
+        (Composition::kahan_li_6(), [40, 80, 160, 320]),
+        (Composition::mclachlan_8(), [20, 30, 45, 68]),
+        (Composition::kahan_li_8(), [20, 30, 45, 68]),
+        (Composition::sofroniou_spaletta_10(), [10, 14, 20, 28]),
+    ];
+    for (composition, ns) in cases {
+        let hs: Vec<f64> = ns.iter().map(|&n| 3.0 / n as f64).collect();
+        let errors: Vec<f64> = ns.iter().map(|&n| kepler_error(&composition, n)).collect();
+        assert_order(composition.name(), &hs, &errors, composition.order() as f64);
+    }
+}
+
+#[test]
+fn compositions_keep_angular_momentum_to_round_off_and_the_energy_bounded() {
+    // Each stage is the flow of a rotation-invariant discrete Lagrangian: the discrete Noether
+    // theorem keeps x p_y − y p_x exactly, so only round-off moves it.
+    let h = 2.0 * std::f64::consts::PI / 200.0;
+    let mut stepper = Stepper::explicit(kepler::SCENE, Composition::kahan_li_8(), h).unwrap();
+    stepper
+        .start_from_momentum(kepler::q0(), kepler::p0())
+        .unwrap();
+    let l0 = kepler::angular_momentum(&kepler::q0(), &kepler::p0());
+    let e0 = stepper.energy().unwrap();
+    let (mut drift, mut energy): (f64, f64) = (0.0, 0.0);
+    let mut first_orbits: f64 = 0.0;
+    for orbit in 0..200 {
+        stepper.run(200).unwrap();
+        drift = drift.max((kepler::angular_momentum(&stepper.q(), &stepper.p()) - l0).abs());
+        energy = energy.max((stepper.energy().unwrap() - e0).abs());
+        if orbit == 19 {
+            first_orbits = energy;
+        }
+    }
+    println!("Kahan–Li 8, 200 orbits: |ΔL| ≤ {drift:.1e}, |ΔE| ≤ {energy:.1e}");
+    assert!(drift < 1e-12, "angular momentum moved by {drift:e}");
+    // Bounded: the error over 200 orbits is that of the first 20, not ten times it.
+    assert!(
+        energy < 2.0 * first_orbits.max(1e-13),
+        "{energy:e} against {first_orbits:e}"
+    );
+}
+
+#[test]
+fn dense_output_is_the_cubic_hermite_interpolant_of_order_four() {
+    // With an order-8 step the interpolant's own error dominates: order 4 in the positions.
+    let errors: Vec<f64> = [0.2, 0.1, 0.05, 0.025]
+        .iter()
+        .map(|&h| {
+            let mut stepper =
+                Stepper::explicit(oscillator::SCENE, Composition::kahan_li_8(), h).unwrap();
+            stepper
+                .start_from_velocity(vector![oscillator::Q0], vector![0.0])
+                .unwrap();
+            stepper.run((1.0 / h).round() as u64).unwrap();
+            stepper.step().unwrap();
+            let t = stepper.t() - 0.5 * h;
+            (stepper.interpolate(t).unwrap().q[0] - oscillator::exact(t)).abs()
+        })
+        .collect();
+    assert_order("dense output", &[0.2, 0.1, 0.05, 0.025], &errors, 4.0);
+}
+
+#[test]
+fn runs_events_and_saved_times_drive_the_explicit_step() {
+    // A pendulum released from 1 rad crosses θ = 0 first at a quarter period.
+    let mut stepper = Stepper::explicit(pendulum::SCENE, Composition::kahan_li_6(), 0.01).unwrap();
+    stepper
+        .start_from_velocity(vector![1.0], vector![0.0])
+        .unwrap();
+    let crossing = Event::new(
+        "theta = 0",
+        |_t, q: &SVector<f64, 1>, _v: &SVector<f64, 1>| q[0],
+    );
+    let solution = stepper
+        .solve(
+            Run::until(3.0)
+                .saveat([1.0, 2.0])
+                .event(crossing.terminal()),
+        )
+        .unwrap();
+    let at = solution.events[0].sample.t;
+    // Saved at t = 1, then stopped by the event before t = 2.
+    assert!(solution.trajectory.t().contains(&1.0));
+    assert!(!solution.trajectory.t().contains(&2.0));
+    // The quarter period of the pendulum at amplitude 1: K(sin ½)/√(g/l).
+    let k = {
+        // Complete elliptic integral of the first kind by the arithmetic–geometric mean.
+        let (mut a, mut b) = (1.0f64, (1.0 - 0.5f64.sin().powi(2)).sqrt());
+        for _ in 0..20 {
+            (a, b) = (0.5 * (a + b), (a * b).sqrt());
+        }
+        std::f64::consts::FRAC_PI_2 / a
+    };
+    let omega = (pendulum::SCENE.g / pendulum::SCENE.l).sqrt();
+    println!("first crossing at {at}, exact {}", k / omega);
+    assert!((at - k / omega).abs() < 1e-6, "{at} against {}", k / omega);
+}
+
+#[test]
+fn models_the_explicit_step_does_not_cover_are_refused() {
+    let unsupported = |r: Result<(), DiracError>| matches!(r, Err(DiracError::Unsupported(_)));
+    // A mass matrix that moves.
+    assert!(unsupported(
+        Stepper::explicit(double_pendulum::SCENE, Composition::verlet(), 0.01).map(|_| ())
+    ));
+    // A constraint.
+    assert!(unsupported(
+        Stepper::explicit(knife_edge::SCENE, Composition::verlet(), 0.01).map(|_| ())
+    ));
+    // Forces (the cart-pole's input).
+    assert!(unsupported(
+        Stepper::explicit(Pushed, Composition::verlet(), 0.01).map(|_| ())
+    ));
+    // A coordinate without kinetic energy: refused at the start, named, nothing started.
+    let mut stepper = Stepper::explicit(Massless, Composition::verlet(), 0.01).unwrap();
+    match stepper.start_from_velocity(vector![1.0, 0.0], vector![0.0, 0.0]) {
+        Err(DiracError::Unsupported(message)) => assert!(message.contains('y'), "{message}"),
+        other => panic!("expected Unsupported, got {other:?}"),
+    }
+    assert!(stepper.state().is_none());
+    // A bad step size or order.
+    assert!(matches!(
+        Stepper::explicit(pendulum::SCENE, Composition::verlet(), -0.1),
+        Err(DiracError::InvalidStep { .. })
+    ));
+    assert!(matches!(
+        Composition::of_order(12),
+        Err(DiracError::InvalidQuadrature(_))
+    ));
+}
+
+/// `½ ẋ² − x² − y²`: `y` has no kinetic energy (its mass matrix row vanishes).
+#[dirac_system(coordinates(x, y), lagrangian = 0.5 * dot(x).powi(2) - x * x - y * y)]
+#[derive(Debug, Clone, Copy)]
+struct Massless;
+
+/// An oscillator pushed by an input.
+#[dirac_system(
+    coordinates(x),
+    lagrangian = 0.5 * dot(x).powi(2) - 0.5 * x * x,
+    forces(u * dx),
+    inputs(u),
+)]
+#[derive(Debug, Clone, Copy)]
+struct Pushed;
+
+/// A hand-written model that claims to be separable and is not: `½ (1 + x²) ẋ²`.
+struct FalseClaim;
+
+impl DiracSystem<1> for FalseClaim {
+    const SEPARABLE: bool = true;
+    fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+        (q[0] * q[0] + 1.0) * v[0] * v[0] * 0.5
+    }
+}
+
+#[test]
+fn a_false_claim_of_separability_is_caught_at_the_start() {
+    let mut stepper = Stepper::explicit(FalseClaim, Composition::verlet(), 0.01).unwrap();
+    let refused = stepper.start_from_velocity(vector![0.5], vector![1.0]);
+    assert!(
+        matches!(refused, Err(DiracError::InconsistentDerivatives(_))),
+        "{refused:?}"
+    );
+    assert!(stepper.state().is_none());
+}
+
+/// `½ ẋ² + eˣ`: pushed to overflow in one step from x = 700.
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2) + exp(x))]
+#[derive(Debug, Clone, Copy)]
+struct Runaway;
+
+#[test]
+fn a_step_that_overflows_is_refused_and_changes_nothing() {
+    let mut stepper = Stepper::explicit(Runaway, Composition::verlet(), 1.0).unwrap();
+    stepper
+        .start_from_velocity(vector![700.0], vector![0.0])
+        .unwrap();
+    let before = *stepper.state().unwrap();
+    let refused = stepper.step();
+    assert!(
+        matches!(refused, Err(DiracError::NonFinite { .. })),
+        "{refused:?}"
+    );
+    assert_eq!(*stepper.state().unwrap(), before);
+    assert_eq!(stepper.steps(), 0);
+}
