@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, criterion_group};
 use dirac::prelude::*;
+use dirac::{StepEquations, Vectors};
 use scenes::hand_written::{Galerkin2, HandStepper, KnifeEdgeMidpoint, Midpoint};
 use scenes::{chain, double_pendulum, knife_edge};
 
@@ -663,8 +664,60 @@ fn forced(c: &mut Criterion) {
     group.finish();
 }
 
+/// One Kepler step (e = 0.5, h = 0.01), restarted every 10 000 steps.
+fn kepler_step<E: StepEquations<2, System = scenes::kepler::Kepler, Manifold = Vectors>>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    mut stepper: Stepper<scenes::kepler::Kepler, 2, E>,
+) {
+    let start = |stepper: &mut Stepper<scenes::kepler::Kepler, 2, E>| {
+        stepper
+            .start_from_momentum(scenes::kepler::q0(), scenes::kepler::p0())
+            .expect("finite start")
+    };
+    start(&mut stepper);
+    group.bench_function(name, |b| {
+        b.iter(|| {
+            if stepper.steps() >= 10_000 {
+                start(&mut stepper);
+            }
+            black_box(stepper.step()).expect("step")
+        })
+    });
+}
+
+/// The explicit variational step of a separable Lagrangian against the implicit step of the
+/// same order on Kepler's problem: Störmer–Verlet against the trapezoidal rule (the same map,
+/// `tests/suite/explicit.rs`), Kahan–Li 8 against `galerkin(4)` (order 8), Sofroniou–Spaletta 10
+/// against `galerkin(5)` (order 10).
+fn explicit(c: &mut Criterion) {
+    let mut group = c.benchmark_group("explicit_step");
+    let (scene, h) = (scenes::kepler::SCENE, 0.01);
+    let cases = [
+        ("order_2", Composition::verlet(), Quadrature::trapezoid()),
+        (
+            "order_8",
+            Composition::kahan_li_8(),
+            Quadrature::galerkin(4).expect("degree 4"),
+        ),
+        (
+            "order_10",
+            Composition::sofroniou_spaletta_10(),
+            Quadrature::galerkin(5).expect("degree 5"),
+        ),
+    ];
+    for (order, composition, quadrature) in cases {
+        let explicit = Stepper::explicit(scene, composition, h).expect("separable scene");
+        kepler_step(&mut group, &format!("kepler_{order}/explicit"), explicit);
+        let implicit = Stepper::new(scene, quadrature, h).expect("valid scene");
+        kepler_step(&mut group, &format!("kepler_{order}/implicit"), implicit);
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
+    explicit,
     forced,
     modular,
     interconnection,

@@ -60,6 +60,16 @@ const GROUPS: &[(&str, &str)] = &[
         "Models built from components against the same models written as one struct.",
     ),
     (
+        "explicit_step",
+        "The explicit variational step of a separable Lagrangian (Störmer–Verlet and its \
+         compositions) against the implicit step of the same order, on Kepler's problem.",
+    ),
+    (
+        "forced_step",
+        "Steps of forced models (an input, a resistor, body torques on SO(3)) with the work of \
+         their forces booked.",
+    ),
+    (
         "modular_step",
         "The modular step (components by parts, Schur complement on the junctions) against the \
          monolithic step, and its cost by number of components.",
@@ -73,6 +83,7 @@ const PAIRS: &[(&str, &str)] = &[
     ("modular", "one_model"),
     ("hamiltonian", "lagrangian"),
     ("run", "step_loop"),
+    ("explicit", "implicit"),
 ];
 
 /// Groups whose every benchmark is divided by one of them.
