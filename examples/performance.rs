@@ -84,6 +84,7 @@ const PAIRS: &[(&str, &str)] = &[
     ("hamiltonian", "lagrangian"),
     ("run", "step_loop"),
     ("explicit", "implicit"),
+    ("explicit", "hand_written"),
 ];
 
 /// Groups whose every benchmark is divided by one of them.
