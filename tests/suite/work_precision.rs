@@ -22,17 +22,34 @@ fn oscillator_at(t: f64) -> Sample<1> {
 
 const STEPS: [f64; 4] = [0.2, 0.1, 0.05, 0.025];
 
-/// `|(q, p)(T) − exact|` by a stepper run here, not by the study.
-fn direct_error(quadrature: Quadrature, h: f64, horizon: f64) -> f64 {
-    let mut stepper = Stepper::new(Oscillator, quadrature, h).unwrap();
+/// `|(q, p)(T) − exact|` by a stepper run here, not by the study, with the quadrature or the
+/// explicit composition called `method`.
+fn direct_error(method: &str, h: f64, horizon: f64) -> f64 {
+    let exact = oscillator_at(horizon);
+    let error =
+        |q: SVector<f64, 1>, p: SVector<f64, 1>| (q - exact.q).amax().max((p - exact.p).amax());
+    if let Some(quadrature) = scenes::quadratures()
+        .into_iter()
+        .find(|q| q.name() == method)
+    {
+        let mut stepper = Stepper::new(Oscillator, quadrature, h).unwrap();
+        stepper
+            .start_from_velocity(vector![1.0], vector![0.0])
+            .unwrap();
+        stepper.run_until(horizon).unwrap();
+        return error(stepper.q(), stepper.p());
+    }
+    let composition = [2, 4, 6, 8]
+        .map(|order| Composition::of_order(order).unwrap())
+        .into_iter()
+        .find(|c| c.name() == method)
+        .unwrap();
+    let mut stepper = Stepper::explicit(Oscillator, composition, h).unwrap();
     stepper
         .start_from_velocity(vector![1.0], vector![0.0])
         .unwrap();
     stepper.run_until(horizon).unwrap();
-    let exact = oscillator_at(horizon);
-    (stepper.q() - exact.q)
-        .amax()
-        .max((stepper.p() - exact.p).amax())
+    error(stepper.q(), stepper.p())
 }
 
 #[test]
@@ -47,30 +64,43 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
     .run()
     .unwrap();
     assert!(study.failures.is_empty(), "{:?}", study.failures);
-    assert_eq!(study.measurements.len(), 12);
+    // Three quadratures, and the oscillator being separable, four explicit compositions.
+    assert_eq!(study.measurements.len(), 28);
     for m in &study.measurements {
-        let quadrature = scenes::quadratures()
-            .into_iter()
-            .find(|q| q.name() == m.quadrature)
-            .unwrap();
-        let direct = direct_error(quadrature, m.h, horizon);
+        let direct = direct_error(&m.quadrature, m.h, horizon);
         assert!(
             (m.error - direct).abs() <= 1e-14 + 1e-9 * direct,
             "{m:?} against {direct:e}"
         );
         assert_eq!(m.steps, (horizon / m.h).round() as u64);
-        assert!(m.seconds_per_unit_time > 0.0 && m.newton_iterations >= 1.0);
-        // A quadratic energy: the Gauss rules keep it to round-off.
-        assert!(m.energy_error < 1e-13, "{m:?}");
+        assert!(m.seconds_per_unit_time > 0.0);
+        let implicit = scenes::quadratures()
+            .iter()
+            .any(|q| q.name() == m.quadrature);
+        if implicit {
+            assert!(m.newton_iterations >= 1.0, "{m:?}");
+            // A quadratic energy: the Gauss rules keep it to round-off.
+            assert!(m.energy_error < 1e-13, "{m:?}");
+        } else {
+            // An explicit step: no Newton iteration. Störmer–Verlet keeps p²/2 + (1 − h²/4) q²/2
+            // exactly, so its energy error is (h²/8)(1 − q_k²), largest near q = 0 (where a step
+            // comes within h/2 of it): h²/8 to a relative h²/4. The higher orders stay below it.
+            assert_eq!(m.newton_iterations, 0.0, "{m:?}");
+            let verlet = m.h * m.h / 8.0;
+            if m.quadrature == "Störmer–Verlet" {
+                assert!(
+                    (m.energy_error - verlet).abs() <= 0.25 * m.h * m.h * verlet,
+                    "{m:?}"
+                );
+            } else {
+                assert!(m.energy_error < verlet, "{m:?}");
+            }
+        }
     }
     for target in [1e-3, 1e-6, 1e-9] {
         let choice = study.cheapest(target).unwrap();
-        let quadrature = scenes::quadratures()
-            .into_iter()
-            .find(|q| q.name() == choice.quadrature)
-            .unwrap();
         assert!(
-            direct_error(quadrature, choice.h, horizon) <= target,
+            direct_error(&choice.quadrature, choice.h, horizon) <= target,
             "{choice:?}"
         );
         assert!(
@@ -85,8 +115,9 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
             choice.quadrature, choice.h, choice.error
         );
     }
-    // Unreachable targets are refused, naming the most accurate run.
-    let refused = study.cheapest(1e-15).unwrap_err();
+    // Unreachable targets (below the spacing of doubles near 1) are refused, naming the most
+    // accurate run.
+    let refused = study.cheapest(1e-17).unwrap_err();
     assert!(refused.to_string().contains("no run reaches"), "{refused}");
     let png = std::env::temp_dir().join("dirac_work_precision_test.png");
     study.save_png(&png, "oscillator to T = 10").unwrap();
@@ -95,7 +126,7 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
     let mut csv = Vec::new();
     study.write_csv(&mut csv).unwrap();
     let text = String::from_utf8(csv).unwrap();
-    assert_eq!(text.lines().count(), 13);
+    assert_eq!(text.lines().count(), 29);
     assert!(text.starts_with("quadrature,h,steps,error,energy_error,"));
 }
 
@@ -179,7 +210,11 @@ fn an_invalid_study_is_refused() {
     assert!(invalid(
         Study::new(Oscillator, 1.0, start).steps([0.1, -0.1])
     ));
-    assert!(invalid(Study::new(Oscillator, 1.0, start).quadratures([])));
+    assert!(invalid(
+        Study::new(Oscillator, 1.0, start)
+            .quadratures([])
+            .compositions([])
+    ));
     assert!(invalid(
         Study::new(Oscillator, 1.0, start).reference(oscillator_at(2.0))
     ));

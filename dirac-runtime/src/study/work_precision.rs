@@ -1,5 +1,6 @@
 //! The trade between speed and accuracy, measured for the user's own model: a grid of
-//! quadratures × steps run to a horizon, each run's error against a reference, its energy error,
+//! methods (quadratures, and for a separable model the explicit compositions) × steps run to a
+//! horizon, each run's error against a reference, its energy error,
 //! constraint violation, Newton iterations and wall time per unit of simulated time; and the
 //! cheapest run meeting a target.
 //!
@@ -26,7 +27,11 @@ use crate::integrate::stepper::Stepper;
 use crate::integrate::trajectory;
 use crate::model::system::DiracSystem;
 use crate::quadrature::Quadrature;
+use crate::space::manifold::Vectors;
+use crate::step::composition::Composition;
 use crate::step::dense_output::Sample;
+use crate::step::step_equations::StepEquations;
+use crate::step::verlet::Verlet;
 
 /// How a study starts each of its steppers (e.g. `|s| s.start_from_velocity(q0, v0)`).
 type Start<'a, S, const N: usize> = Box<dyn Fn(&mut Stepper<S, N>) -> Result<(), DiracError> + 'a>;
@@ -58,6 +63,7 @@ pub struct Study<'a, S: DiracSystem<N>, const N: usize> {
     horizon: f64,
     start: Start<'a, S, N>,
     quadratures: Vec<Quadrature>,
+    compositions: Vec<Composition>,
     steps: Vec<f64>,
     repetitions: usize,
     /// The given reference and its error estimate.
@@ -69,6 +75,7 @@ impl<S: DiracSystem<N>, const N: usize> std::fmt::Debug for Study<'_, S, N> {
         f.debug_struct("Study")
             .field("horizon", &self.horizon)
             .field("quadratures", &self.quadratures)
+            .field("compositions", &self.compositions)
             .field("steps", &self.steps)
             .field("repetitions", &self.repetitions)
             .field("reference", &self.reference)
@@ -80,7 +87,7 @@ impl<S: DiracSystem<N>, const N: usize> std::fmt::Debug for Study<'_, S, N> {
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Measurement {
-    /// The quadrature's name.
+    /// The method's name: the quadrature's, or the composition's for an explicit step.
     pub quadrature: String,
     /// The step size.
     pub h: f64,
@@ -101,7 +108,7 @@ pub struct Measurement {
 /// A run of the grid that could not be measured, and why.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Failure {
-    /// The quadrature's name.
+    /// The method's name: the quadrature's, or the composition's.
     pub quadrature: String,
     /// The step size.
     pub h: f64,
@@ -127,8 +134,11 @@ pub struct WorkPrecision<const N: usize> {
 
 impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
     /// A study of `system` to time `horizon`, each stepper started by `start`; by default
-    /// `midpoint`, `galerkin(2)` and `galerkin(3)` at `h = horizon/16, /32, /64, /128`, three
-    /// timing repetitions, and a converged reference.
+    /// `midpoint`, `galerkin(2)` and `galerkin(3)`, and for a separable model without
+    /// constraints or forces ([`DiracSystem::SEPARABLE`]) the explicit compositions of orders 2,
+    /// 4, 6 and 8 ([`Composition::of_order`]), at `h = horizon/16, /32, /64, /128`, three timing
+    /// repetitions, and a converged reference. An explicit step starts from the state `start`
+    /// gives a `midpoint` stepper.
     pub fn new(
         system: S,
         horizon: f64,
@@ -138,11 +148,20 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
             .iter()
             .filter_map(|&s| Quadrature::galerkin(s).ok())
             .collect();
+        let explicit = S::SEPARABLE && S::ONE_FORMS + S::HOLONOMIC == 0 && !S::FORCES;
+        let compositions = match explicit {
+            true => [2, 4, 6, 8]
+                .iter()
+                .filter_map(|&order| Composition::of_order(order).ok())
+                .collect(),
+            false => Vec::new(),
+        };
         Self {
             system,
             horizon,
             start: Box::new(start),
             quadratures,
+            compositions,
             steps: [16.0, 32.0, 64.0, 128.0].map(|n| horizon / n).to_vec(),
             repetitions: 3,
             reference: None,
@@ -153,6 +172,37 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
     pub fn quadratures(self, quadratures: impl IntoIterator<Item = Quadrature>) -> Self {
         Self {
             quadratures: quadratures.into_iter().collect(),
+            ..self
+        }
+    }
+
+    /// The explicit compositions of the grid (none: quadratures only). A model the explicit step
+    /// does not cover has each of its runs refused, reported in [`WorkPrecision::failures`].
+    ///
+    /// ```
+    /// use dirac_runtime::{Composition, DiracSystem, Scalar, work_precision::Study};
+    /// use nalgebra::{SVector, vector};
+    /// #[derive(Clone)]
+    /// struct Pendulum;
+    /// impl DiracSystem<1> for Pendulum {
+    ///     const SEPARABLE: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] * 0.5 + q[0].cos()
+    ///     }
+    /// }
+    /// let study = Study::new(Pendulum, 5.0, |s| s.start_from_velocity(vector![1.0], vector![0.0]))
+    ///     .steps([0.1, 0.05])
+    ///     .compositions([Composition::kahan_li_8()])
+    ///     .run()?;
+    /// // midpoint, galerkin(2), galerkin(3) and Kahan–Li 8 at two steps.
+    /// assert_eq!(study.measurements.len(), 8);
+    /// let explicit = study.measurements.iter().find(|m| m.quadrature.starts_with("Kahan–Li 8"));
+    /// assert_eq!(explicit.map(|m| m.newton_iterations), Some(0.0));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn compositions(self, compositions: impl IntoIterator<Item = Composition>) -> Self {
+        Self {
+            compositions: compositions.into_iter().collect(),
             ..self
         }
     }
@@ -223,16 +273,26 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
         };
         let mut measurements = Vec::new();
         let mut failures = Vec::new();
+        let mut record =
+            |name: String, h: f64, measured: Result<Measurement, DiracError>| match measured {
+                Ok(measurement) => measurements.push(measurement),
+                Err(error) => failures.push(Failure {
+                    quadrature: name,
+                    h,
+                    error,
+                }),
+            };
         for quadrature in &self.quadratures {
             for &h in &self.steps {
-                match self.measure(quadrature, h, &reference) {
-                    Ok(measurement) => measurements.push(measurement),
-                    Err(error) => failures.push(Failure {
-                        quadrature: quadrature.name(),
-                        h,
-                        error,
-                    }),
-                }
+                let stepper = || self.stepper(quadrature, h);
+                record(quadrature.name(), h, self.measure(&stepper, h, &reference));
+            }
+        }
+        for composition in &self.compositions {
+            for &h in &self.steps {
+                let stepper = || self.explicit(composition, h);
+                let name = composition.name().to_string();
+                record(name, h, self.measure(&stepper, h, &reference));
             }
         }
         Ok(WorkPrecision {
@@ -252,8 +312,8 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
                 self.horizon
             ));
         }
-        if self.quadratures.is_empty() || self.steps.is_empty() {
-            return invalid("the grid needs at least one quadrature and one step".into());
+        if self.quadratures.is_empty() && self.compositions.is_empty() || self.steps.is_empty() {
+            return invalid("the grid needs at least one method and one step".into());
         }
         if let Some(h) = self.steps.iter().find(|h| !(h.is_finite() && **h > 0.0)) {
             return invalid(format!("steps must be positive and finite, got {h}"));
@@ -276,7 +336,7 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
                 ));
             }
             // The start function sets the time the horizon counts from.
-            let t0 = self.stepper(&self.quadratures[0], self.steps[0])?.t();
+            let t0 = self.stepper(&Quadrature::midpoint(), self.steps[0])?.t();
             let t_end = t0 + self.horizon;
             if (reference.t - t_end).abs() > 1e-12 * t_end.abs().max(1.0) {
                 return invalid(format!(
@@ -292,6 +352,20 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
     fn stepper(&self, quadrature: &Quadrature, h: f64) -> Result<Stepper<S, N>, DiracError> {
         let mut stepper = Stepper::new(self.system.clone(), quadrature.clone(), h)?;
         (self.start)(&mut stepper)?;
+        Ok(stepper)
+    }
+
+    /// A started explicit stepper with `composition` and step `h`, from the state `start` gives
+    /// a midpoint stepper.
+    fn explicit(
+        &self,
+        composition: &Composition,
+        h: f64,
+    ) -> Result<Stepper<S, N, Verlet<S, N>>, DiracError> {
+        let mut stepper = Stepper::explicit(self.system.clone(), composition.clone(), h)?;
+        let start = self.stepper(&Quadrature::midpoint(), h)?;
+        let state = start.state().ok_or(DiracError::NotStarted)?;
+        stepper.start_from_state(*state)?;
         Ok(stepper)
     }
 
@@ -327,14 +401,14 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
         Err(refusal.expect("three rules were tried"))
     }
 
-    /// One run of the grid.
-    fn measure(
+    /// One run of the grid, each of its steppers made (and started) by `make`.
+    fn measure<E: StepEquations<N, System = S, Manifold = Vectors>>(
         &self,
-        quadrature: &Quadrature,
+        make: &dyn Fn() -> Result<Stepper<S, N, E>, DiracError>,
         h: f64,
         reference: &Sample<N>,
     ) -> Result<Measurement, DiracError> {
-        let mut stepper = self.stepper(quadrature, h)?;
+        let mut stepper = make()?;
         let t_end = stepper.t() + self.horizon;
         let mut iterations = 0;
         let run = Run::until(t_end).observe(|progress| {
@@ -348,13 +422,13 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
         let steps = stepper.steps();
         let mut fastest = f64::INFINITY;
         for _ in 0..self.repetitions {
-            let mut timed = self.stepper(quadrature, h)?;
+            let mut timed = make()?;
             let clock = Instant::now();
             timed.solve(Run::until(t_end).every(usize::MAX))?;
             fastest = fastest.min(clock.elapsed().as_secs_f64());
         }
         Ok(Measurement {
-            quadrature: quadrature.name(),
+            quadrature: stepper.equations().method(),
             h,
             steps,
             error,
