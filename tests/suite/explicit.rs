@@ -240,9 +240,10 @@ fn models_the_explicit_step_does_not_cover_are_refused() {
     assert!(unsupported(
         Stepper::explicit(knife_edge::SCENE, Composition::verlet(), 0.01).map(|_| ())
     ));
-    // Forces (the cart-pole's input).
+    // A force that reads the velocity (a damper).
+    assert!(!<Damped as DiracSystem<1>>::FORCES_FREE_OF_VELOCITY);
     assert!(unsupported(
-        Stepper::explicit(Pushed, Composition::verlet(), 0.01).map(|_| ())
+        Stepper::explicit(Damped, Composition::verlet(), 0.01).map(|_| ())
     ));
     // A coordinate without kinetic energy: refused at the start, named, nothing started.
     let mut stepper = Stepper::explicit(Massless, Composition::verlet(), 0.01).unwrap();
@@ -267,15 +268,88 @@ fn models_the_explicit_step_does_not_cover_are_refused() {
 #[derive(Debug, Clone, Copy)]
 struct Massless;
 
-/// An oscillator pushed by an input.
+/// A damped oscillator: its force reads the velocity.
 #[dirac_system(
     coordinates(x),
     lagrangian = 0.5 * dot(x).powi(2) - 0.5 * x * x,
-    forces(u * dx),
+    forces(-0.1 * dot(x) * dx),
+)]
+#[derive(Debug, Clone, Copy)]
+struct Damped;
+
+/// A Duffing oscillator driven by `u cos t`, its cubic spring written as a force: forces of the
+/// position, the time and an input.
+#[dirac_system(
+    coordinates(x, y),
+    lagrangian = 0.5 * (dot(x).powi(2) + dot(y).powi(2)) - 0.5 * (x * x + y * y),
+    forces((u * cos(t) - k * x.powi(3)) * dx - k * x * y * dy),
     inputs(u),
 )]
 #[derive(Debug, Clone, Copy)]
-struct Pushed;
+struct Duffing {
+    k: f64,
+}
+
+#[test]
+fn forces_of_position_time_and_inputs_keep_the_step_explicit() {
+    assert!(<Duffing as DiracSystem<2>>::FORCES_FREE_OF_VELOCITY);
+    let duffing = Duffing { k: 0.3 };
+    let h = 0.02;
+    let mut explicit = Stepper::explicit(duffing, Composition::verlet(), h).unwrap();
+    let mut implicit = Stepper::new(duffing, Quadrature::trapezoid(), h).unwrap();
+    for stepper_start in [
+        explicit.start_from_velocity(vector![1.0, 0.5], vector![0.0, 0.2]),
+        implicit.start_from_velocity(vector![1.0, 0.5], vector![0.0, 0.2]),
+    ] {
+        stepper_start.unwrap();
+    }
+    let mut largest: f64 = 0.0;
+    for k in 0..500 {
+        // The input changes between steps and is held over each.
+        let u = 0.5 + 0.3 * (k as f64 * 0.01).sin();
+        explicit.set_input("u", u).unwrap();
+        implicit.set_input("u", u).unwrap();
+        explicit.step().unwrap();
+        implicit.step().unwrap();
+        largest = largest
+            .max((explicit.q() - implicit.q()).amax())
+            .max((explicit.p() - implicit.p()).amax());
+    }
+    // The same map as the trapezoidal rule's, and the same work booked for its forces.
+    println!("driven Duffing, explicit against implicit trapezoid: {largest:.1e}");
+    assert!(largest < 1e-12, "{largest:e}");
+    let (a, b) = (explicit.work().unwrap(), implicit.work().unwrap());
+    println!("work: explicit {a}, implicit {b}");
+    assert!((a - b).abs() < 1e-12 * (1.0 + b.abs()), "{a} against {b}");
+    assert!(a.abs() > 1e-3);
+}
+
+#[test]
+fn the_energy_balance_of_a_driven_explicit_step_closes_to_its_order() {
+    // E_{k+1} − E_k − W_k is the unforced step's own energy error, O(h²) for Störmer–Verlet and
+    // O(h⁸) for Kahan–Li 8: the balance closes at the step's order.
+    let defect = |composition: Composition, h: f64| {
+        let mut stepper = Stepper::explicit(Duffing { k: 0.3 }, composition, h).unwrap();
+        stepper
+            .start_from_velocity(vector![1.0, 0.5], vector![0.0, 0.2])
+            .unwrap();
+        stepper.set_input("u", 0.5).unwrap();
+        stepper.run_until(2.0).unwrap();
+        stepper.energy_balance_error().unwrap().abs()
+    };
+    let hs = [0.1, 0.05, 0.025, 0.0125];
+    let errors: Vec<f64> = hs
+        .iter()
+        .map(|&h| defect(Composition::verlet(), h))
+        .collect();
+    assert_order("Störmer–Verlet energy balance", &hs, &errors, 2.0);
+    let hs = [0.4, 0.3, 0.2, 0.15];
+    let errors: Vec<f64> = hs
+        .iter()
+        .map(|&h| defect(Composition::kahan_li_8(), h))
+        .collect();
+    assert_order("Kahan–Li 8 energy balance", &hs, &errors, 8.0);
+}
 
 /// A hand-written model that claims to be separable and is not: `½ (1 + x²) ẋ²`.
 struct FalseClaim;

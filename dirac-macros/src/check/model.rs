@@ -30,6 +30,9 @@ pub struct Model {
     pub holonomic: Vec<TokenStream>,
     /// Terms of all force one-forms together.
     pub forces: Vec<Term>,
+    /// Whether no force reads a velocity (`dot(x)`, `omega(R)`): the forces are functions of
+    /// the positions, the time and the inputs alone.
+    pub forces_free_of_velocity: bool,
     pub inputs: Vec<Ident>,
     /// `__dirac::ConstraintPoint::...` when `constraint_at` is given.
     pub constraint_point: Option<TokenStream>,

@@ -5,7 +5,7 @@ use std::cell::RefCell;
 use std::collections::HashSet;
 
 use proc_macro2::{Span, TokenStream};
-use quote::quote;
+use quote::{ToTokens, quote};
 use syn::punctuated::Punctuated;
 use syn::spanned::Spanned;
 use syn::{Expr, Fields, GenericParam, Ident, Meta, Token, Type};
@@ -331,6 +331,11 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         &parameters,
         &mut errors,
     );
+    let forces_free_of_velocity = e
+        .forces
+        .iter()
+        .flatten()
+        .all(|force| !reads_velocity(force.to_token_stream()));
     let one_forms = e.constraints.is_some() || e.holonomic.is_some() || e.forces.is_some();
     check_differential_names(
         coordinates.as_deref().unwrap_or_default(),
@@ -531,6 +536,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 one_form_names,
                 holonomic,
                 forces,
+                forces_free_of_velocity,
                 inputs,
                 constraint_point,
                 closed_form,
@@ -884,4 +890,26 @@ fn parameters(item: &syn::ItemStruct, errors: &mut Errors) -> Vec<Parameter> {
             }
         })
         .collect()
+}
+
+/// Whether `tokens` read a velocity: a call `dot(x)` of one argument (`dot(u, v)` is the scalar
+/// product) or `omega(R)`, at any depth. Read on the tokens, so that a method call `a.dot(b)`
+/// counts too: the answer errs only towards "reads one".
+fn reads_velocity(tokens: proc_macro2::TokenStream) -> bool {
+    use proc_macro2::{Delimiter, TokenTree};
+    let tokens: Vec<TokenTree> = tokens.into_iter().collect();
+    tokens.iter().enumerate().any(|(i, token)| match token {
+        TokenTree::Ident(name) if name == "dot" || name == "omega" => match tokens.get(i + 1) {
+            Some(TokenTree::Group(group)) if group.delimiter() == Delimiter::Parenthesis => {
+                let top_level_comma = group
+                    .stream()
+                    .into_iter()
+                    .any(|t| matches!(&t, TokenTree::Punct(p) if p.as_char() == ','));
+                name == "omega" || !top_level_comma || reads_velocity(group.stream())
+            }
+            _ => false,
+        },
+        TokenTree::Group(group) => reads_velocity(group.stream()),
+        _ => false,
+    })
 }

@@ -569,8 +569,14 @@ fn dirac_items(
         let state = bindings(true);
         let inputs = input_bindings(model);
         let sum = accumulate(&quote!(__f), &model.forces);
+        let free = (model.forces_free_of_velocity && !model.hamiltonian).then(|| {
+            quote!(
+                const FORCES_FREE_OF_VELOCITY: bool = true;
+            )
+        });
         items.extend(quote! {
             const FORCES: bool = true;
+            #free
 
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
             fn force<__D: __dirac::Scalar>(

@@ -112,6 +112,14 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// ```
     const SEPARABLE: bool = false;
 
+    /// Whether the [`force`](Self::force) does not depend on the velocity: a function of the
+    /// position, the time and the inputs alone (a potential force written as a force, a
+    /// source, an actuator). The explicit step ([`Stepper::explicit`](crate::Stepper::explicit))
+    /// takes such forces and refuses others. `false` by default; `#[dirac_system]` derives it
+    /// (no `dot(x)` or `omega(R)` in `forces(...)`), and the explicit step checks the claim at
+    /// the start of every run.
+    const FORCES_FREE_OF_VELOCITY: bool = false;
+
     /// Whether [`one_form_with_derivative`](Self::one_form_with_derivative) gives the one-forms'
     /// derivatives in closed form (`false` by default: dual numbers take them).
     const ONE_FORM_DERIVATIVES: bool = false;

@@ -16,10 +16,16 @@
 //! discrete variational structure (each factor is the flow of a discrete Lagrangian) and raises
 //! the order to 4, 6, 8 or 10.
 //!
+//! Forces that do not depend on the velocity ([`DiracSystem::FORCES_FREE_OF_VELOCITY`]: sources,
+//! actuators, inputs held over the step) join the kicks as the trapezoidal rule's discrete forces
+//! `f⁻ = (h/2) F(q_0, t_0, u)`, `f⁺ = (h/2) F(q_1, t_1, u)`, and each stage books the work
+//! `½ (F(q_a) + F(q_b)) · (q_b − q_a)`: the step stays explicit.
+//!
 //! `M` and `b` are read at the start of a run; the claim that they are constant (and that
-//! `∂²L/∂q∂v = 0`) is checked there at the start and at a second state, and `M` must be
-//! invertible. Positions and momenta are summed with compensation, as in the implicit steps.
-//! Models with constraints or forces are refused: their steps are not explicit here.
+//! `∂²L/∂q∂v = 0`) is checked there at the start and at a second state, the forces' claim at the
+//! start, and `M` must be invertible. Positions and momenta are summed with compensation, as in
+//! the implicit steps. Models with constraints, or with forces that read the velocity (a damper,
+//! a resistor), are refused: their steps are not explicit.
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
@@ -70,8 +76,19 @@ pub struct Verlet<S, const N: usize> {
     kinetic: Option<Kinetic<N>>,
     /// The last gradient taken, with the position it was taken at: the next step's first.
     memo: Option<(SVector<f64, N>, SVector<f64, N>)>,
+    /// The inputs' values, held over each step.
+    inputs: Vec<f64>,
     /// The step [`predict`](StepEquations::predict) took, from the state it took it from.
-    proposal: Option<(State<N>, Result<State<N>, Blowup>)>,
+    proposal: Option<(State<N>, Taken<N>)>,
+}
+
+/// A step taken: the state it reached (or where it left the finite numbers), the gradient of
+/// the potential at its end, and the work of its forces on each coordinate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Taken<const N: usize> {
+    next: Result<State<N>, Blowup>,
+    gradient: SVector<f64, N>,
+    work: SVector<f64, N>,
 }
 
 /// The constant kinetic terms: `v = M⁻¹ (p − b)`.
@@ -92,8 +109,9 @@ struct Blowup {
 
 impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
     /// The explicit step of `system` by `composition` with step `h`. Refused (`Unsupported`)
-    /// for a model that does not declare [`DiracSystem::SEPARABLE`], or that has constraints
-    /// or forces; `InvalidStep` and `NonFinite` as for any stepper.
+    /// for a model that does not declare [`DiracSystem::SEPARABLE`], that has constraints, or
+    /// forces that are not [`FORCES_FREE_OF_VELOCITY`](DiracSystem::FORCES_FREE_OF_VELOCITY);
+    /// `InvalidStep` and `NonFinite` as for any stepper.
     ///
     /// ```
     /// use dirac_runtime::{Composition, DiracError, DiracSystem, Scalar, Verlet};
@@ -128,14 +146,18 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
         if S::ONE_FORMS + S::HOLONOMIC > 0 {
             return refuse("with constraints");
         }
-        if S::FORCES {
-            return refuse("with forces");
+        if S::FORCES && !S::FORCES_FREE_OF_VELOCITY {
+            return refuse(
+                "with forces that may depend on the velocity (DiracSystem::FORCES_FREE_OF_VELOCITY \
+                 is not declared: a force reading dot(x) makes the step implicit)",
+            );
         }
         Ok(Self {
             discrete,
             composition,
             kinetic: None,
             memo: None,
+            inputs: vec![0.0; S::INPUTS],
             proposal: None,
         })
     }
@@ -153,6 +175,41 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
             &SVector::zeros(),
             Seed::POSITION,
         )
+    }
+
+    /// The force `F(q, t, u)` with the held inputs (zero for a model without forces), read at
+    /// zero velocity.
+    fn force(&self, q: &SVector<f64, N>, t: f64) -> SVector<f64, N> {
+        match S::FORCES {
+            true => self
+                .discrete
+                .system()
+                .force(q, &SVector::zeros(), t, &self.inputs),
+            false => SVector::zeros(),
+        }
+    }
+
+    /// Checks at `(q, v)` that the forces do not read the velocity: the same force at `v` and
+    /// at zero velocity.
+    fn check_forces(
+        &self,
+        t: f64,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Result<(), DiracError> {
+        if !S::FORCES {
+            return Ok(());
+        }
+        let at_rest = self.force(q, t);
+        let moving = self.discrete.system().force(q, v, t, &self.inputs);
+        let scale = 1.0 + at_rest.amax();
+        match (at_rest - moving).amax() <= PROBE_TOLERANCE * scale {
+            true => Ok(()),
+            false => Err(DiracError::InconsistentDerivatives(format!(
+                "the model declares FORCES_FREE_OF_VELOCITY, but its force at q = {q:?} is \
+                 {at_rest:?} at rest and {moving:?} at v = {v:?}"
+            ))),
+        }
     }
 
     /// `M⁻¹` and `b` at `(q, v)`, checked against a second state: `∂²L/∂q∂v = 0` at both, the
@@ -225,23 +282,33 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
     }
 
     /// The step from `state` with the run's kinetic terms, starting from the gradient `first`
-    /// at `state.q` where it is known; with the gradient at the step's end.
+    /// at `state.q` where it is known.
     fn take_step(
         &self,
         state: &State<N>,
         kinetic: &Kinetic<N>,
         first: Option<SVector<f64, N>>,
-    ) -> (Result<State<N>, Blowup>, SVector<f64, N>) {
+    ) -> Taken<N> {
         let h = self.discrete.h();
         let mut next = *state;
         let mut g = first.unwrap_or_else(|| self.gradient(&state.q));
+        let mut t = state.t;
+        let mut force = self.force(&state.q, t);
+        let mut work = SVector::zeros();
         for &gamma in self.composition.coefficients() {
             let half = 0.5 * gamma * h;
-            compensated_add(&mut next.p, &mut next.p_carry, &(g * half));
+            compensated_add(&mut next.p, &mut next.p_carry, &((g + force) * half));
             let v = kinetic.inverse_mass * (next.p - kinetic.offset);
-            compensated_add(&mut next.q, &mut next.q_carry, &(v * (gamma * h)));
+            let increment = v * (gamma * h);
+            compensated_add(&mut next.q, &mut next.q_carry, &increment);
+            t += gamma * h;
             g = self.gradient(&next.q);
-            compensated_add(&mut next.p, &mut next.p_carry, &(g * half));
+            if S::FORCES {
+                let end = self.force(&next.q, t);
+                work += ((force + end) * 0.5).component_mul(&increment);
+                force = end;
+            }
+            compensated_add(&mut next.p, &mut next.p_carry, &((g + force) * half));
         }
         let blowup = |x: &SVector<f64, N>, momentum| {
             x.iter()
@@ -252,11 +319,26 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
                     value: x[coordinate],
                 })
         };
-        if let Some(blowup) = blowup(&next.q, false).or_else(|| blowup(&next.p, true)) {
-            return (Err(blowup), g);
+        let next = match blowup(&next.q, false).or_else(|| blowup(&next.p, true)) {
+            Some(blowup) => Err(blowup),
+            None => {
+                next.velocity = kinetic.inverse_mass * (next.p - kinetic.offset);
+                Ok(next)
+            }
+        };
+        Taken {
+            next,
+            gradient: g,
+            work,
         }
-        next.velocity = kinetic.inverse_mass * (next.p - kinetic.offset);
-        (Ok(next), g)
+    }
+
+    /// The step from `state`: the one [`predict`](StepEquations::predict) took, or taken again.
+    fn taken(&self, state: &State<N>) -> Result<Taken<N>, DiracError> {
+        match &self.proposal {
+            Some((from, taken)) if from == state => Ok(*taken),
+            _ => Ok(self.take_step(state, &self.kinetic_at(state)?, None)),
+        }
     }
 
     /// The run's kinetic terms, or those at `state` before a run.
@@ -278,7 +360,7 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
 
     const NAME: &'static str = "the explicit variational step";
     const VELOCITY: &'static str = "the Legendre transform (velocity from momentum)";
-    const FORCED: bool = false;
+    const FORCED: bool = S::FORCES;
 
     fn h(&self) -> f64 {
         self.discrete.h()
@@ -314,6 +396,7 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
                 value,
             });
         }
+        self.check_forces(state.t, &state.q, &state.velocity)?;
         self.kinetic(&state.q, &state.velocity).map(|_| ())
     }
 
@@ -335,11 +418,11 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
             return;
         };
         let first = self.memo.filter(|(q, _)| *q == state.q).map(|(_, g)| g);
-        let (step, last) = self.take_step(state, &kinetic, first);
-        if let Ok(next) = &step {
-            self.memo = Some((next.q, last));
+        let taken = self.take_step(state, &kinetic, first);
+        if let Ok(next) = &taken.next {
+            self.memo = Some((next.q, taken.gradient));
         }
-        self.proposal = Some((*state, step));
+        self.proposal = Some((*state, taken));
     }
 
     fn assemble(
@@ -358,25 +441,20 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
         _x: &DVector<f64>,
         step: u64,
     ) -> Result<State<N>, DiracError> {
-        let taken = match &self.proposal {
-            Some((from, taken)) if from == state => *taken,
-            _ => {
-                let kinetic = self.kinetic_at(state)?;
-                self.take_step(state, &kinetic, None).0
-            }
-        };
-        taken.map_err(|blowup| DiracError::NonFinite {
-            what: format!(
-                "the {} of {} after step {step}",
-                if blowup.momentum {
-                    "momentum"
-                } else {
-                    "position"
-                },
-                self.coordinate_name(blowup.coordinate)
-            ),
-            value: blowup.value,
-        })
+        self.taken(state)?
+            .next
+            .map_err(|blowup| DiracError::NonFinite {
+                what: format!(
+                    "the {} of {} after step {step}",
+                    if blowup.momentum {
+                        "momentum"
+                    } else {
+                        "position"
+                    },
+                    self.coordinate_name(blowup.coordinate)
+                ),
+                value: blowup.value,
+            })
     }
 
     fn violation(&self, _from: &State<N>, _to: &State<N>, _x: &DVector<f64>) -> f64 {
@@ -473,9 +551,25 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
         })
     }
 
-    /// No forces and no constraints: no work.
-    fn work(&self, _state: &State<N>, _x: &DVector<f64>) -> Option<StepWork<N>> {
-        Some(StepWork::zero())
+    /// The forces' work, stage by stage `½ (F(q_a) + F(q_b)) · (q_b − q_a)`; no constraints.
+    fn work(&self, state: &State<N>, _x: &DVector<f64>) -> Option<StepWork<N>> {
+        let taken = self.taken(state).ok()?;
+        Some(StepWork {
+            forces: taken.work,
+            constraints: Some(SVector::zeros()),
+        })
+    }
+
+    fn inputs(&self) -> &[f64] {
+        &self.inputs
+    }
+
+    fn inputs_mut(&mut self) -> &mut [f64] {
+        &mut self.inputs
+    }
+
+    fn input_name(&self, i: usize) -> String {
+        self.discrete.system().input_name(i)
     }
 
     fn energy(&self, q: &SVector<f64, N>, _p: &SVector<f64, N>, v: &SVector<f64, N>) -> f64 {

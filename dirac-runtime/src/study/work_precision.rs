@@ -135,7 +135,7 @@ pub struct WorkPrecision<const N: usize> {
 impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
     /// A study of `system` to time `horizon`, each stepper started by `start`; by default
     /// `midpoint`, `galerkin(2)` and `galerkin(3)`, and for a separable model without
-    /// constraints or forces ([`DiracSystem::SEPARABLE`]) the explicit compositions of orders 2,
+    /// constraints or forces that read the velocity ([`DiracSystem::SEPARABLE`]) the explicit compositions of orders 2,
     /// 4, 6 and 8 ([`Composition::of_order`]), at `h = horizon/16, /32, /64, /128`, three timing
     /// repetitions, and a converged reference. An explicit step starts from the state `start`
     /// gives a `midpoint` stepper.
@@ -148,7 +148,9 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
             .iter()
             .filter_map(|&s| Quadrature::galerkin(s).ok())
             .collect();
-        let explicit = S::SEPARABLE && S::ONE_FORMS + S::HOLONOMIC == 0 && !S::FORCES;
+        let explicit = S::SEPARABLE
+            && S::ONE_FORMS + S::HOLONOMIC == 0
+            && (!S::FORCES || S::FORCES_FREE_OF_VELOCITY);
         let compositions = match explicit {
             true => [2, 4, 6, 8]
                 .iter()
