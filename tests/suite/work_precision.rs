@@ -130,6 +130,51 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
     assert!(text.starts_with("quadrature,h,steps,error,energy_error,"));
 }
 
+/// `½ ẋ² − ½ x²` pushed by an input `u`.
+#[dirac_system(
+    coordinates(x),
+    lagrangian = 0.5 * dot(x).powi(2) - 0.5 * x * x,
+    forces(u * dx),
+    inputs(u)
+)]
+#[derive(Debug, Clone, Copy)]
+struct Pushed;
+
+/// The explicit runs hold the inputs the start function sets, as the implicit runs do:
+/// Störmer–Verlet and the trapezoidal rule are one map, so their errors agree.
+#[test]
+fn explicit_runs_hold_the_inputs_the_start_sets() {
+    let horizon = 2.0;
+    // x = u + (x₀ − u) cos t from rest.
+    let (x0, u) = (1.0, 0.5);
+    let x = u + (x0 - u) * horizon.cos();
+    let v = -(x0 - u) * horizon.sin();
+    let exact = Sample {
+        t: horizon,
+        q: vector![x],
+        v: vector![v],
+        p: vector![v],
+    };
+    let study = Study::new(Pushed, horizon, |s| {
+        s.set_input("u", u)?;
+        s.start_from_velocity(vector![x0], vector![0.0])
+    })
+    .quadratures([Quadrature::trapezoid()])
+    .compositions([Composition::verlet()])
+    .steps([0.1])
+    .repetitions(1)
+    .reference(exact)
+    .run()
+    .unwrap();
+    let [implicit, explicit] = [0, 1].map(|i| &study.measurements[i]);
+    assert_eq!(explicit.quadrature, "Störmer–Verlet");
+    assert!(
+        (implicit.error - explicit.error).abs() < 1e-12,
+        "{implicit:?} {explicit:?}"
+    );
+    assert!(explicit.error < 1e-2);
+}
+
 /// Without a reference the study converges one, and it agrees with the pendulum's known q(5),
 /// p(5) (14 digits) to its own error estimate.
 #[test]

@@ -185,6 +185,28 @@ impl Graph {
         self.value(id) == Some(x)
     }
 
+    /// Whether `abs` or `signum` is applied to something that depends on a velocity (a kink
+    /// the closed-form derivatives step over).
+    fn kinks_in_velocity(&self) -> bool {
+        // Operands come before the nodes that use them: one pass in order.
+        let mut velocity = vec![false; self.nodes.len()];
+        for (id, node) in self.nodes.iter().enumerate() {
+            velocity[id] = match node {
+                Node::Number(_) | Node::Constant(_) => false,
+                Node::Variable(i) => *i >= self.n,
+                Node::Call(Function::Abs | Function::Signum, a) if velocity[*a] => return true,
+                Node::Neg(a) | Node::Call(_, a) | Node::Powi(a, _) => velocity[*a],
+                Node::Add(a, b)
+                | Node::Sub(a, b)
+                | Node::Mul(a, b)
+                | Node::Div(a, b)
+                | Node::Powf(a, b)
+                | Node::Atan2(a, b) => velocity[*a] || velocity[*b],
+            };
+        }
+        false
+    }
+
     /// Whether every node is finite wherever the state is (short of overflow): sums, products,
     /// integer powers, division by what the state does not change and functions defined on
     /// every real; no division by the state, root, logarithm or inverse with a bounded domain.
@@ -964,11 +986,15 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
             _ => (zeros[2][i - n][j - n], zeros[2][j - n][i - n]) = (zero, zero),
         }
     }
-    let separable = second.iter().all(|&(i, j, id)| match (i < n, j < n) {
-        (true, false) => graph.is(id, 0.0),
-        (false, false) => !graph.state[id],
-        _ => true,
-    });
+    // `abs` and `signum` of a velocity have derivatives that vanish almost everywhere but jump
+    // (`c |v|` is linear in v on each side of 0 with a momentum offset that changes sign): not
+    // separable, whatever the graph's second derivatives say.
+    let separable = !graph.kinks_in_velocity()
+        && second.iter().all(|&(i, j, id)| match (i < n, j < n) {
+            (true, false) => graph.is(id, 0.0),
+            (false, false) => !graph.state[id],
+            _ => true,
+        });
     let zero = quote!(__dirac::nalgebra::SMatrix::<f64, #n, #n>::zeros());
     let hessian = quote! {
         #statements

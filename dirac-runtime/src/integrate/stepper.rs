@@ -213,7 +213,8 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N, Verlet<S, N>> {
     /// An explicit stepper for a separable model ([`DiracSystem::SEPARABLE`]): Störmer–Verlet
     /// or one of its symmetric compositions ([`Verlet`]), one gradient of the potential per
     /// stage and no Newton iteration. Refused (`Unsupported`) for a model not known to be
-    /// separable, or with constraints or forces; a singular mass matrix is refused at the start.
+    /// separable, with constraints, or with forces that may read the velocity; a singular mass
+    /// matrix is refused at the start.
     ///
     /// ```
     /// use dirac_runtime::{Composition, DiracSystem, Scalar, Stepper};
@@ -1146,13 +1147,13 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         self.begin(&state)?;
         // A rule that does not determine the model's motion (the first step's Jacobian is
         // singular) is refused here, before the first step, naming the undetermined unknowns.
-        let equations = &mut self.equations;
-        equations.predict(&state, None, &mut self.unknowns);
         if self.unknowns.is_empty() {
-            // An explicit step: nothing to solve.
+            // An explicit step: nothing to solve, no rule to find singular.
             self.reset(state);
             return Ok(());
         }
+        let equations = &mut self.equations;
+        equations.predict(&state, None, &mut self.unknowns);
         // The start's own Jacobian decides, not one reused from another run.
         self.newton.forget_jacobian();
         let trial = self.newton.solve(&mut self.unknowns, |x, r, j| {

@@ -64,6 +64,8 @@ pub struct Study<'a, S: DiracSystem<N>, const N: usize> {
     start: Start<'a, S, N>,
     quadratures: Vec<Quadrature>,
     compositions: Vec<Composition>,
+    /// Whether the compositions are the default ones (not asked for).
+    compositions_by_default: bool,
     steps: Vec<f64>,
     repetitions: usize,
     /// The given reference and its error estimate.
@@ -137,8 +139,11 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
     /// `midpoint`, `galerkin(2)` and `galerkin(3)`, and for a separable model without
     /// constraints or forces that read the velocity ([`DiracSystem::SEPARABLE`]) the explicit compositions of orders 2,
     /// 4, 6 and 8 ([`Composition::of_order`]), at `h = horizon/16, /32, /64, /128`, three timing
-    /// repetitions, and a converged reference. An explicit step starts from the state `start`
-    /// gives a `midpoint` stepper.
+    /// repetitions, and a converged reference. An explicit step starts from the state and the
+    /// inputs `start` gives a `midpoint` stepper; the default compositions are left out where
+    /// the explicit step refuses the model's start (a singular mass matrix). Errors at a horizon
+    /// inside a step come from dense output, of order 4 for the explicit steps: give steps that
+    /// divide the horizon.
     pub fn new(
         system: S,
         horizon: f64,
@@ -164,6 +169,7 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
             start: Box::new(start),
             quadratures,
             compositions,
+            compositions_by_default: true,
             steps: [16.0, 32.0, 64.0, 128.0].map(|n| horizon / n).to_vec(),
             repetitions: 3,
             reference: None,
@@ -205,6 +211,7 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
     pub fn compositions(self, compositions: impl IntoIterator<Item = Composition>) -> Self {
         Self {
             compositions: compositions.into_iter().collect(),
+            compositions_by_default: false,
             ..self
         }
     }
@@ -290,7 +297,17 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
                 record(quadrature.name(), h, self.measure(&stepper, h, &reference));
             }
         }
-        for composition in &self.compositions {
+        // The default compositions are left out, without failures, for a separable model the
+        // explicit step refuses at its start (a singular mass matrix: a circuit's capacitors).
+        let refused = self.compositions_by_default
+            && self.compositions.first().is_some_and(|c| {
+                matches!(
+                    self.explicit(c, self.steps[0]),
+                    Err(DiracError::Unsupported(_))
+                )
+            });
+        let compositions: &[Composition] = if refused { &[] } else { &self.compositions };
+        for composition in compositions {
             for &h in &self.steps {
                 let stepper = || self.explicit(composition, h);
                 let name = composition.name().to_string();
@@ -367,6 +384,8 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
         let mut stepper = Stepper::explicit(self.system.clone(), composition.clone(), h)?;
         let start = self.stepper(&Quadrature::midpoint(), h)?;
         let state = start.state().ok_or(DiracError::NotStarted)?;
+        // The inputs `start` set, held as the implicit runs hold them.
+        stepper.set_inputs(start.inputs())?;
         stepper.start_from_state(*state)?;
         Ok(stepper)
     }
