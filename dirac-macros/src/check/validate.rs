@@ -335,7 +335,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         .forces
         .iter()
         .flatten()
-        .all(|force| !reads_velocity(force.to_token_stream()));
+        .all(|force| !expression_reads_velocity(force));
     let one_forms = e.constraints.is_some() || e.holonomic.is_some() || e.forces.is_some();
     check_differential_names(
         coordinates.as_deref().unwrap_or_default(),
@@ -890,6 +890,29 @@ fn parameters(item: &syn::ItemStruct, errors: &mut Errors) -> Vec<Parameter> {
             }
         })
         .collect()
+}
+
+/// Whether `expr` reads a velocity: a call `dot(x)` of one argument or `omega(R)`, a method
+/// `.dot(..)`, or one in an expression of a kind the walk does not look into (read on its
+/// tokens). Walked with an explicit stack, so that a force of ten thousand terms costs no depth.
+fn expression_reads_velocity(expr: &Expr) -> bool {
+    expression::subexpressions(expr).any(|e| match e {
+        Expr::Call(call) => match &*call.func {
+            Expr::Path(path) => {
+                path.path.is_ident("omega") || (path.path.is_ident("dot") && call.args.len() == 1)
+            }
+            other => reads_velocity(other.to_token_stream()),
+        },
+        Expr::MethodCall(method) => method.method == "dot",
+        Expr::Lit(_)
+        | Expr::Path(_)
+        | Expr::Paren(_)
+        | Expr::Group(_)
+        | Expr::Unary(_)
+        | Expr::Binary(_)
+        | Expr::Index(_) => false,
+        other => reads_velocity(other.to_token_stream()),
+    })
 }
 
 /// Whether `tokens` read a velocity: a call `dot(x)` of one argument (`dot(u, v)` is the scalar
