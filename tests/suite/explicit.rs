@@ -8,6 +8,16 @@ use crate::support::assert_order;
 use dirac::prelude::*;
 use scenes::{cart_pole, double_pendulum, kepler, knife_edge, oscillator, pendulum};
 
+/// What the attribute declared: whether `S` is separable.
+fn separable<S: DiracSystem<N>, const N: usize>() -> bool {
+    S::SEPARABLE
+}
+
+/// What the attribute declared: whether the forces of `S` do not read the velocity.
+fn forces_free_of_velocity<S: DiracSystem<N>, const N: usize>() -> bool {
+    S::FORCES_FREE_OF_VELOCITY
+}
+
 /// Kepler's orbit for μ = 1, e = 0.5 from perihelion (the scene's start): `x = cos E − e`,
 /// `y = √(1 − e²) sin E` with `E − e sin E = t` (a = 1, period 2π).
 fn kepler_exact(t: f64) -> SVector<f64, 2> {
@@ -34,14 +44,14 @@ fn kepler_error(composition: &Composition, n: usize) -> f64 {
 #[test]
 fn the_attribute_declares_the_separable_lagrangians() {
     // ½ m l² θ̇² + m g l cos θ, ½ |v|² + μ/|q|, ½ m ẋ² − ½ k x²: constant mass matrices.
-    assert!(<pendulum::Pendulum as DiracSystem<1>>::SEPARABLE);
-    assert!(<kepler::Kepler as DiracSystem<2>>::SEPARABLE);
-    assert!(<oscillator::Oscillator as DiracSystem<1>>::SEPARABLE);
+    assert!(separable::<pendulum::Pendulum, 1>());
+    assert!(separable::<kepler::Kepler, 2>());
+    assert!(separable::<oscillator::Oscillator, 1>());
     // The knife edge's Lagrangian is separable too (its constraint is refused elsewhere).
-    assert!(<knife_edge::KnifeEdge as DiracSystem<3>>::SEPARABLE);
+    assert!(separable::<knife_edge::KnifeEdge, 3>());
     // cos(θ₁ − θ₂) θ̇₁ θ̇₂ and the cart-pole's cos θ ẋ θ̇: mass matrices that move.
-    assert!(!<double_pendulum::DoublePendulum as DiracSystem<2>>::SEPARABLE);
-    assert!(!<cart_pole::CartPole as DiracSystem<2>>::SEPARABLE);
+    assert!(!separable::<double_pendulum::DoublePendulum, 2>());
+    assert!(!separable::<cart_pole::CartPole, 2>());
 }
 
 /// `½ m (ẋ² + ẏ²) + B (x ẏ − y ẋ)/2 − k (x² + y²)/2`: a charge in a uniform magnetic field.
@@ -74,9 +84,9 @@ struct Shifted {
 
 #[test]
 fn a_velocity_coupled_to_the_position_is_not_separable_a_constant_offset_is() {
-    assert!(!<Charge as DiracSystem<2>>::SEPARABLE);
+    assert!(!separable::<Charge, 2>());
     // c |ẋ|: its second derivatives vanish away from ẋ = 0, but its momentum offset jumps there.
-    assert!(!<Kinked as DiracSystem<1>>::SEPARABLE);
+    assert!(!separable::<Kinked, 1>());
     let charge = Charge {
         m: 1.0,
         b: 0.5,
@@ -87,7 +97,7 @@ fn a_velocity_coupled_to_the_position_is_not_separable_a_constant_offset_is() {
         Err(DiracError::Unsupported(_))
     ));
     // The offset is read at the start: the step equals the implicit trapezoidal one.
-    assert!(<Shifted as DiracSystem<1>>::SEPARABLE);
+    assert!(separable::<Shifted, 1>());
     let shifted = Shifted { c: 0.7 };
     let h = 0.05;
     let mut explicit = Stepper::explicit(shifted, Composition::verlet(), h).unwrap();
@@ -267,7 +277,7 @@ fn models_the_explicit_step_does_not_cover_are_refused() {
         Stepper::explicit(knife_edge::SCENE, Composition::verlet(), 0.01).map(|_| ())
     ));
     // A force that reads the velocity (a damper).
-    assert!(!<Damped as DiracSystem<1>>::FORCES_FREE_OF_VELOCITY);
+    assert!(!forces_free_of_velocity::<Damped, 1>());
     assert!(unsupported(
         Stepper::explicit(Damped, Composition::verlet(), 0.01).map(|_| ())
     ));
@@ -320,7 +330,7 @@ struct Duffing {
 
 #[test]
 fn forces_of_position_time_and_inputs_keep_the_step_explicit() {
-    assert!(<Duffing as DiracSystem<2>>::FORCES_FREE_OF_VELOCITY);
+    assert!(forces_free_of_velocity::<Duffing, 2>());
     let duffing = Duffing { k: 0.3 };
     let h = 0.02;
     let mut explicit = Stepper::explicit(duffing, Composition::verlet(), h).unwrap();
