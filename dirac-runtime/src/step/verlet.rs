@@ -41,6 +41,7 @@ use crate::space::configuration_space::compensated_add;
 use crate::space::manifold::Vectors;
 use crate::step::composition::Composition;
 use crate::step::dense_output::Sample;
+use crate::step::euler_lagrange::check_finite;
 use crate::step::step_equations::{StepEquations, StepWork};
 
 /// Relative size of a disagreement between the two probes of the kinetic energy that refuses a
@@ -516,21 +517,11 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
         v: &SVector<f64, N>,
     ) -> Result<SVector<f64, N>, DiracError> {
         let system = self.discrete.system();
+        check_finite(system, "initial position", q)?;
+        check_finite(system, "initial velocity", v)?;
         let p = legendre::momentum(system, q, v);
-        let first = [
-            ("initial position", q),
-            ("initial velocity", v),
-            ("initial momentum", &p),
-        ]
-        .into_iter()
-        .find_map(|(what, x)| {
-            let i = x.iter().position(|v| !v.is_finite())?;
-            Some(DiracError::NonFinite {
-                what: format!("{what} of {}", system.coordinate_name(i)),
-                value: x[i],
-            })
-        });
-        first.map_or(Ok(p), Err)
+        check_finite(system, "initial momentum", &p)?;
+        Ok(p)
     }
 
     /// The cubic Hermite interpolant of the positions through the step's ends with their
