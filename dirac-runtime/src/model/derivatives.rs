@@ -622,6 +622,17 @@ pub(crate) fn degenerate_at<S: DiracSystem<N>, const N: usize>(
         .collect()
 }
 
+/// How far [`moved`] takes a position and a velocity to a second probe of a property claimed
+/// everywhere.
+pub(crate) const POSITION_SHIFT: f64 = 0.0137;
+pub(crate) const VELOCITY_SHIFT: f64 = 0.291;
+
+/// `x` moved by uneven amounts, `shift (1 + i/10)(1 + |x_i|)` in coordinate `i`: a second
+/// probe of a property a term could hold at one state by accident (`ẏ⁴` vanishes at `ẏ = 0`).
+pub(crate) fn moved<const N: usize>(x: &SVector<f64, N>, shift: f64) -> SVector<f64, N> {
+    SVector::from_fn(|i, _| x[i] + shift * (1.0 + 0.1 * i as f64) * (1.0 + x[i].abs()))
+}
+
 /// Coordinates with no kinetic term: rows of `∂²L/∂v²` that vanish at `(q, v)` and at a second
 /// state near it (none where neither can be evaluated).
 pub(crate) fn degenerate<S: DiracSystem<N>, const N: usize>(
@@ -631,12 +642,10 @@ pub(crate) fn degenerate<S: DiracSystem<N>, const N: usize>(
 ) -> Vec<usize> {
     // Probed at (q, v) and at a point moved by uneven amounts: a kinetic term can vanish at one
     // state (ẏ⁴ at ẏ = 0). A probe outside the Lagrangian's domain (not finite) is skipped.
-    let moved = |x: &SVector<f64, N>, shift: f64| {
-        SVector::<f64, N>::from_fn(|i, _| {
-            x[i] + shift * (1.0 + 0.1 * i as f64) * (1.0 + x[i].abs())
-        })
-    };
-    let probes = [(*q, *v), (moved(q, 0.0137), moved(v, 0.291))];
+    let probes = [
+        (*q, *v),
+        (moved(q, POSITION_SHIFT), moved(v, VELOCITY_SHIFT)),
+    ];
     let hessians: Vec<_> = probes
         .iter()
         .map(|(q, v)| seeded_by_duals(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed)

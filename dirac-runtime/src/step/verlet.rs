@@ -83,11 +83,11 @@ pub struct Verlet<S, const N: usize> {
     proposal: Option<(State<N>, Taken<N>)>,
 }
 
-/// A step taken: the state it reached (or where it left the finite numbers), the gradient of
-/// the potential at its end, and the work of its forces on each coordinate.
+/// A step taken: the state it reached (not yet checked to be finite), the gradient of the
+/// potential at its end, and the work of its forces on each coordinate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Taken<const N: usize> {
-    next: Result<State<N>, Blowup>,
+    next: State<N>,
     gradient: SVector<f64, N>,
     work: SVector<f64, N>,
 }
@@ -98,14 +98,6 @@ struct Kinetic<const N: usize> {
     mass: SMatrix<f64, N, N>,
     inverse_mass: SMatrix<f64, N, N>,
     offset: SVector<f64, N>,
-}
-
-/// A step whose momentum or position left the finite numbers: which, and where.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Blowup {
-    momentum: bool,
-    coordinate: usize,
-    value: f64,
 }
 
 impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
@@ -202,11 +194,8 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
             return Ok(());
         }
         let at_rest = self.force(q, t);
-        let moved = SVector::<f64, N>::from_fn(|i, _| {
-            v[i] + 0.291 * (1.0 + 0.1 * i as f64) * (1.0 + v[i].abs())
-        });
         let scale = 1.0 + at_rest.amax();
-        for velocity in [*v, moved] {
+        for velocity in [*v, derivatives::moved(v, derivatives::VELOCITY_SHIFT)] {
             let moving = self.discrete.system().force(q, &velocity, t, &self.inputs);
             if (at_rest - moving).amax() > PROBE_TOLERANCE * scale {
                 return Err(DiracError::InconsistentDerivatives(format!(
@@ -239,12 +228,8 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
             });
         }
         // A second state, moved by uneven amounts (a term may vanish at one state).
-        let moved = |x: &SVector<f64, N>, shift: f64| {
-            SVector::<f64, N>::from_fn(|i, _| {
-                x[i] + shift * (1.0 + 0.1 * i as f64) * (1.0 + x[i].abs())
-            })
-        };
-        let (q2, v2) = (moved(q, 0.0137), moved(v, 0.291));
+        let q2 = derivatives::moved(q, derivatives::POSITION_SHIFT);
+        let v2 = derivatives::moved(v, derivatives::VELOCITY_SHIFT);
         let (mass2, offset2, mixed2) = at(&q2, &v2);
         let scale = 1.0 + mass.amax() + offset.amax();
         let differs = |a: f64, b: f64| (a - b).abs() > PROBE_TOLERANCE * scale;
@@ -316,22 +301,7 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
             }
             compensated_add(&mut next.p, &mut next.p_carry, &((g + force) * half));
         }
-        let blowup = |x: &SVector<f64, N>, momentum| {
-            x.iter()
-                .position(|v| !v.is_finite())
-                .map(|coordinate| Blowup {
-                    momentum,
-                    coordinate,
-                    value: x[coordinate],
-                })
-        };
-        let next = match blowup(&next.q, false).or_else(|| blowup(&next.p, true)) {
-            Some(blowup) => Err(blowup),
-            None => {
-                next.velocity = kinetic.inverse_mass * (next.p - kinetic.offset);
-                Ok(next)
-            }
-        };
+        next.velocity = kinetic.inverse_mass * (next.p - kinetic.offset);
         Taken {
             next,
             gradient: g,
@@ -425,9 +395,7 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
         };
         let first = self.memo.filter(|(q, _)| *q == state.q).map(|(_, g)| g);
         let taken = self.take_step(state, &kinetic, first);
-        if let Ok(next) = &taken.next {
-            self.memo = Some((next.q, taken.gradient));
-        }
+        self.memo = Some((taken.next.q, taken.gradient));
         self.proposal = Some((*state, taken));
     }
 
@@ -447,20 +415,14 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
         _x: &DVector<f64>,
         step: u64,
     ) -> Result<State<N>, DiracError> {
-        self.taken(state)?
-            .next
-            .map_err(|blowup| DiracError::NonFinite {
-                what: format!(
-                    "the {} of {} after step {step}",
-                    if blowup.momentum {
-                        "momentum"
-                    } else {
-                        "position"
-                    },
-                    self.coordinate_name(blowup.coordinate)
-                ),
-                value: blowup.value,
-            })
+        let next = self.taken(state)?.next;
+        for (what, x) in [("position", &next.q), ("momentum", &next.p)] {
+            // The message is written only for a step that left the finite numbers.
+            if !x.iter().all(|v| v.is_finite()) {
+                check_finite(self.system(), &format!("the {what} after step {step}"), x)?;
+            }
+        }
+        Ok(next)
     }
 
     fn violation(&self, _from: &State<N>, _to: &State<N>, _x: &DVector<f64>) -> f64 {
