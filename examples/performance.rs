@@ -270,7 +270,7 @@ fn write(groups: &BTreeMap<String, Vec<Result>>, study: Option<String>) -> Strin
         let _ = writeln!(
             out,
             "## Against other integrators\n\nThe work–precision study \
-             (`cargo run --release --example work_precision`): the cost of each integrator to \
+             (`cargo run --release --example work_precision --features scenes/bdf`): the cost of each integrator to \
              reach each target, as the study wrote it.\n\n{}",
             study.trim()
         );

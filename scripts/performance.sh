@@ -16,7 +16,8 @@ criterion="${CARGO_TARGET_DIR:-target}/criterion"
 rm -rf "$criterion"
 cargo bench --bench step
 if [ "$study" = yes ]; then
-    cargo run --release --example work_precision
+    # With the BDF peer, which the tests' build leaves out.
+    cargo run --release --example work_precision --features scenes/bdf
     cargo run --example performance -- "$criterion" docs/performance.md \
         output/work_precision/summary.md
 else

@@ -1,10 +1,30 @@
 //! Compile-time behaviour of `#[dirac_system]`: every malformed input is a compile error pointing
-//! at the user's tokens (tests/ui/fail, one diagnostic per file), and valid inputs compile and run
-//! (tests/ui/pass).
+//! at the user's tokens (tests/ui/fail, one diagnostic per file), valid inputs compile and run
+//! (tests/ui/pass), and so does a model with a 10 000-term Lagrangian (tests/ui/long_lagrangian.rs).
+//! One set of cases, so that trybuild builds its dependencies once and the cases side by side.
+
+use std::path::Path;
+
+#[path = "ui/long_lagrangian.rs"]
+mod long_lagrangian;
 
 #[test]
 fn ui() {
+    let directory = Path::new(env!("CARGO_TARGET_TMPDIR")).join("long_lagrangian");
+    let long = long_lagrangian::write_program(&directory, 10_000);
     let cases = trybuild::TestCases::new();
     cases.compile_fail("tests/ui/fail/*.rs");
     cases.pass("tests/ui/pass/*.rs");
+    cases.pass(long);
+}
+
+/// For `scripts/compile_times.sh`: writes the programs for 100, 1 000 and 10 000 terms into
+/// `$DIRAC_PROGRAMS`.
+#[test]
+#[ignore = "run by scripts/compile_times.sh"]
+fn write_programs() {
+    let directory = std::env::var("DIRAC_PROGRAMS").expect("DIRAC_PROGRAMS names a directory");
+    for terms in [100, 1_000, 10_000] {
+        long_lagrangian::write_program(Path::new(&directory), terms);
+    }
 }

@@ -5,14 +5,15 @@
 //! `rtol = atol = 1e-13` (its error estimated by the run at 1e-12); dirac's `midpoint`, `galerkin(2)` and `galerkin(3)` at the scene's
 //! steps, measured by `Study`; Dop853 and Dopri5 (ode_solvers) at tolerances 1e-4 … 1e-12 on the
 //! hand-derived first-order form; and BDF (diffsol) on the index-1 DAE of the circuit and of the
-//! knife edge. Every run's error at the horizon, largest energy error over every step and wall
+//! knife edge, in a build with `--features scenes/bdf` (as `scripts/performance.sh` runs it). Every run's error at the horizon, largest energy error over every step and wall
 //! time per unit of simulated time go to `output/work_precision/study.csv`, with two PNGs per
 //! scene and horizon (error and energy error against cost); the summary prints, for each error
 //! and energy error target, the cheapest run of dirac and of the peers and their cost ratio.
 //! Constraint violations are printed but not compared: dirac records its discrete constraint
 //! `A(q_c)(q_{k+1} − q_k)`, the peers' forms the velocity constraint at each state.
 //!
-//! `cargo run --release --example work_precision` (16 minutes here; `-- 10` runs T = 10 only)
+//! `cargo run --release --example work_precision --features scenes/bdf` (16 minutes here; `-- 10`
+//! runs T = 10 only)
 
 use std::fmt::Write as _;
 
@@ -245,6 +246,9 @@ fn main() -> Result<(), String> {
         None => vec![10.0, 1e4],
     };
     std::fs::create_dir_all("output/work_precision").map_err(|e| e.to_string())?;
+    if !scenes::peers::Peer::Bdf.is_built() {
+        println!("BDF is left out: it is built with `--features scenes/bdf`");
+    }
     let mut runner = Runner {
         horizons,
         rows: Vec::new(),

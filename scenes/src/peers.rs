@@ -10,13 +10,16 @@
 //! Peers: `Dop853` and `Dopri5` (explicit Runge–Kutta of orders 8 and 5, ode_solvers) and `Bdf`
 //! (variable-order BDF with a dense LU, diffsol; its Jacobian-vector products by dual numbers),
 //! each with `rtol = atol = tolerance`.
+//!
+//! BDF is built only with this crate's `bdf` feature (`--features scenes/bdf` from the
+//! workspace root): diffsol's linear algebra (faer) would otherwise be a third of the tests'
+//! build. Without it, [`Peer::Bdf`] is refused with an `Err` that says so, and
+//! [`Peer::is_built`] tells the study to leave it out.
 
 use std::cell::RefCell;
 use std::time::Instant;
 
-use diffsol::{NalgebraLU, NalgebraMat, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
 use dirac::Sample;
-use dirac::num_dual::Dual64;
 use ode_solvers::{Dop853, Dopri5, OutputType, System};
 
 use super::first_order::FirstOrder;
@@ -36,6 +39,11 @@ impl Peer {
             Peer::Dopri5 => "Dopri5",
             Peer::Bdf => "BDF",
         }
+    }
+
+    /// Whether this build has the peer: BDF needs the `bdf` feature.
+    pub fn is_built(self) -> bool {
+        self != Peer::Bdf || cfg!(feature = "bdf")
     }
 }
 
@@ -198,15 +206,32 @@ pub fn dop853_end<S: System<f64, ode_solvers::SVector<f64, Y>>, const Y: usize>(
         .ok_or_else(|| "no output".into())
 }
 
+/// Without the `bdf` feature: a refusal that names it.
+#[cfg(not(feature = "bdf"))]
+fn bdf<F: FirstOrder<Y, N>, const Y: usize, const N: usize>(
+    _ode: &F,
+    _horizon: f64,
+    _tolerance: f64,
+    _monitor: Option<&RefCell<Monitor>>,
+) -> Result<([f64; Y], u64), String> {
+    Err(
+        "BDF is not built: enable the `bdf` feature of dirac-scenes (`--features scenes/bdf`)"
+            .into(),
+    )
+}
+
 /// diffsol's BDF on `ode`, its algebraic rows given a zero row of the mass matrix. It stops at
 /// the stop time to within diffsol's 100 ε (|t| + |h|), and that state is taken as the end.
 /// The index-1 forms hold a constraint only in its differentiated form, so it may drift.
+#[cfg(feature = "bdf")]
 fn bdf<F: FirstOrder<Y, N>, const Y: usize, const N: usize>(
     ode: &F,
     horizon: f64,
     tolerance: f64,
     monitor: Option<&RefCell<Monitor>>,
 ) -> Result<([f64; Y], u64), String> {
+    use diffsol::{NalgebraLU, NalgebraMat, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
+    use dirac::num_dual::Dual64;
     let failed = |e: diffsol::error::DiffsolError| format!("BDF: {e}");
     let initial = ode.initial();
     let problem = OdeBuilder::<NalgebraMat<f64>>::new()

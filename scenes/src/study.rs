@@ -249,7 +249,8 @@ where
             runs.push((tolerance, run));
         }
     }
-    if let Some(dae) = &scene.dae {
+    // BDF only where this build has it (the `bdf` feature).
+    if let Some(dae) = scene.dae.as_ref().filter(|_| Peer::Bdf.is_built()) {
         // BDF is of order ≤ 5: 1e-12 costs it 10⁶ steps per unit of time.
         for &tolerance in tolerances.iter().filter(|&&t| t >= 1e-10) {
             let run = peers::measure(Peer::Bdf, dae, horizon, tolerance, &reference, repetitions);

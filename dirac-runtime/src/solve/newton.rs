@@ -279,6 +279,10 @@ pub struct Newton<J: Jacobian = Dense> {
     iterate: DVector<f64>,
 }
 
+/// The residual's closure as the iteration sees it: behind a reference, so that the iteration is
+/// compiled once per Jacobian shape.
+type Residual<'a, M> = dyn FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut M>) -> f64 + 'a;
+
 /// A factorised Jacobian set aside (see [`Newton::solve`]).
 #[derive(Debug, Clone)]
 struct Kept<J> {
@@ -383,15 +387,12 @@ impl<J: Jacobian> Newton<J> {
     /// factorised in place): the residual's norm and the tolerance it is held to there. Fails
     /// when an entry of the residual or the Jacobian is not finite, when the Jacobian is singular,
     /// or when the closure resized a buffer (the buffers are then restored for the next solve).
-    fn evaluate<F>(
+    fn evaluate(
         &mut self,
         x: &DVector<f64>,
-        evaluate: &mut F,
+        evaluate: &mut Residual<'_, J::Matrix>,
         with_jacobian: bool,
-    ) -> Result<Evaluation, NewtonFailure>
-    where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
-    {
+    ) -> Result<Evaluation, NewtonFailure> {
         let n = x.len();
         let scale = if with_jacobian {
             if std::mem::take(&mut self.kept.pending) {
@@ -465,15 +466,12 @@ impl<J: Jacobian> Newton<J> {
     /// finite and its norm decreases sufficiently (or is within tolerance, where round-off admits
     /// no decrease). Leaves the accepted point in `trial`; `None` when the step became negligible.
     /// The trial points' Jacobians are evaluated: the accepted one is the next iteration's.
-    fn backtrack<F>(
+    fn backtrack(
         &mut self,
         x: &DVector<f64>,
         at_x: Evaluation,
-        evaluate: &mut F,
-    ) -> Result<Option<(Evaluation, f64)>, NewtonFailure>
-    where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
-    {
+        evaluate: &mut Residual<'_, J::Matrix>,
+    ) -> Result<Option<(Evaluation, f64)>, NewtonFailure> {
         let mut length = 1.0;
         while length >= 1e-10 {
             self.trial.copy_from_slice(x.as_slice());
@@ -541,7 +539,8 @@ impl<J: Jacobian> Newton<J> {
             x = DVector::zeros(start.len());
         }
         x.copy_from_slice(start);
-        let solved = self.solve(&mut x, evaluate);
+        let mut evaluate = evaluate;
+        let solved = self.solve_with(&mut x, &mut evaluate);
         self.iterate = x;
         solved.map(|_| &self.iterate)
     }
@@ -583,6 +582,16 @@ impl<J: Jacobian> Newton<J> {
     where
         F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
     {
+        self.factorise_at_with(x, &mut evaluate)
+    }
+
+    /// [`factorise_at`](Self::factorise_at) with the closure behind a reference: compiled once
+    /// per Jacobian shape, not once per closure.
+    fn factorise_at_with(
+        &mut self,
+        x: &DVector<f64>,
+        evaluate: &mut Residual<'_, J::Matrix>,
+    ) -> Result<(), NewtonFailure> {
         if x.len() != self.root.len() {
             return Err(NewtonFailure::Dimension {
                 expected: self.root.len(),
@@ -595,7 +604,7 @@ impl<J: Jacobian> Newton<J> {
         self.unpark();
         std::mem::swap(&mut self.jacobian, &mut self.kept.jacobian);
         self.parked = Some((self.jacobian_norm, self.factorised));
-        if let Err(failure) = self.evaluate(x, &mut evaluate, true) {
+        if let Err(failure) = self.evaluate(x, evaluate, true) {
             self.unpark();
             return Err(failure);
         }
@@ -645,6 +654,16 @@ impl<J: Jacobian> Newton<J> {
     where
         F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
     {
+        self.solve_with(x, &mut evaluate)
+    }
+
+    /// [`solve`](Self::solve) with the closure behind a reference: the iteration is compiled
+    /// once per Jacobian shape, not once per closure (a model's steppers call it from many).
+    fn solve_with(
+        &mut self,
+        x: &mut DVector<f64>,
+        evaluate: &mut Residual<'_, J::Matrix>,
+    ) -> Result<NewtonReport, NewtonFailure> {
         if x.len() != self.residual.len() {
             return Err(NewtonFailure::Dimension {
                 expected: self.residual.len(),
@@ -663,7 +682,7 @@ impl<J: Jacobian> Newton<J> {
         let reused = !newton && self.factorised;
         self.kept.pending = reused;
         self.kept.holding = false;
-        let mut at_x = match self.evaluate(x, &mut evaluate, !reused) {
+        let mut at_x = match self.evaluate(x, evaluate, !reused) {
             Ok(e) => e,
             Err(failure) => return Err(self.failed(failure)),
         };
@@ -730,7 +749,7 @@ impl<J: Jacobian> Newton<J> {
                 if !current && ratio > options.max_contraction && update > round_off {
                     // An older Jacobian does not contract: evaluate it here and start the
                     // measurement again.
-                    at_x = self.refresh(x, &mut evaluate)?;
+                    at_x = self.refresh(x, evaluate)?;
                     (jacobian_at, previous) = (Some(updates), None);
                     (jacobians, evaluations) = (jacobians + 1, evaluations + 1);
                     continue;
@@ -751,7 +770,7 @@ impl<J: Jacobian> Newton<J> {
             }
             let length = if options.line_search {
                 let Some((at_trial, length)) = self
-                    .backtrack(x, at_x, &mut evaluate)
+                    .backtrack(x, at_x, evaluate)
                     .map_err(|f| self.failed(f))?
                 else {
                     return Err(self.failed(NewtonFailure::NoConvergence {
@@ -772,7 +791,7 @@ impl<J: Jacobian> Newton<J> {
                 // After an update below the step tolerance the next point is the root to
                 // round-off: its correction needs no Jacobian of its own.
                 let with_jacobian = newton && (update > noise || self.jacobian_at_root);
-                match self.evaluate(x, &mut evaluate, with_jacobian) {
+                match self.evaluate(x, evaluate, with_jacobian) {
                     Ok(e) => at_x = e,
                     Err(NewtonFailure::NonFinite)
                         if !with_jacobian && jacobian_at != Some(updates) =>
@@ -780,7 +799,7 @@ impl<J: Jacobian> Newton<J> {
                         // An update of an older Jacobian left the residual's domain: back to
                         // the iterate it came from, with its own Jacobian.
                         subtract(x, -1.0, &self.update);
-                        at_x = self.refresh(x, &mut evaluate)?;
+                        at_x = self.refresh(x, evaluate)?;
                         (jacobian_at, previous) = (Some(updates), None);
                         (jacobians, evaluations) = (jacobians + 1, evaluations + 1);
                         continue;
@@ -804,14 +823,11 @@ impl<J: Jacobian> Newton<J> {
     }
 
     /// The residual and a new Jacobian at `x` in the middle of a solve (a failure ends it).
-    fn refresh<F>(
+    fn refresh(
         &mut self,
         x: &DVector<f64>,
-        evaluate: &mut F,
-    ) -> Result<Evaluation, NewtonFailure>
-    where
-        F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
-    {
+        evaluate: &mut Residual<'_, J::Matrix>,
+    ) -> Result<Evaluation, NewtonFailure> {
         self.evaluate(x, evaluate, true).map_err(|f| self.failed(f))
     }
 

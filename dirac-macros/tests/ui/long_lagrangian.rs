@@ -1,8 +1,9 @@
-//! A model with a 10 000-term Lagrangian and a 10 000-term force one-form compiles (the macro and
-//! rustc see no recursion as deep as the sum is long) and evaluates to the value computed term by
-//! term in plain Rust, and its momentum ∂L/∂v (through the stepper's dual numbers) to the
-//! closed form. `scripts/compile_times.sh` writes the same programs (through
-//! `write_programs`) to time their builds.
+//! A model with a 10 000-term Lagrangian and a 10 000-term force one-form, written as a program
+//! that checks it (a pass case of `tests/ui.rs`): it compiles (the macro and rustc see no
+//! recursion as deep as the sum is long) and evaluates to the value computed term by term in
+//! plain Rust, and its momentum ∂L/∂v (through the stepper's dual numbers) to the closed form.
+//! `scripts/compile_times.sh` writes the same programs (through `write_programs`) to time their
+//! builds.
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -91,27 +92,9 @@ fn main() {{
 }
 
 /// Writes the program with `terms` terms into `directory`.
-fn write_program(directory: &Path, terms: usize) -> PathBuf {
+pub fn write_program(directory: &Path, terms: usize) -> PathBuf {
     std::fs::create_dir_all(directory).unwrap();
     let path = directory.join(format!("terms_{terms}.rs"));
     std::fs::write(&path, program(terms)).unwrap();
     path
-}
-
-#[test]
-fn ten_thousand_terms_compile_and_evaluate() {
-    let directory = Path::new(env!("CARGO_TARGET_TMPDIR")).join("long_lagrangian");
-    let path = write_program(&directory, 10_000);
-    trybuild::TestCases::new().pass(path);
-}
-
-/// For `scripts/compile_times.sh`: writes the programs for 100, 1 000 and 10 000 terms into
-/// `$DIRAC_PROGRAMS`.
-#[test]
-#[ignore = "run by scripts/compile_times.sh"]
-fn write_programs() {
-    let directory = std::env::var("DIRAC_PROGRAMS").expect("DIRAC_PROGRAMS names a directory");
-    for terms in [100, 1_000, 10_000] {
-        write_program(Path::new(&directory), terms);
-    }
 }
