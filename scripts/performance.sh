@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Renews docs/performance.md from one bench run: every criterion bench of `benches/step.rs`, then
-# (unless --no-study) the work–precision study, then `examples/performance.rs`, which writes the
+# (unless --no-study) the peers' tests with BDF (which the default build leaves out) and the
+# work–precision study, then `examples/performance.rs`, which writes the
 # tables from target/criterion and output/work_precision/summary.md.
 # Usage: scripts/performance.sh [--no-study]
 set -euo pipefail
@@ -16,7 +17,8 @@ criterion="${CARGO_TARGET_DIR:-target}/criterion"
 rm -rf "$criterion"
 cargo bench --bench step
 if [ "$study" = yes ]; then
-    # With the BDF peer, which the tests' build leaves out.
+    # With the BDF peer, which the default build leaves out: its tests first.
+    cargo test --features scenes/bdf --test suite peers
     cargo run --release --example work_precision --features scenes/bdf
     cargo run --example performance -- "$criterion" docs/performance.md \
         output/work_precision/summary.md
