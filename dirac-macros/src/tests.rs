@@ -1,9 +1,8 @@
-//! The macro as a library function: random token streams and random expression trees never make
-//! it panic, and well-formed expressions expand to Rust that parses.
+//! The macro as a library function: random token streams and random expression trees (256 of
+//! each, from fixed seeds) never make it panic, and well-formed expressions expand to Rust that
+//! parses.
 
 use proc_macro2::TokenStream;
-use proptest::prelude::*;
-use proptest::sample::select;
 
 use crate::expand::dirac_system;
 use crate::lower::expression::{BINARY, UNARY};
@@ -25,9 +24,51 @@ fn parses(output: &TokenStream) -> bool {
     syn::parse2::<syn::File>(output.clone()).is_ok()
 }
 
-/// Expressions built from every supported form, with odd literals and paths.
-fn expression(one_form: bool) -> impl Strategy<Value = String> {
-    let mut leaves = vec![
+/// Random cases from a fixed seed (xorshift64*): reproducible, and a failing case is printed
+/// whole by the assertion that catches it.
+struct Random(u64);
+
+impl Random {
+    fn new(seed: u64) -> Self {
+        Random(seed.max(1))
+    }
+
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    /// Uniform in `0..n`.
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+
+    fn pick<'a>(&mut self, from: &[&'a str]) -> &'a str {
+        from[self.below(from.len())]
+    }
+
+    fn coin(&mut self) -> bool {
+        self.next() & 1 == 1
+    }
+}
+
+/// How many random cases each property takes.
+const CASES: u64 = 256;
+
+/// Runs `property` on `CASES` random cases.
+fn for_random_cases(seed: u64, mut property: impl FnMut(&mut Random)) {
+    let mut random = Random::new(seed);
+    for _ in 0..CASES {
+        property(&mut random);
+    }
+}
+
+/// An expression built from every supported form, with odd literals and paths, nested at most
+/// `depth` deep.
+fn expression(random: &mut Random, one_form: bool, depth: usize) -> String {
+    const LEAVES: [&str; 15] = [
         "x",
         "y",
         "theta[0]",
@@ -44,54 +85,61 @@ fn expression(one_form: bool) -> impl Strategy<Value = String> {
         "18446744073709551616",
         "0x10",
     ];
-    leaves.extend(match one_form {
+    let differentials = match one_form {
         true => ["dx", "dtheta[1]"],
         false => ["dot(x)", "dot(theta[1])"],
-    });
-    let functions: Vec<&str> = UNARY.to_vec();
-    let binary: Vec<&str> = BINARY
-        .iter()
-        .map(|b| b.0)
-        .filter(|f| *f != "powi")
-        .collect();
-    select(leaves)
-        .prop_map(String::from)
-        .prop_recursive(6, 48, 3, move |inner| {
-            prop_oneof![
-                (
-                    inner.clone(),
-                    select(vec!["+", "-", "*", "/"]),
-                    inner.clone()
-                )
-                    .prop_map(|(a, op, b)| format!("{a} {op} {b}")),
-                inner.clone().prop_map(|a| format!("-{a}")),
-                inner.clone().prop_map(|a| format!("({a})")),
-                (select(functions.clone()), inner.clone(), any::<bool>()).prop_map(
-                    |(f, a, method)| match method {
-                        true => format!("({a}).{f}()"),
-                        false => format!("{f}({a})"),
-                    }
-                ),
-                (
-                    select(binary.clone()),
-                    inner.clone(),
-                    inner.clone(),
-                    any::<bool>()
-                )
-                    .prop_map(|(f, a, b, method)| match method {
-                        true => format!("({a}).{f}({b})"),
-                        false => format!("{f}({a}, {b})"),
-                    }),
-                (inner.clone(), -3i32..4).prop_map(|(a, n)| format!("powi({a}, {n})")),
-                inner.clone().prop_map(|a| format!("user({a})")),
-            ]
-        })
+    };
+    // A leaf a third of the time, and always at the bottom.
+    if depth == 0 || random.below(3) == 0 {
+        let i = random.below(LEAVES.len() + differentials.len());
+        return LEAVES
+            .get(i)
+            .copied()
+            .unwrap_or_else(|| differentials[i - LEAVES.len()])
+            .into();
+    }
+    let mut inner = |random: &mut Random| expression(random, one_form, depth - 1);
+    match random.below(7) {
+        0 => {
+            let (a, op, b) = (
+                inner(random),
+                random.pick(&["+", "-", "*", "/"]),
+                inner(random),
+            );
+            format!("{a} {op} {b}")
+        }
+        1 => format!("-{}", inner(random)),
+        2 => format!("({})", inner(random)),
+        3 => {
+            let f = random.pick(UNARY);
+            let a = inner(random);
+            match random.coin() {
+                true => format!("({a}).{f}()"),
+                false => format!("{f}({a})"),
+            }
+        }
+        4 => {
+            let binary: Vec<&str> = BINARY
+                .iter()
+                .map(|b| b.0)
+                .filter(|f| *f != "powi")
+                .collect();
+            let f = random.pick(&binary);
+            let (a, b) = (inner(random), inner(random));
+            match random.coin() {
+                true => format!("({a}).{f}({b})"),
+                false => format!("{f}({a}, {b})"),
+            }
+        }
+        5 => format!("powi({}, {})", inner(random), random.below(7) as i32 - 3),
+        _ => format!("user({})", inner(random)),
+    }
 }
 
-/// Expressions of numbers, vectors and matrices on a model with a rotation `R`, a unit vector
-/// `n` and a real `x`: well and badly shaped alike.
-fn group_expression(one_form: bool) -> impl Strategy<Value = String> {
-    let mut leaves = vec![
+/// An expression of numbers, vectors and matrices on a model with a rotation `R`, a unit vector
+/// `n` and a real `x`, well and badly shaped alike, nested at most `depth` deep.
+fn group_expression(random: &mut Random, one_form: bool, depth: usize) -> String {
+    const LEAVES: [&str; 19] = [
         "x",
         "R",
         "n",
@@ -113,48 +161,46 @@ fn group_expression(one_form: bool) -> impl Strategy<Value = String> {
         "d2",
         "d[1]",
     ];
-    leaves.extend(match one_form {
+    let differentials = match one_form {
         true => ["dR", "dn", "dx", "dbodies[0]"],
         false => ["omega(R)", "dot(n)", "dot(R)", "omega(n)"],
-    });
-    select(leaves)
-        .prop_map(String::from)
-        .prop_recursive(5, 40, 3, move |inner| {
-            prop_oneof![
-                (
-                    inner.clone(),
-                    select(vec!["+", "-", "*", "/"]),
-                    inner.clone()
-                )
-                    .prop_map(|(a, op, b)| format!("{a} {op} {b}")),
-                inner.clone().prop_map(|a| format!("-({a})")),
-                (
-                    select(vec![
-                        "dot",
-                        "cross",
-                        "transpose",
-                        "trace",
-                        "norm",
-                        "sin",
-                        "omega"
-                    ]),
-                    inner.clone(),
-                    inner.clone(),
-                    0..3usize
-                )
-                    .prop_map(|(f, a, b, arity)| match arity {
-                        0 => format!("{f}({a})"),
-                        1 => format!("{f}({a}, {b})"),
-                        _ => format!("({a}).{f}({b})"),
-                    }),
-                (inner.clone(), 0..4usize).prop_map(|(a, i)| format!("({a})[{i}]")),
-            ]
-        })
+    };
+    if depth == 0 || random.below(3) == 0 {
+        let i = random.below(LEAVES.len() + differentials.len());
+        return LEAVES
+            .get(i)
+            .copied()
+            .unwrap_or_else(|| differentials[i - LEAVES.len()])
+            .into();
+    }
+    let mut inner = |random: &mut Random| group_expression(random, one_form, depth - 1);
+    match random.below(4) {
+        0 => {
+            let (a, op, b) = (
+                inner(random),
+                random.pick(&["+", "-", "*", "/"]),
+                inner(random),
+            );
+            format!("{a} {op} {b}")
+        }
+        1 => format!("-({})", inner(random)),
+        2 => {
+            let f = random.pick(&["dot", "cross", "transpose", "trace", "norm", "sin", "omega"]);
+            let (a, b) = (inner(random), inner(random));
+            match random.below(3) {
+                0 => format!("{f}({a})"),
+                1 => format!("{f}({a}, {b})"),
+                _ => format!("({a}).{f}({b})"),
+            }
+        }
+        _ => format!("({})[{}]", inner(random), random.below(4)),
+    }
 }
 
-/// Balanced token soup: names, keywords, operators and literals, grouped at random.
-fn tokens() -> impl Strategy<Value = String> {
-    let vocabulary = vec![
+/// Balanced token soup: names, keywords, operators and literals, grouped at random, nested at
+/// most `depth` deep.
+fn tokens(random: &mut Random, depth: usize) -> String {
+    const VOCABULARY: [&str; 49] = [
         "x",
         "theta",
         "dx",
@@ -205,46 +251,50 @@ fn tokens() -> impl Strategy<Value = String> {
         "\"s\"",
         "true",
     ];
-    select(vocabulary)
-        .prop_map(String::from)
-        .prop_recursive(5, 64, 6, |inner| {
-            (
-                prop::collection::vec(inner, 0..6),
-                select(vec![("(", ")"), ("[", "]"), ("{", "}"), ("", "")]),
-            )
-                .prop_map(|(parts, (open, close))| format!("{open}{}{close}", parts.join(" ")))
-        })
+    if depth == 0 || random.below(3) == 0 {
+        return random.pick(&VOCABULARY).into();
+    }
+    let parts: Vec<String> = (0..random.below(6))
+        .map(|_| tokens(random, depth - 1))
+        .collect();
+    let (open, close) = [("(", ")"), ("[", "]"), ("{", "}"), ("", "")][random.below(4)];
+    format!("{open}{}{close}", parts.join(" "))
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig { cases: 256, failure_persistence: None, ..ProptestConfig::default() })]
+#[test]
+fn random_lagrangians_expand_to_rust() {
+    for_random_cases(1, |random| {
+        let expr = expression(random, false, 6);
+        let output = expand(
+            &format!("coordinates(x, y, theta[2]), lagrangian = {expr}"),
+            ITEM,
+        )
+        .expect("tokenises");
+        assert!(!is_error(&output), "{expr}\n{output}");
+        assert!(parses(&output), "{expr}\n{output}");
+    });
+}
 
-    #[test]
-    fn random_lagrangians_expand_to_rust(expr in expression(false)) {
-        let output = expand(&format!("coordinates(x, y, theta[2]), lagrangian = {expr}"), ITEM)
-            .expect("tokenises");
-        prop_assert!(!is_error(&output), "{expr}\n{output}");
-        prop_assert!(parses(&output), "{expr}\n{output}");
-    }
-
-    #[test]
-    fn random_one_forms_and_holonomic_constraints_never_panic(
-        form in expression(true),
-        g in expression(false),
-    ) {
+#[test]
+fn random_one_forms_and_holonomic_constraints_never_panic() {
+    for_random_cases(2, |random| {
+        let (form, g) = (expression(random, true, 6), expression(random, false, 6));
         let args = format!(
             "coordinates(x, y, theta[2]), lagrangian = dot(x) * dot(x), constraints({form}), \
              holonomic({g}), forces({form})"
         );
         let output = expand(&args, ITEM).expect("tokenises");
-        prop_assert!(parses(&output), "{args}\n{output}");
-    }
+        assert!(parses(&output), "{args}\n{output}");
+    });
+}
 
-    #[test]
-    fn random_vector_expressions_never_panic(
-        expr in group_expression(false),
-        form in group_expression(true),
-    ) {
+#[test]
+fn random_vector_expressions_never_panic() {
+    for_random_cases(3, |random| {
+        let (expr, form) = (
+            group_expression(random, false, 5),
+            group_expression(random, true, 5),
+        );
         let item = "struct S { m: f64, rho: [f64; 3], j: [[f64; 3]; 3], dm: f64, d: [f64; 3] }";
         for args in [
             format!("coordinates(x, R: SO3, n: S2, bodies[2]: SO3), lagrangian = {expr}"),
@@ -254,12 +304,15 @@ proptest! {
             ),
         ] {
             let output = expand(&args, item).expect("tokenises");
-            prop_assert!(parses(&output), "{args}\n{output}");
+            assert!(parses(&output), "{args}\n{output}");
         }
-    }
+    });
+}
 
-    #[test]
-    fn random_tokens_never_panic(soup in tokens()) {
+#[test]
+fn random_tokens_never_panic() {
+    for_random_cases(4, |random| {
+        let soup = tokens(random, 5);
         for args in [
             soup.clone(),
             format!("coordinates(x, theta[2]), lagrangian = {soup}"),
@@ -268,12 +321,15 @@ proptest! {
             format!("coordinates(x), lagrangian = x, quadrature = {soup}"),
         ] {
             if let Some(output) = expand(&args, ITEM) {
-                prop_assert!(parses(&output), "{args}\n{output}");
+                assert!(parses(&output), "{args}\n{output}");
             }
         }
-        let _ = expand("coordinates(x), lagrangian = x", &format!("struct S {{ {soup} }}"));
+        let _ = expand(
+            "coordinates(x), lagrangian = x",
+            &format!("struct S {{ {soup} }}"),
+        );
         let _ = expand("coordinates(x), lagrangian = x", &soup);
-    }
+    });
 }
 
 /// A 10 000-term sum, as syn parses it a 10 000-deep left spine, expands without deep recursion.

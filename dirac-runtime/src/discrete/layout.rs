@@ -117,7 +117,7 @@ impl Layout {
     }
 
     /// What unknown `column` is, with `coordinate` naming coordinates.
-    pub(crate) fn name(&self, column: usize, coordinate: impl Fn(usize) -> String) -> String {
+    pub(crate) fn name(&self, column: usize, coordinate: &dyn Fn(usize) -> String) -> String {
         if column >= self.projection() {
             let coordinate = coordinate(column - self.projection());
             return format!("the multiplier projecting {coordinate} onto p = ϑ(q)");

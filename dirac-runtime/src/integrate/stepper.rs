@@ -1755,7 +1755,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         };
         let options = self.newton.options();
         if which == Problem::Step {
-            return failure.into_error(problem, self.steps, options, |column| {
+            return failure.into_error(problem, self.steps, options, &|column| {
                 self.equations.unknown_name(column)
             });
         }
@@ -1768,7 +1768,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                 ),
                 value: f64::NAN,
             },
-            failure => failure.into_error(problem, self.steps, options, |column| {
+            failure => failure.into_error(problem, self.steps, options, &|column| {
                 if column < N {
                     format!("{} (velocity)", self.equations.coordinate_name(column))
                 } else {

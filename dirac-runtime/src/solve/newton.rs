@@ -174,7 +174,7 @@ impl NewtonFailure {
         problem: &'static str,
         step: u64,
         options: &NewtonOptions,
-        name: impl Fn(usize) -> String,
+        name: &dyn Fn(usize) -> String,
     ) -> DiracError {
         match self {
             NewtonFailure::NoConvergence {

@@ -1402,7 +1402,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     }
 
     fn unknown_name(&self, column: usize) -> String {
-        self.layout.name(column, |i| self.coordinate_name(i))
+        self.layout.name(column, &|i| self.coordinate_name(i))
     }
 
     /// `N`, plus one multiplier per constraint on the velocity for a constrained model or one

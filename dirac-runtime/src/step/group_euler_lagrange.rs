@@ -563,7 +563,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             .map(|i| self.variable(i))
             .collect();
         let names = <C::Manifold as Manifold<N>>::chart_names(&variables);
-        self.layout.name(column, |i| names[i].clone())
+        self.layout.name(column, &|i| names[i].clone())
     }
 
     /// `N`, plus one multiplier per one-form.

@@ -1044,7 +1044,7 @@ impl Modular {
                 "the modular discrete Euler–Lagrange equations",
                 run.steps,
                 &self.options,
-                names,
+                &names,
             ),
         })?;
         let x = run.unknowns.as_slice();
@@ -1244,7 +1244,7 @@ impl Modular {
                 "the modular velocity solve",
                 run.steps,
                 &self.options,
-                names,
+                &names,
             )
         })?;
         let mut v = DVector::zeros(self.total);
