@@ -98,7 +98,7 @@ fn expression(random: &mut Random, one_form: bool, depth: usize) -> String {
             .unwrap_or_else(|| differentials[i - LEAVES.len()])
             .into();
     }
-    let mut inner = |random: &mut Random| expression(random, one_form, depth - 1);
+    let inner = |random: &mut Random| expression(random, one_form, depth - 1);
     match random.below(7) {
         0 => {
             let (a, op, b) = (
@@ -173,7 +173,7 @@ fn group_expression(random: &mut Random, one_form: bool, depth: usize) -> String
             .unwrap_or_else(|| differentials[i - LEAVES.len()])
             .into();
     }
-    let mut inner = |random: &mut Random| group_expression(random, one_form, depth - 1);
+    let inner = |random: &mut Random| group_expression(random, one_form, depth - 1);
     match random.below(4) {
         0 => {
             let (a, op, b) = (
