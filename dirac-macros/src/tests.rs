@@ -52,6 +52,27 @@ impl Random {
     fn coin(&mut self) -> bool {
         self.next() & 1 == 1
     }
+
+    /// One of `first` and `then` taken together, uniformly.
+    fn pick_of_two<'a>(&mut self, first: &[&'a str], then: &[&'a str]) -> &'a str {
+        let i = self.below(first.len() + then.len());
+        first
+            .get(i)
+            .copied()
+            .unwrap_or_else(|| then[i - first.len()])
+    }
+
+    /// Whether a tree stops here: a leaf a third of the time, and always at `depth` 0.
+    fn at_leaf(&mut self, depth: usize) -> bool {
+        depth == 0 || self.below(3) == 0
+    }
+}
+
+/// `a op b` for an arithmetic operator, its operands from `inner`.
+fn arithmetic(random: &mut Random, inner: impl Fn(&mut Random) -> String) -> String {
+    let a = inner(random);
+    let op = random.pick(&["+", "-", "*", "/"]);
+    format!("{a} {op} {}", inner(random))
 }
 
 /// How many random cases each property takes.
@@ -89,25 +110,12 @@ fn expression(random: &mut Random, one_form: bool, depth: usize) -> String {
         true => ["dx", "dtheta[1]"],
         false => ["dot(x)", "dot(theta[1])"],
     };
-    // A leaf a third of the time, and always at the bottom.
-    if depth == 0 || random.below(3) == 0 {
-        let i = random.below(LEAVES.len() + differentials.len());
-        return LEAVES
-            .get(i)
-            .copied()
-            .unwrap_or_else(|| differentials[i - LEAVES.len()])
-            .into();
+    if random.at_leaf(depth) {
+        return random.pick_of_two(&LEAVES, &differentials).into();
     }
     let inner = |random: &mut Random| expression(random, one_form, depth - 1);
     match random.below(7) {
-        0 => {
-            let (a, op, b) = (
-                inner(random),
-                random.pick(&["+", "-", "*", "/"]),
-                inner(random),
-            );
-            format!("{a} {op} {b}")
-        }
+        0 => arithmetic(random, inner),
         1 => format!("-{}", inner(random)),
         2 => format!("({})", inner(random)),
         3 => {
@@ -165,24 +173,12 @@ fn group_expression(random: &mut Random, one_form: bool, depth: usize) -> String
         true => ["dR", "dn", "dx", "dbodies[0]"],
         false => ["omega(R)", "dot(n)", "dot(R)", "omega(n)"],
     };
-    if depth == 0 || random.below(3) == 0 {
-        let i = random.below(LEAVES.len() + differentials.len());
-        return LEAVES
-            .get(i)
-            .copied()
-            .unwrap_or_else(|| differentials[i - LEAVES.len()])
-            .into();
+    if random.at_leaf(depth) {
+        return random.pick_of_two(&LEAVES, &differentials).into();
     }
     let inner = |random: &mut Random| group_expression(random, one_form, depth - 1);
     match random.below(4) {
-        0 => {
-            let (a, op, b) = (
-                inner(random),
-                random.pick(&["+", "-", "*", "/"]),
-                inner(random),
-            );
-            format!("{a} {op} {b}")
-        }
+        0 => arithmetic(random, inner),
         1 => format!("-({})", inner(random)),
         2 => {
             let f = random.pick(&["dot", "cross", "transpose", "trace", "norm", "sin", "omega"]);
@@ -251,7 +247,7 @@ fn tokens(random: &mut Random, depth: usize) -> String {
         "\"s\"",
         "true",
     ];
-    if depth == 0 || random.below(3) == 0 {
+    if random.at_leaf(depth) {
         return random.pick(&VOCABULARY).into();
     }
     let parts: Vec<String> = (0..random.below(6))
