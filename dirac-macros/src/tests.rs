@@ -42,7 +42,8 @@ impl Random {
 
     /// Uniform in `0..n`.
     fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
+        // The high bits: xorshift64*'s low bits are its weakest.
+        ((self.next() >> 32) % n as u64) as usize
     }
 
     fn pick<'a>(&mut self, from: &[&'a str]) -> &'a str {
@@ -50,7 +51,7 @@ impl Random {
     }
 
     fn coin(&mut self) -> bool {
-        self.next() & 1 == 1
+        self.next() >> 63 == 1
     }
 
     /// One of `first` and `then` taken together, uniformly.
@@ -62,9 +63,10 @@ impl Random {
             .unwrap_or_else(|| then[i - first.len()])
     }
 
-    /// Whether a tree stops here: a leaf a third of the time, and always at `depth` 0.
-    fn at_leaf(&mut self, depth: usize) -> bool {
-        depth == 0 || self.below(3) == 0
+    /// Whether a tree of at most `top` levels stops here, `depth` levels above its bottom: never
+    /// at its root, always at the bottom, a third of the time in between.
+    fn at_leaf(&mut self, depth: usize, top: usize) -> bool {
+        depth == 0 || (depth < top && self.below(3) == 0)
     }
 }
 
@@ -78,13 +80,33 @@ fn arithmetic(random: &mut Random, inner: impl Fn(&mut Random) -> String) -> Str
 /// How many random cases each property takes.
 const CASES: u64 = 256;
 
-/// Runs `property` on `CASES` random cases.
+/// Runs `property` on `CASES` random cases from `seed`, offset by `DIRAC_PROPERTY_SEED` where
+/// that is set (to explore other cases); a failure names the offset that reproduces it.
 fn for_random_cases(seed: u64, mut property: impl FnMut(&mut Random)) {
-    let mut random = Random::new(seed);
+    let offset: u64 = std::env::var("DIRAC_PROPERTY_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
+    /// Says how to run the failing case again when the property panics.
+    struct Reproduce(u64);
+    impl Drop for Reproduce {
+        fn drop(&mut self) {
+            if std::thread::panicking() {
+                eprintln!("these cases run again with DIRAC_PROPERTY_SEED={}", self.0);
+            }
+        }
+    }
+    let _reproduce = Reproduce(offset);
+    let mut random = Random::new(seed.wrapping_add(offset));
     for _ in 0..CASES {
         property(&mut random);
     }
 }
+
+/// The depths of the random trees.
+const EXPRESSION_DEPTH: usize = 6;
+const GROUP_DEPTH: usize = 5;
+const TOKEN_DEPTH: usize = 5;
 
 /// An expression built from every supported form, with odd literals and paths, nested at most
 /// `depth` deep.
@@ -110,7 +132,7 @@ fn expression(random: &mut Random, one_form: bool, depth: usize) -> String {
         true => ["dx", "dtheta[1]"],
         false => ["dot(x)", "dot(theta[1])"],
     };
-    if random.at_leaf(depth) {
+    if random.at_leaf(depth, EXPRESSION_DEPTH) {
         return random.pick_of_two(&LEAVES, &differentials).into();
     }
     let inner = |random: &mut Random| expression(random, one_form, depth - 1);
@@ -173,7 +195,7 @@ fn group_expression(random: &mut Random, one_form: bool, depth: usize) -> String
         true => ["dR", "dn", "dx", "dbodies[0]"],
         false => ["omega(R)", "dot(n)", "dot(R)", "omega(n)"],
     };
-    if random.at_leaf(depth) {
+    if random.at_leaf(depth, GROUP_DEPTH) {
         return random.pick_of_two(&LEAVES, &differentials).into();
     }
     let inner = |random: &mut Random| group_expression(random, one_form, depth - 1);
@@ -247,7 +269,7 @@ fn tokens(random: &mut Random, depth: usize) -> String {
         "\"s\"",
         "true",
     ];
-    if random.at_leaf(depth) {
+    if random.at_leaf(depth, TOKEN_DEPTH) {
         return random.pick(&VOCABULARY).into();
     }
     let parts: Vec<String> = (0..random.below(6))
@@ -260,7 +282,7 @@ fn tokens(random: &mut Random, depth: usize) -> String {
 #[test]
 fn random_lagrangians_expand_to_rust() {
     for_random_cases(1, |random| {
-        let expr = expression(random, false, 6);
+        let expr = expression(random, false, EXPRESSION_DEPTH);
         let output = expand(
             &format!("coordinates(x, y, theta[2]), lagrangian = {expr}"),
             ITEM,
@@ -274,7 +296,10 @@ fn random_lagrangians_expand_to_rust() {
 #[test]
 fn random_one_forms_and_holonomic_constraints_never_panic() {
     for_random_cases(2, |random| {
-        let (form, g) = (expression(random, true, 6), expression(random, false, 6));
+        let (form, g) = (
+            expression(random, true, EXPRESSION_DEPTH),
+            expression(random, false, EXPRESSION_DEPTH),
+        );
         let args = format!(
             "coordinates(x, y, theta[2]), lagrangian = dot(x) * dot(x), constraints({form}), \
              holonomic({g}), forces({form})"
@@ -288,8 +313,8 @@ fn random_one_forms_and_holonomic_constraints_never_panic() {
 fn random_vector_expressions_never_panic() {
     for_random_cases(3, |random| {
         let (expr, form) = (
-            group_expression(random, false, 5),
-            group_expression(random, true, 5),
+            group_expression(random, false, GROUP_DEPTH),
+            group_expression(random, true, GROUP_DEPTH),
         );
         let item = "struct S { m: f64, rho: [f64; 3], j: [[f64; 3]; 3], dm: f64, d: [f64; 3] }";
         for args in [
@@ -308,7 +333,7 @@ fn random_vector_expressions_never_panic() {
 #[test]
 fn random_tokens_never_panic() {
     for_random_cases(4, |random| {
-        let soup = tokens(random, 5);
+        let soup = tokens(random, TOKEN_DEPTH);
         for args in [
             soup.clone(),
             format!("coordinates(x, theta[2]), lagrangian = {soup}"),

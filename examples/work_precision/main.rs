@@ -5,7 +5,8 @@
 //! `rtol = atol = 1e-13` (its error estimated by the run at 1e-12); dirac's `midpoint`, `galerkin(2)` and `galerkin(3)` at the scene's
 //! steps, measured by `Study`; Dop853 and Dopri5 (ode_solvers) at tolerances 1e-4 … 1e-12 on the
 //! hand-derived first-order form; and BDF (diffsol) on the index-1 DAE of the circuit and of the
-//! knife edge, in a build with `--features scenes/bdf` (as `scripts/performance.sh` runs it). Every run's error at the horizon, largest energy error over every step and wall
+//! knife edge, in a build with `--features scenes/bdf` (as `scripts/performance.sh` runs
+//! it). Every run's error at the horizon, largest energy error over every step and wall
 //! time per unit of simulated time go to `output/work_precision/study.csv`, with two PNGs per
 //! scene and horizon (error and energy error against cost); the summary prints, for each error
 //! and energy error target, the cheapest run of dirac and of the peers and their cost ratio.

@@ -108,6 +108,69 @@ fn every_scene_agrees_with_dirac_and_the_peers_with_each_other() {
     study::visit_all(&mut AgreeWithDirac).unwrap();
 }
 
+/// The index-1 DAE forms that BDF integrates, checked without BDF (so in every build) along the
+/// ODE forms' closed-form solutions: their algebraic rows vanish there, their differential rows
+/// are the ODE's right-hand sides, their states are the same samples of the model, and they
+/// start where the ODE forms start.
+#[test]
+fn the_dae_forms_are_the_ode_forms_on_their_constraints() {
+    use scenes::first_order::{KnifeEdgeDae, KnifeEdgeOde, LcDae, LcOde};
+    /// `to_dae` maps an ODE state to the DAE's (and an ODE rate to the DAE's differential rates).
+    fn compare<F, G, const Y: usize, const Z: usize, const N: usize>(
+        ode: &F,
+        dae: &G,
+        to_dae: impl Fn(&[f64; Y]) -> [f64; Z],
+        name: &str,
+    ) where
+        F: FirstOrder<Y, N>,
+        G: FirstOrder<Z, N>,
+    {
+        assert_eq!(
+            dae.initial(),
+            to_dae(&ode.initial()),
+            "{name}: initial states"
+        );
+        for t in [0.0, 0.7, 3.1, 10.0] {
+            let y = ode.exact(t).expect("a closed form");
+            let z = to_dae(&y);
+            let (expected, rate) = (to_dae(&ode.rhs(&y)), dae.rhs(&z));
+            for row in 0..Z {
+                let want = if row < G::DIFFERENTIAL {
+                    expected[row]
+                } else {
+                    0.0
+                };
+                assert!(
+                    (rate[row] - want).abs() < 1e-12,
+                    "{name} at t = {t}, row {row}: {} against {want}",
+                    rate[row]
+                );
+            }
+            let gap = peers::distance(&dae.sample(t, &z), &ode.sample(t, &y));
+            assert!(gap < 1e-15, "{name} at t = {t}: samples {gap:e} apart");
+        }
+    }
+    // (q_l, q_c1, q_c2, q_c3, i) in the ODE; (q_l, q_c2, i | q_c1, q_c3) in the DAE.
+    let lc = LcOde {
+        circuit: circuit::LC,
+        q0: circuit::q0().into(),
+    };
+    let to_dae = |y: &[f64; 5]| [y[0], y[2], y[4], y[1], y[3]];
+    compare(&lc, &LcDae(lc), to_dae, "LC circuit");
+    // (x, y, φ, ẋ, ẏ, φ̇) in the ODE; the DAE appends λ/m, the value its algebraic row holds.
+    let knife = KnifeEdgeOde {
+        knife: knife_edge::SCENE,
+        omega: knife_edge::OMEGA,
+    };
+    let dae = KnifeEdgeDae(knife);
+    let to_dae = |y: &[f64; 6]| {
+        let mut z = [y[0], y[1], y[2], y[3], y[4], y[5], 0.0];
+        z[6] = -dae.rhs(&z)[6];
+        z
+    };
+    compare(&knife, &dae, to_dae, "knife edge");
+}
+
 /// The forms against the scenes' closed forms, with no dirac involved.
 #[test]
 fn the_first_order_forms_meet_the_closed_forms() {

@@ -2,8 +2,8 @@
 //! that checks it (a pass case of `tests/ui.rs`): it compiles (the macro and rustc see no
 //! recursion as deep as the sum is long) and evaluates to the value computed term by term in
 //! plain Rust, and its momentum ∂L/∂v (through the stepper's dual numbers) to the closed form.
-//! `scripts/compile_times.sh` writes the same programs (through `write_programs`) to time their
-//! builds.
+//! `scripts/compile_times.sh` writes the same programs (through `write_programs` in
+//! `tests/ui.rs`) to time their builds.
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
