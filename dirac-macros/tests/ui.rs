@@ -5,7 +5,6 @@
 
 use std::path::Path;
 
-#[path = "ui/long_lagrangian.rs"]
 mod long_lagrangian;
 
 #[test]

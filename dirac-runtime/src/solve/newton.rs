@@ -529,7 +529,7 @@ impl<J: Jacobian> Newton<J> {
     pub(crate) fn solve_from<F>(
         &mut self,
         start: &[f64],
-        evaluate: F,
+        mut evaluate: F,
     ) -> Result<&DVector<f64>, NewtonFailure>
     where
         F: FnMut(&DVector<f64>, &mut DVector<f64>, Option<&mut J::Matrix>) -> f64,
@@ -539,7 +539,6 @@ impl<J: Jacobian> Newton<J> {
             x = DVector::zeros(start.len());
         }
         x.copy_from_slice(start);
-        let mut evaluate = evaluate;
         let solved = self.solve_with(&mut x, &mut evaluate);
         self.iterate = x;
         solved.map(|_| &self.iterate)
