@@ -14,6 +14,26 @@ mod long_lagrangian;
 fn ui() {
     let directory = Path::new(env!("CARGO_TARGET_TMPDIR")).join("long_lagrangian");
     let long = long_lagrangian::write_program(&directory, 10_000);
+    // trybuild passes its flags as `build.rustflags`, adding `--diagnostic-width=140` for the
+    // batch build and not for the runs of the pass cases, so each run built its program again
+    // (the 10 000-term one takes 14 s). The environment's flags win over the configuration's:
+    // one set for all of trybuild's builds.
+    // SAFETY: std serialises its own reads and writes of the environment, and nothing in this
+    // process reads it through libc.
+    unsafe {
+        std::env::set_var(
+            "CARGO_ENCODED_RUSTFLAGS",
+            [
+                "--cfg",
+                "trybuild",
+                "--verbose",
+                "-A",
+                "dead_code",
+                "--diagnostic-width=140",
+            ]
+            .join("\x1f"),
+        )
+    };
     let cases = trybuild::TestCases::new();
     cases.compile_fail("tests/ui/fail/*.rs");
     cases.pass("tests/ui/pass/*.rs");
