@@ -484,8 +484,9 @@ pub(crate) trait Projection {
 /// Newton's method on `c(q + Z α) = 0` with the minimal-norm update (singular values below
 /// `1e-12` of the largest count as zero). It stops on a residual at round-off of its terms or
 /// one that no longer halves, and accepts a residual within [`TOLERANCE`] of its terms; `Err`
-/// says why not (a residual that is not finite, or too large).
-pub(crate) fn hold(projection: &mut impl Projection) -> Result<(), String> {
+/// says why not (a residual that is not finite, or too large). The projection is a trait object,
+/// so this iteration is compiled once, not once per model.
+pub(crate) fn hold(projection: &mut dyn Projection) -> Result<(), String> {
     let mut last = f64::INFINITY;
     let settled = |residual: f64, scale: f64, last: f64| {
         if !residual.is_finite() {
