@@ -1,13 +1,13 @@
 //! Compile-time behaviour of `#[dirac_system]`: every malformed input is a compile error pointing
 //! at the user's tokens (tests/ui/fail, one diagnostic per file), valid inputs compile and run
-//! (tests/ui/pass), and so does a model with a 10 000-term Lagrangian (tests/ui/long_lagrangian.rs).
-//! One set of cases, so that trybuild builds its dependencies once and the cases side by side.
+//! (tests/ui/pass), and so does a model with a 10 000-term Lagrangian
+//! (tests/long_lagrangian/mod.rs). One set of cases, so that trybuild builds its dependencies
+//! once and the cases side by side.
 
 use std::path::Path;
 
-// The generator of the 10 000-term program (not the scenes): a crate root resolves `mod` beside
-// itself, in tests/, so the file in tests/ui/ is named.
-#[path = "ui/long_lagrangian.rs"]
+// The generator of the 10 000-term program (a folder's mod.rs: cargo does not take it for a test
+// binary of its own).
 mod long_lagrangian;
 
 #[test]
