@@ -62,6 +62,11 @@ pub mod prelude {
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
 
+/// The attribute's examples (its documentation, written in `dirac-macros`, is shown here too).
+#[doc = include_str!("../dirac-macros/src/dirac_system.md")]
+#[cfg(doctest)]
+pub struct AttributeDoctests;
+
 #[doc = include_str!("../docs/guide.md")]
 #[cfg(doctest)]
 pub struct GuideDoctests;

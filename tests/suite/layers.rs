@@ -1,6 +1,6 @@
 //! The folders of the runtime and of the attribute's crate are layers: a file may name
 //! (`crate::…` or `super::…`, outside comments) its own folder and the folders of lower layers,
-//! never a folder of its own layer or above it, and every file of `src/` but `lib.rs` belongs to
+//! never a folder of its own layer or above it, and every Rust file of `src/` but `lib.rs` belongs to
 //! a folder of the table. Doc links may point anywhere. The public paths of before the folders
 //! still resolve.
 
@@ -102,7 +102,9 @@ fn breaches(src: &Path, layers: &[(&str, u8)]) -> Vec<String> {
     for entry in fs::read_dir(src).unwrap() {
         let path = entry.unwrap().path();
         let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
-        if stem == "lib" {
+        // `lib.rs`, and documents (the attribute's reference is a markdown file) are no module.
+        let module = path.is_dir() || path.extension().is_some_and(|e| e == "rs");
+        if stem == "lib" || !module {
             continue;
         }
         if layer(layers, stem).is_some() {
