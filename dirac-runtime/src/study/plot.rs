@@ -1,6 +1,6 @@
-//! Line charts drawn to PNG (feature `plot`) by plotters' pure-Rust bitmap backend with the
-//! bundled DejaVu Sans (Bitstream Vera licence): no system font library is needed. The tour's
-//! figures and the work–precision charts use them.
+//! Line charts drawn to PNG (feature `plot`): plotters' pure-Rust bitmap backend draws them, with the
+//! bundled DejaVu Sans (Bitstream Vera licence), and `png` encodes them: no system library is needed.
+//! The tour's figures and the work–precision charts use them.
 //!
 //! ```
 //! use dirac_runtime::plot::{Series, line_chart};
@@ -114,7 +114,9 @@ fn draw(
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
     }
-    let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
+    let (width, height) = (900, 600);
+    let mut pixels = vec![0u8; 3 * width as usize * height as usize];
+    let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 24))
@@ -149,5 +151,51 @@ fn draw(
         .label_font(("sans-serif", 15))
         .draw()?;
     root.present()?;
+    drop(chart);
+    drop(root);
+    write_png(path, (width, height), &pixels)
+}
+
+/// Writes 8-bit RGB `pixels`, row by row, to the PNG file `path`.
+fn write_png(
+    path: &Path,
+    (width, height): (u32, u32),
+    pixels: &[u8],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut encoder = png::Encoder::new(file, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(pixels)?;
+    writer.finish()?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The file decodes as a 900×600 RGB image: a white margin, and the curve's colour inside.
+    #[test]
+    fn the_chart_is_a_png_of_the_drawn_pixels() {
+        let line = Series {
+            label: "line".into(),
+            points: vec![(0.0, 0.0), (1.0, 1.0)],
+        };
+        let path = std::env::temp_dir().join("dirac_plot_unit_test.png");
+        line_chart(&path, "a line", ("x", "y"), &[line]).unwrap();
+        let decoder =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
+        let mut reader = decoder.read_info().unwrap();
+        let mut pixels = vec![0; reader.output_buffer_size()];
+        let frame = reader.next_frame(&mut pixels).unwrap();
+        assert_eq!((frame.width, frame.height), (900, 600));
+        assert_eq!(frame.color_type, png::ColorType::Rgb);
+        assert_eq!(&pixels[..3], &[255, 255, 255]);
+        // Palette99's first colour, on the diagonal the line is drawn along.
+        let colour = Palette99::pick(0).to_rgba();
+        let (r, g, b) = (colour.0, colour.1, colour.2);
+        assert!(pixels.chunks(3).any(|p| p == [r, g, b]));
+    }
 }
