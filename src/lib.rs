@@ -62,7 +62,8 @@ pub mod prelude {
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
 
-/// The attribute's examples (its documentation, written in `dirac-macros`, is shown here too).
+/// The attribute's documentation (written in `dirac-macros`, whose own doctests are off): its
+/// examples run here. The file is outside this package, so they run from the repository only.
 #[doc = include_str!("../dirac-macros/src/dirac_system.md")]
 #[cfg(doctest)]
 pub struct AttributeDoctests;

@@ -74,8 +74,12 @@ fn register_font() -> Result<(), DiracError> {
     result
 }
 
+/// The size of a chart, in pixels.
+const SIZE: (u32, u32) = (900, 600);
+
 /// Draws `series` as lines on one chart, 900×600, with a legend, to the PNG file `path` (its
-/// directory created if needed). An error when nothing is finite or the file cannot be written.
+/// directory created if needed). An error when `path` does not end in `.png`, nothing is finite
+/// or the file cannot be written.
 pub fn line_chart(
     path: impl AsRef<Path>,
     title: &str,
@@ -83,17 +87,32 @@ pub fn line_chart(
     series: &[Series],
 ) -> Result<(), DiracError> {
     let path = path.as_ref();
+    let png = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !png {
+        return Err(DiracError::Io(format!(
+            "{}: charts are written as PNG; name the file *.png",
+            path.display()
+        )));
+    }
     register_font()?;
-    draw(path, title, (x_label, y_label), series)
-        .map_err(|e| DiracError::Io(format!("{}: {e}", path.display())))
+    let written = draw(title, (x_label, y_label), series).and_then(|pixels| {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)?;
+        }
+        write_png(path, SIZE, &pixels)
+    });
+    written.map_err(|e| DiracError::Io(format!("{}: {e}", path.display())))
 }
 
+/// The chart's pixels: 8-bit RGB, row by row.
 fn draw(
-    path: &Path,
     title: &str,
     (x_label, y_label): (&str, &str),
     series: &[Series],
-) -> Result<(), Box<dyn std::error::Error>> {
+) -> Result<Vec<u8>, Box<dyn std::error::Error>> {
     let points = series
         .iter()
         .flat_map(|s| s.points.iter())
@@ -111,12 +130,8 @@ fn draw(
         return Err("nothing to draw".into());
     }
     let pad = 0.05 * (y1 - y0).max(1e-12);
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)?;
-    }
-    let (width, height) = (900, 600);
-    let mut pixels = vec![0u8; 3 * width as usize * height as usize];
-    let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
+    let mut pixels = vec![0u8; 3 * SIZE.0 as usize * SIZE.1 as usize];
+    let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 24))
@@ -153,7 +168,7 @@ fn draw(
     root.present()?;
     drop(chart);
     drop(root);
-    write_png(path, (width, height), &pixels)
+    Ok(pixels)
 }
 
 /// Writes 8-bit RGB `pixels`, row by row, to the PNG file `path`.
@@ -178,26 +193,49 @@ fn write_png(
 mod tests {
     use super::*;
 
-    /// The file decodes as a 900×600 RGB image: a white margin, and the curve's colour inside.
-    #[test]
-    fn the_chart_is_a_png_of_the_drawn_pixels() {
-        let line = Series {
+    fn line() -> Series {
+        Series {
             label: "line".into(),
             points: vec![(0.0, 0.0), (1.0, 1.0)],
-        };
-        let path = std::env::temp_dir().join("dirac_plot_unit_test.png");
-        line_chart(&path, "a line", ("x", "y"), &[line]).unwrap();
-        let decoder =
-            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
-        let mut reader = decoder.read_info().unwrap();
+        }
+    }
+
+    /// The file decodes to the pixels drawn, and those hold the curve: its colour in the lower
+    /// left quarter, away from the legend (upper right).
+    #[test]
+    fn the_chart_is_a_png_of_the_drawn_pixels() {
+        register_font().unwrap();
+        let drawn = draw("a line", ("x", "y"), &[line()]).unwrap();
+        let path = std::env::temp_dir().join(format!("dirac_plot_{}.png", std::process::id()));
+        line_chart(&path, "a line", ("x", "y"), &[line()]).unwrap();
+        let file = std::fs::File::open(&path).unwrap();
+        let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+            .read_info()
+            .unwrap();
         let mut pixels = vec![0; reader.output_buffer_size()];
         let frame = reader.next_frame(&mut pixels).unwrap();
-        assert_eq!((frame.width, frame.height), (900, 600));
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!((frame.width, frame.height), SIZE);
         assert_eq!(frame.color_type, png::ColorType::Rgb);
-        assert_eq!(&pixels[..3], &[255, 255, 255]);
-        // Palette99's first colour, on the diagonal the line is drawn along.
+        assert_eq!(pixels, drawn);
         let colour = Palette99::pick(0).to_rgba();
-        let (r, g, b) = (colour.0, colour.1, colour.2);
-        assert!(pixels.chunks(3).any(|p| p == [r, g, b]));
+        let (width, height) = (SIZE.0 as usize, SIZE.1 as usize);
+        let curve_in_lower_left = (height / 2..height).any(|row| {
+            (0..width / 2).any(|column| {
+                let at = 3 * (row * width + column);
+                pixels[at..at + 3] == [colour.0, colour.1, colour.2]
+            })
+        });
+        assert!(curve_in_lower_left);
+        assert_eq!(&pixels[..3], &[255, 255, 255]);
+    }
+
+    /// Another format is refused before anything is drawn or written.
+    #[test]
+    fn only_png_files_are_written() {
+        let path = std::env::temp_dir().join(format!("dirac_plot_{}.jpg", std::process::id()));
+        let refused = line_chart(&path, "a line", ("x", "y"), &[line()]).unwrap_err();
+        assert!(refused.to_string().contains("*.png"), "{refused}");
+        assert!(!path.exists());
     }
 }
