@@ -1,15 +1,17 @@
 //! The tour's pictures: orders of convergence, energy errors over time, the knife edge's paths
 //! under the three discrete constraints, the LC circuit against its closed form, and the
 //! cart-pole balanced by LQR on the step map's derivatives, the pendulum's energy error against
-//! cost to T = 10⁴ beside the explicit Runge–Kutta and BDF peers, the heavy top's nutation, and
-//! its energy error and vertical momentum over 10⁶ steps.
+//! cost to T = 10⁴ beside the explicit Runge–Kutta and BDF peers, the heavy top's nutation, its
+//! energy error and vertical momentum over 10⁶ steps, and a chain of two rigid bodies in space.
 
 use std::error::Error;
 
 use dirac::prelude::*;
 
-use super::{cart_pole, circuit, double_pendulum, knife_edge, pendulum, rigid_body, study};
-use dirac::plot::{Series, line_chart};
+use super::{
+    cart_pole, circuit, double_pendulum, knife_edge, pendulum, rigid_body, rigid_chain, study,
+};
+use dirac::plot::{Series, SpaceSeries, line_chart, space_chart};
 
 /// Writes every figure to `output/` and returns their paths.
 pub fn draw_all() -> Result<Vec<&'static str>, Box<dyn Error>> {
@@ -22,6 +24,7 @@ pub fn draw_all() -> Result<Vec<&'static str>, Box<dyn Error>> {
         long_horizon()?,
         heavy_top_nutation()?,
         heavy_top_invariants()?,
+        chain_in_space()?,
     ])
 }
 
@@ -38,6 +41,34 @@ pub fn heavy_top_nutation() -> Result<&'static str, Box<dyn Error>> {
             label: "R e₃ (midpoint, Cayley, h = 0.001)".into(),
             points: axis.iter().map(|(_, a)| (a[0], a[1])).collect(),
         }],
+    )?;
+    Ok(path)
+}
+
+/// The chain of two rigid bodies in space over 3 s (midpoint, Cayley, h = 0.005): the paths of
+/// its joint and of the second body's centre of mass, and the chain (pivot, joint, centre) at
+/// the start and at the end.
+pub fn chain_in_space() -> Result<&'static str, Box<dyn Error>> {
+    let path = "output/rigid_chain.png";
+    let points = rigid_chain::points_in_space(Product::cayley(), 0.005, 600, 2)?;
+    let path_of = |label: &str, point: fn(&rigid_chain::ChainPoints) -> Vector3<f64>| SpaceSeries {
+        label: label.into(),
+        points: points.iter().map(|p| point(p).into()).collect(),
+    };
+    let chain_at = |label: &str, p: &rigid_chain::ChainPoints| SpaceSeries {
+        label: label.into(),
+        points: vec![[0.0; 3], p.joint.into(), p.centre.into()],
+    };
+    let (first, last) = (&points[0], &points[points.len() - 1]);
+    space_chart(
+        path,
+        "Two rigid bodies joined by a ball joint, 3 s in space (z up)",
+        &[
+            path_of("joint R₁ d", |p| p.joint),
+            path_of("second body's centre R₁ d + R₂ ρ₂", |p| p.centre),
+            chain_at("the chain at t = 0", first),
+            chain_at(&format!("the chain at t = {:.0}", last.t), last),
+        ],
     )?;
     Ok(path)
 }

@@ -126,3 +126,40 @@ pub fn start() -> (Configuration<f64, 0, 2, 0>, Rates<f64, 0, 2, 0>) {
 pub fn vertical_momentum(q: &Configuration<f64, 0, 2, 0>, p: &Rates<f64, 0, 2, 0>) -> f64 {
     (q.spatial(p, 0) + q.spatial(p, 1))[2]
 }
+
+/// Where the chain is at one time: its joint `R₁ d` and the second body's centre of mass
+/// `R₁ d + R₂ ρ₂` (the pivot at the origin).
+#[derive(Debug, Clone, Copy)]
+pub struct ChainPoints {
+    pub t: f64,
+    pub joint: Vector3<f64>,
+    pub centre: Vector3<f64>,
+}
+
+/// The chain's points every `every` steps of a midpoint run of `steps` steps of `h` from
+/// [`start`] on `space`.
+pub fn points_in_space(
+    space: Product<0, 2, 0>,
+    h: f64,
+    steps: u64,
+    every: usize,
+) -> Result<Vec<ChainPoints>, DiracError> {
+    let mut stepper = Stepper::on_manifold(CHAIN, space, Quadrature::midpoint(), h)?;
+    let (q0, v0) = start();
+    stepper.start_from_velocity(q0, v0)?;
+    let trajectory = stepper.solve(Run::steps(steps).every(every))?.trajectory;
+    let (d, rho2) = (Vector3::from(CHAIN.d), Vector3::from(CHAIN.rho2));
+    Ok(trajectory
+        .t()
+        .iter()
+        .zip(trajectory.q())
+        .map(|(&t, q)| {
+            let joint = q.rotation[0] * d;
+            ChainPoints {
+                t,
+                joint,
+                centre: joint + q.rotation[1] * rho2,
+            }
+        })
+        .collect())
+}

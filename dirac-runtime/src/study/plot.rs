@@ -17,6 +17,8 @@
 use std::path::Path;
 use std::sync::Once;
 
+use plotters::chart::SeriesLabelStyle;
+use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 
 use crate::base::error::DiracError;
@@ -74,8 +76,20 @@ fn register_font() -> Result<(), DiracError> {
     result
 }
 
+/// One labelled curve in space.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpaceSeries {
+    /// The legend's label.
+    pub label: String,
+    /// The points `[x, y, z]`, in drawing order (non-finite ones are left out).
+    pub points: Vec<[f64; 3]>,
+}
+
 /// The size of a chart, in pixels.
 const SIZE: (u32, u32) = (900, 600);
+
+/// An error, for the chart's file.
+type Failure = Box<dyn std::error::Error>;
 
 /// Draws `series` as lines on one chart, 900×600, with a legend, to the PNG file `path` (its
 /// directory created if needed). An error when `path` does not end in `.png`, nothing is finite
@@ -86,7 +100,37 @@ pub fn line_chart(
     (x_label, y_label): (&str, &str),
     series: &[Series],
 ) -> Result<(), DiracError> {
-    let path = path.as_ref();
+    save(path.as_ref(), || draw(title, (x_label, y_label), series))
+}
+
+/// Draws `series` as curves in space, seen in perspective from above and aside with `z` up, in
+/// a cube of equal scales (lengths and angles as they are), 900×600 with a legend, to the PNG
+/// file `path`: the motion of a mechanism or a body's axis. Errors as [`line_chart`]'s.
+///
+/// ```
+/// use dirac_runtime::plot::{SpaceSeries, space_chart};
+/// let helix = SpaceSeries {
+///     label: "helix".into(),
+///     points: (0..=200).map(|i| {
+///         let t = 0.1 * i as f64;
+///         [t.cos(), t.sin(), 0.05 * t]
+///     }).collect(),
+/// };
+/// let path = std::env::temp_dir().join("dirac_space_chart_example.png");
+/// space_chart(&path, "a helix", &[helix])?;
+/// assert!(std::fs::metadata(&path)?.len() > 1000);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn space_chart(
+    path: impl AsRef<Path>,
+    title: &str,
+    series: &[SpaceSeries],
+) -> Result<(), DiracError> {
+    save(path.as_ref(), || draw_in_space(title, series))
+}
+
+/// Checks that `path` names a PNG file, draws, and writes the pixels there.
+fn save(path: &Path, pixels: impl FnOnce() -> Result<Vec<u8>, Failure>) -> Result<(), DiracError> {
     let png = path
         .extension()
         .and_then(|e| e.to_str())
@@ -98,7 +142,7 @@ pub fn line_chart(
         )));
     }
     register_font()?;
-    let written = draw(title, (x_label, y_label), series).and_then(|pixels| {
+    let written = pixels().and_then(|pixels| {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)?;
         }
@@ -107,76 +151,128 @@ pub fn line_chart(
     written.map_err(|e| DiracError::Io(format!("{}: {e}", path.display())))
 }
 
-/// The chart's pixels: 8-bit RGB, row by row.
-fn draw(
-    title: &str,
-    (x_label, y_label): (&str, &str),
-    series: &[Series],
-) -> Result<Vec<u8>, Box<dyn std::error::Error>> {
-    let points = series
-        .iter()
-        .flat_map(|s| s.points.iter())
-        .filter(|(x, y)| x.is_finite() && y.is_finite());
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for &(x, y) in points {
-        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
-    }
-    if x0 >= x1 || !x0.is_finite() {
-        return Err("nothing to draw".into());
-    }
-    let pad = 0.05 * (y1 - y0).max(1e-12);
+/// The pixels (8-bit RGB, row by row) of a white chart on which `draw` draws.
+fn canvas(
+    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), Failure>,
+) -> Result<Vec<u8>, Failure> {
     let mut pixels = vec![0u8; 3 * SIZE.0 as usize * SIZE.1 as usize];
     let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
     root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 24))
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))?;
-    chart
-        .configure_mesh()
-        .x_desc(x_label)
-        .y_desc(y_label)
-        .label_style(("sans-serif", 15))
-        .draw()?;
-    for (k, s) in series.iter().enumerate() {
-        let color = Palette99::pick(k).to_rgba();
-        let finite = s
-            .points
-            .iter()
-            .cloned()
-            .filter(|(x, y)| x.is_finite() && y.is_finite());
-        chart
-            .draw_series(LineSeries::new(finite, color.stroke_width(2)))?
-            .label(s.label.clone())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-            });
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 15))
-        .draw()?;
+    draw(&root)?;
     root.present()?;
-    drop(chart);
     drop(root);
     Ok(pixels)
 }
 
+/// The smallest and largest finite value of each of `values`' coordinates; `None` where no point
+/// is finite or every point is the same.
+fn bounds<const D: usize>(values: impl Iterator<Item = [f64; D]>) -> Option<[(f64, f64); D]> {
+    let mut bounds = [(f64::INFINITY, f64::NEG_INFINITY); D];
+    for point in values.filter(|p| p.iter().all(|x| x.is_finite())) {
+        for (b, x) in bounds.iter_mut().zip(point) {
+            *b = (b.0.min(x), b.1.max(x));
+        }
+    }
+    let spread = bounds.iter().map(|b| b.1 - b.0).fold(0.0, f64::max);
+    (spread > 0.0).then_some(bounds)
+}
+
+/// The 2-D chart's pixels.
+fn draw(
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    series: &[Series],
+) -> Result<Vec<u8>, Failure> {
+    let points = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|&(x, y)| [x, y]));
+    let [(x0, x1), (y0, y1)] = bounds(points).ok_or("nothing to draw")?;
+    if x0 >= x1 {
+        return Err("nothing to draw".into());
+    }
+    let pad = 0.05 * (y1 - y0).max(1e-12);
+    canvas(|root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, ("sans-serif", 24))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        for (k, s) in series.iter().enumerate() {
+            let color = Palette99::pick(k).to_rgba();
+            let finite = s
+                .points
+                .iter()
+                .cloned()
+                .filter(|(x, y)| x.is_finite() && y.is_finite());
+            chart
+                .draw_series(LineSeries::new(finite, color.stroke_width(2)))?
+                .label(s.label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+        }
+        legend(&mut chart.configure_series_labels())
+    })
+}
+
+/// The 3-D chart's pixels. plotters' second axis is the vertical one: `z` is drawn along it.
+fn draw_in_space(title: &str, series: &[SpaceSeries]) -> Result<Vec<u8>, Failure> {
+    let points = series.iter().flat_map(|s| s.points.iter().copied());
+    let [(x0, x1), (y0, y1), (z0, z1)] = bounds(points).ok_or("nothing to draw")?;
+    // A cube about the points' centre, so that every axis has the same scale.
+    let half = 0.55 * (x1 - x0).max(y1 - y0).max(z1 - z0);
+    let range = |(a, b): (f64, f64)| (0.5 * (a + b) - half)..(0.5 * (a + b) + half);
+    let finite = |p: &&[f64; 3]| p.iter().all(|x| x.is_finite());
+    canvas(|root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, ("sans-serif", 24))
+            .margin(15)
+            .build_cartesian_3d(range((x0, x1)), range((z0, z1)), range((y0, y1)))?;
+        chart.with_projection(|mut view| {
+            view.yaw = 0.6;
+            view.pitch = 0.35;
+            view.scale = 0.85;
+            view.into_matrix()
+        });
+        chart
+            .configure_axes()
+            .label_style(("sans-serif", 13))
+            .draw()?;
+        for (k, s) in series.iter().enumerate() {
+            let color = Palette99::pick(k).to_rgba();
+            let points = s.points.iter().filter(finite).map(|p| (p[0], p[2], p[1]));
+            chart
+                .draw_series(LineSeries::new(points, color.stroke_width(2)))?
+                .label(s.label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+        }
+        legend(&mut chart.configure_series_labels())
+    })
+}
+
+/// Draws a chart's legend, in the style of every chart.
+fn legend<'a, 'p: 'a, CT: CoordTranslate>(
+    labels: &mut SeriesLabelStyle<'a, '_, BitMapBackend<'p>, CT>,
+) -> Result<(), Failure> {
+    labels
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 15))
+        .draw()?;
+    Ok(())
+}
+
 /// Writes 8-bit RGB `pixels`, row by row, to the PNG file `path`.
-fn write_png(
-    path: &Path,
-    (width, height): (u32, u32),
-    pixels: &[u8],
-) -> Result<(), Box<dyn std::error::Error>> {
+fn write_png(path: &Path, (width, height): (u32, u32), pixels: &[u8]) -> Result<(), Failure> {
     let file = std::io::BufWriter::new(std::fs::File::create(path)?);
     let mut encoder = png::Encoder::new(file, width, height);
     encoder.set_color(png::ColorType::Rgb);
@@ -228,6 +324,41 @@ mod tests {
         });
         assert!(curve_in_lower_left);
         assert_eq!(&pixels[..3], &[255, 255, 255]);
+    }
+
+    /// The columns and rows, left of the legend, of the pixels in series `k`'s colour.
+    fn spans(pixels: &[u8], k: usize) -> ((usize, usize), (usize, usize)) {
+        let colour = Palette99::pick(k).to_rgba();
+        let width = SIZE.0 as usize;
+        let (mut columns, mut rows) = ((usize::MAX, 0), (usize::MAX, 0));
+        for (at, pixel) in pixels.chunks(3).enumerate() {
+            let (row, column) = (at / width, at % width);
+            if column < 600 && pixel == [colour.0, colour.1, colour.2] {
+                columns = (columns.0.min(column), columns.1.max(column));
+                rows = (rows.0.min(row), rows.1.max(row));
+            }
+        }
+        (columns, rows)
+    }
+
+    /// `z` is up: a vertical segment is drawn upright, a horizontal one across.
+    #[test]
+    fn space_charts_stand_z_upright() {
+        register_font().unwrap();
+        let segment = |end: [f64; 3]| SpaceSeries {
+            label: "segment".into(),
+            points: vec![[0.0; 3], end],
+        };
+        let upright = draw_in_space("z", &[segment([0.0, 0.0, 1.0])]).unwrap();
+        let ((left, right), (top, bottom)) = spans(&upright, 0);
+        assert!(
+            right - left <= 3 && bottom - top > 100,
+            "{left}..{right}, {top}..{bottom}"
+        );
+        let across = draw_in_space("x", &[segment([1.0, 0.0, 0.0])]).unwrap();
+        let ((left, right), _) = spans(&across, 0);
+        assert!(right - left > 100, "{left}..{right}");
+        assert!(draw_in_space("a point", &[segment([0.0; 3])]).is_err());
     }
 
     /// Another format is refused before anything is drawn or written.
