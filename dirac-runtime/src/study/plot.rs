@@ -205,18 +205,11 @@ fn draw(
             .label_style(("sans-serif", 15))
             .draw()?;
         for (k, s) in series.iter().enumerate() {
-            let color = Palette99::pick(k).to_rgba();
             let finite = s
                 .points
                 .iter()
-                .cloned()
                 .filter(|(x, y)| x.is_finite() && y.is_finite());
-            chart
-                .draw_series(LineSeries::new(finite, color.stroke_width(2)))?
-                .label(s.label.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
+            curve(&mut chart, k, &s.label, finite.copied())?;
         }
         legend(&mut chart.configure_series_labels())
     })
@@ -246,17 +239,29 @@ fn draw_in_space(title: &str, series: &[SpaceSeries]) -> Result<Vec<u8>, Failure
             .label_style(("sans-serif", 13))
             .draw()?;
         for (k, s) in series.iter().enumerate() {
-            let color = Palette99::pick(k).to_rgba();
             let points = s.points.iter().filter(finite).map(|p| (p[0], p[2], p[1]));
-            chart
-                .draw_series(LineSeries::new(points, color.stroke_width(2)))?
-                .label(s.label.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
+            curve(&mut chart, k, &s.label, points)?;
         }
         legend(&mut chart.configure_series_labels())
     })
+}
+
+/// Draws `points` as a line in the `k`-th colour of the palette, with its entry in the legend.
+fn curve<'a, 'p: 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, BitMapBackend<'p>, CT>,
+    k: usize,
+    label: &str,
+    points: impl Iterator<Item = CT::From>,
+) -> Result<(), Failure>
+where
+    CT::From: Clone + 'static,
+{
+    let color = Palette99::pick(k).to_rgba();
+    chart
+        .draw_series(LineSeries::new(points, color.stroke_width(2)))?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+    Ok(())
 }
 
 /// Draws a chart's legend, in the style of every chart.
