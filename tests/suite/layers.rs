@@ -1,8 +1,8 @@
 //! The folders of the runtime and of the attribute's crate are layers: a file may name
 //! (`crate::…` or `super::…`, outside comments) its own folder and the folders of lower layers,
-//! never a folder of its own layer or above it, and every Rust file of `src/` but `lib.rs` belongs to
-//! a folder of the table. Doc links may point anywhere. The public paths of before the folders
-//! still resolve.
+//! never a folder of its own layer or above it, and every Rust file of `src/` but `lib.rs`
+//! belongs to a folder of the table. Doc links may point anywhere. The public paths of before
+//! the folders still resolve.
 
 use std::fs;
 use std::path::Path;

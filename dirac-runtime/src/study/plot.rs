@@ -1,6 +1,7 @@
-//! Line charts drawn to PNG (feature `plot`): plotters' pure-Rust bitmap backend draws them, with the
-//! bundled DejaVu Sans (Bitstream Vera licence), and `png` encodes them: no system library is needed.
-//! The tour's figures and the work–precision charts use them.
+//! Charts drawn to PNG (feature `plot`): lines in the plane ([`line_chart`]) and curves in space
+//! ([`space_chart`]). Plotters' pure-Rust bitmap backend draws them with the bundled DejaVu Sans
+//! (Bitstream Vera licence) and `png` encodes them: no system library is needed. The tour's
+//! figures and the work–precision charts use them.
 //!
 //! ```
 //! use dirac_runtime::plot::{Series, line_chart};
