@@ -40,6 +40,8 @@ pub struct Model {
     pub closed_form: Option<ClosedForm>,
     /// Continuations of long chains, each emitted as a method of its own.
     pub parts: Vec<Part>,
+    /// Constant items asserting indices rustc checks, emitted beside the struct.
+    pub index_checks: Vec<TokenStream>,
     /// The path of the runtime crate (`crate = ...`, `::dirac` by default), bound to `__dirac`
     /// in the generated code.
     pub krate: syn::Path,

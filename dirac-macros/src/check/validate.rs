@@ -287,6 +287,7 @@ fn composite(
 pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     let mut errors = Errors::default();
     let parts = RefCell::new(Vec::new());
+    let index_checks = RefCell::new(Vec::new());
     repeated_attributes(&mut item, &mut errors);
     let mut e = entries(arguments, &mut errors);
     let krate = runtime_path(e.krate.take(), &mut errors);
@@ -301,6 +302,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         );
     }
     let parameters = parameters(&item, &mut errors);
+    let const_params = const_params(&item);
     if e.forces.is_some() {
         for p in parameters.iter().filter(|p| p.name == "t") {
             errors.push(
@@ -378,8 +380,15 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
             let n =
                 literal_dimension(coordinates).filter(|_| !is_product(coordinates) && !hamiltonian);
             let closed = n.and_then(|n| symbolic::closed_form(&expr, coordinates, n));
-            let lagrangian =
-                lagrangian_of(expr, coordinates, &parameters, &parts, rate, &mut errors);
+            let lagrangian = lagrangian_of(
+                expr,
+                coordinates,
+                &parameters,
+                &const_params,
+                (&parts, &index_checks),
+                rate,
+                &mut errors,
+            );
             // A function path has no expression to differentiate.
             if matches!(lagrangian, Some(Lagrangian::Expression(_))) {
                 closed_form = closed;
@@ -431,11 +440,13 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 coordinates,
                 inputs: &[],
                 fields: &fields,
+                const_params: &const_params,
                 no_velocities: Some(NO_VELOCITIES),
                 rate,
                 elsewhere: "",
                 context: Context::Positions,
                 parts: &parts,
+                index_checks: &index_checks,
                 atoms: product,
             };
             // On rotations and unit vectors, one-forms and forces are lowered to scalars first.
@@ -496,11 +507,13 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 coordinates,
                 inputs: &inputs,
                 fields: &fields,
+                const_params: &const_params,
                 no_velocities: None,
                 rate,
                 elsewhere: "",
                 context: Context::Force,
                 parts: &parts,
+                index_checks: &index_checks,
                 atoms: product,
             };
             let forces = e
@@ -541,6 +554,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 constraint_point,
                 closed_form,
                 parts: parts.into_inner(),
+                index_checks: index_checks.into_inner(),
                 krate,
             }))
         }
@@ -647,7 +661,8 @@ fn lagrangian_of(
     expr: Expr,
     coordinates: &[Coordinate],
     parameters: &[Parameter],
-    parts: &RefCell<Vec<Part>>,
+    const_params: &[Ident],
+    (parts, index_checks): (&RefCell<Vec<Part>>, &RefCell<Vec<TokenStream>>),
     rate: &'static str,
     errors: &mut Errors,
 ) -> Option<Lagrangian> {
@@ -665,12 +680,14 @@ fn lagrangian_of(
         coordinates,
         inputs: &[],
         fields: &fields,
+        const_params,
         no_velocities: None,
         rate,
         elsewhere: "; for other code write a generic function and give \
                     `lagrangian = path::to::function`",
         context: Context::Lagrangian,
         parts,
+        index_checks,
         atoms: product,
     };
     let expr = match product {
@@ -803,15 +820,7 @@ fn check_coordinates(
         }
     }
     // A generic struct: the dimension must be one const parameter, not an expression of it.
-    let const_params: Vec<_> = item
-        .generics
-        .params
-        .iter()
-        .filter_map(|g| match g {
-            GenericParam::Const(c) => Some(c.ident.clone()),
-            _ => None,
-        })
-        .collect();
+    let const_params = const_params(item);
     let generic_length = list.iter().find_map(|c| match &c.length {
         Some(Length::Named(n)) if const_params.contains(n) => Some(n.clone()),
         _ => None,
@@ -825,6 +834,18 @@ fn check_coordinates(
             ),
         );
     }
+}
+
+/// The struct's const parameters.
+fn const_params(item: &syn::ItemStruct) -> Vec<Ident> {
+    item.generics
+        .params
+        .iter()
+        .filter_map(|g| match g {
+            GenericParam::Const(c) => Some(c.ident.clone()),
+            _ => None,
+        })
+        .collect()
 }
 
 /// The struct's fields, each `f64` or `[f64; K]`; other shapes are errors.

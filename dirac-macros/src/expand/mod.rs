@@ -249,7 +249,8 @@ fn expand(model: &Model) -> TokenStream {
         #component
     };
     let implementation = in_scope(&model.krate, implementation);
-    quote!(#item #implementation)
+    let index_checks = &model.index_checks;
+    quote!(#item #(#index_checks)* #implementation)
 }
 
 /// What a model on `Rⁿ` given by a Lagrangian offers as a subsystem of

@@ -75,6 +75,9 @@ pub struct Scope<'a> {
     pub inputs: &'a [Ident],
     /// The struct's fields (a reserved one is reported on the field, not where it is used).
     pub fields: &'a [Ident],
+    /// The struct's const parameters: an index or a length that names one is known only after
+    /// monomorphisation (see [`Rewriter::checked_index`]).
+    pub const_params: &'a [Ident],
     /// `None` where velocities are allowed, else what to say when `dot(...)` appears.
     pub no_velocities: Option<&'static str>,
     /// The name of the rate of a coordinate: `dot` (a velocity, for a Lagrangian) or `p` (a
@@ -86,6 +89,9 @@ pub struct Scope<'a> {
     pub context: Context,
     /// The model's hoisted parts of long chains, shared by every expression of the model.
     pub parts: &'a RefCell<Vec<Part>>,
+    /// Constant items asserting the model's indices that rustc checks (see
+    /// [`Rewriter::checked_index`]), shared by every expression of the model.
+    pub index_checks: &'a RefCell<Vec<TokenStream>>,
     /// Whether the expression was lowered from vectors and matrices (a model on rotations and
     /// unit vectors), so that its atoms are bound scalars (see `vector_algebra`).
     pub atoms: bool,
@@ -446,6 +452,52 @@ impl<'a> Rewriter<'a> {
         }
     }
 
+    /// The tokens of `index` into the array `coordinate`, once [`index`](Self::index) accepted it.
+    /// A literal index into an array of literal length was checked here. Any other is checked by
+    /// rustc on the user's tokens: where neither the index nor the length names one of the
+    /// struct's const parameters (or `Self`), by a constant item pushed into the scope's `index_checks`
+    /// (emitted beside the struct, so that `cargo check` reports it: rustc's
+    /// `unconditional_panic` lint on an array index fires only when code is generated); else the
+    /// index goes through an array of the coordinate's length, which that lint rejects at build
+    /// time (and a run-time index would panic rather than land on another coordinate).
+    pub fn checked_index(&self, coordinate: &Coordinate, index: &Expr) -> TokenStream {
+        let Some(length) = &coordinate.length else {
+            return index.to_token_stream();
+        };
+        if let (Length::Literal(..), Expr::Lit(_)) = (length, index) {
+            return index.to_token_stream();
+        }
+        let (at, _) = bounds(index);
+        let length = length.tokens();
+        // A const parameter, or an associated constant through `Self`, is out of a free item's
+        // reach.
+        let local = [index.to_token_stream(), length.clone()]
+            .into_iter()
+            .flatten()
+            .any(|t| {
+                matches!(&t, TokenTree::Ident(i) if i == "Self" || self.scope.const_params.contains(i))
+            });
+        if local {
+            return quote_spanned! {at=>
+                { let __k: usize = #index; let _: () = [(); #length][__k]; __k }
+            };
+        }
+        let compact = |tokens: TokenStream| tokens.to_string().replace(' ', "");
+        let message = format!(
+            "index `{}` is out of range: `{}` has `{}` elements",
+            compact(index.to_token_stream()),
+            coordinate.name,
+            compact(length.clone())
+        );
+        self.scope
+            .index_checks
+            .borrow_mut()
+            .push(quote_spanned! {at=>
+                const _: () = ::core::assert!((#index) < (#length), #message);
+            });
+        index.to_token_stream()
+    }
+
     /// Whether `expr` is an integer constant (integer literals, names that are not coordinates,
     /// `+ - * / %`, unary minus, parentheses); reports `message` on it if not.
     fn integer_constant(&mut self, expr: &Expr, message: &str) -> bool {
@@ -506,7 +558,8 @@ impl<'a> Rewriter<'a> {
                 if !self.index(coordinate, &ix.index) {
                     return Piece::invalid(ident.span());
                 }
-                let mut bracket = Group::new(Delimiter::Bracket, ix.index.to_token_stream());
+                let index = self.checked_index(coordinate, &ix.index);
+                let mut bracket = Group::new(Delimiter::Bracket, index);
                 bracket.set_span(ix.bracket_token.span.join());
                 Piece::atom(quote!(#velocity #bracket), Class::Dual, ident.span())
             }
@@ -773,7 +826,11 @@ impl<'a> Rewriter<'a> {
                 if !self.index(coordinate, &ix.index) {
                     return Piece::invalid(span);
                 }
-                Class::Dual
+                let index = self.checked_index(coordinate, &ix.index);
+                let mut bracket = Group::new(Delimiter::Bracket, index);
+                bracket.set_span(ix.bracket_token.span.join());
+                let base = &ix.expr;
+                return Piece::atom(quote!(#base #bracket), Class::Dual, span);
             }
             None => {
                 let reserved = |i: &&Ident| is_reserved(i) && !self.scope.fields.contains(i);

@@ -7,7 +7,7 @@ use proc_macro2::{Span, TokenStream};
 use quote::quote_spanned;
 use syn::{BinOp, Expr, ExprIndex, UnOp};
 
-use crate::internals::ast::{Coordinate, Length, Term, offsets};
+use crate::internals::ast::{Coordinate, Term, offsets};
 use crate::lower::atom::differential_index;
 use crate::lower::expression::{Family, Piece, Rewriter, bounds, spine, subexpressions};
 
@@ -162,31 +162,21 @@ impl Splitter<'_, '_> {
         self.rewriter.errors.push_range(start, end, message);
     }
 
-    /// The flat index of `dx` or `dtheta[i]` with coefficient one. An index the macro cannot check
-    /// goes through an array of the coordinate's length, so rustc rejects a constant one out of
-    /// range (and a run-time one panics rather than landing on another coordinate).
+    /// The flat index of `dx` or `dtheta[i]` with coefficient one; an index the macro cannot check
+    /// is checked by rustc ([`Rewriter::checked_index`]).
     fn differential(&mut self, k: usize, index: Option<&ExprIndex>, expr: &Expr) -> Vec<Part> {
         let coordinate = &self.rewriter.scope.coordinates[k];
         let offset = self.offsets[k].clone();
         let (span, _) = bounds(expr);
         match (&coordinate.length, index) {
             (None, None) => vec![(offset, Piece::one(span))],
-            (Some(length), Some(ix)) => {
+            (Some(_), Some(ix)) => {
                 if !self.rewriter.index(coordinate, &ix.index) {
                     return Vec::new();
                 }
-                let i = &ix.index;
-                let (at, _) = bounds(i);
-                let index = match (length, &**i) {
-                    // Checked by `index` above.
-                    (Length::Literal(..), Expr::Lit(_)) => quote_spanned!(at=> #offset + #i),
-                    _ => {
-                        let length = length.tokens();
-                        quote_spanned! {at=>
-                            #offset + { let __k: usize = #i; let _: () = [(); #length][__k]; __k }
-                        }
-                    }
-                };
+                let i = self.rewriter.checked_index(coordinate, &ix.index);
+                let (at, _) = bounds(&ix.index);
+                let index = quote_spanned!(at=> #offset + #i);
                 vec![(index, Piece::one(span))]
             }
             (Some(_), None) => {

@@ -9,7 +9,8 @@ use dirac::prelude::*;
 )]
 struct Like;
 
-fn main() {
+#[test]
+fn compiles_and_runs() {
     let turned = Retraction::Exp.map(&Vector3::new(0.3, 0.0, 0.0));
     let q = Configuration::<f64, 0, 3, 2>::new(
         SVector::zeros(),
@@ -18,9 +19,13 @@ fn main() {
     );
     let v = Rates::<f64, 0, 3, 2>::new(
         SVector::zeros(),
-        [Vector3::new(1.0, 0.0, 0.0), Vector3::zeros(), Vector3::new(0.0, 3.0, 0.0)],
+        [
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::zeros(),
+            Vector3::new(0.0, 3.0, 0.0),
+        ],
         [Vector3::zeros(), Vector3::zeros()],
     );
-    let expected = 0.5 * 1.0 + 2.0 * 9.0 + 3.0 * 1.0 + 5.0 * -1.0 + 7.0 * turned[(1, 2)];
+    let expected = 0.5 * 1.0 + 2.0 * 9.0 + 3.0 * 1.0 - 5.0 * 1.0 + 7.0 * turned[(1, 2)];
     assert!((Like.lagrangian(&q, &v) - expected).abs() < 1e-14);
 }

@@ -9,9 +9,12 @@ impl DiracSystem<2> for Free {
     }
 }
 
-fn main() {
+#[test]
+fn compiles_and_runs() {
     let mut stepper = Stepper::new(Free, Quadrature::trapezoid(), 0.5).unwrap();
-    stepper.start_from_velocity(vector![0.0, 0.0], vector![1.0, 2.0]).unwrap();
+    stepper
+        .start_from_velocity(vector![0.0, 0.0], vector![1.0, 2.0])
+        .unwrap();
     stepper.run(4).unwrap();
     assert!((stepper.q() - vector![2.0, 4.0]).amax() < 1e-14);
 }

@@ -52,7 +52,8 @@ struct Series {
     c: Capacitor,
 }
 
-fn main() -> Result<(), DiracError> {
+#[test]
+fn compiles_and_runs() -> Result<(), DiracError> {
     let circuit = Circuit {
         outer: Loop {
             l: Inductor { l: 1.0 },
@@ -90,6 +91,10 @@ fn main() -> Result<(), DiracError> {
     let (alpha, t) = (0.05f64, 10.0);
     let omega = (1.0 - alpha * alpha).sqrt();
     let exact = (-alpha * t).exp() * ((omega * t).cos() + alpha / omega * (omega * t).sin());
-    assert!((stepper.q()[2] - exact).abs() < 1e-5, "{} against {exact}", stepper.q()[2]);
+    assert!(
+        (stepper.q()[2] - exact).abs() < 1e-5,
+        "{} against {exact}",
+        stepper.q()[2]
+    );
     Ok(())
 }

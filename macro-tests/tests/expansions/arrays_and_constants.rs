@@ -12,7 +12,8 @@ struct Mixed {
     m: [f64; 2],
 }
 
-fn main() {
+#[test]
+fn compiles_and_runs() {
     let system = Mixed { m: [2.0, 3.0] };
     assert_eq!(system.coordinate_name(2), "theta[1]");
     assert_eq!(system.parameters()[1], ("m[1]".to_string(), 3.0));

@@ -22,7 +22,8 @@ fn energy<D: Scalar>(_model: &Free, q: &SVector<D, 1>, p: &SVector<D, 1>) -> D {
 #[dirac_system(coordinates(x), hamiltonian = energy)]
 struct Free;
 
-fn main() -> Result<(), DiracError> {
+#[test]
+fn compiles_and_runs() -> Result<(), DiracError> {
     let mut skate = Stepper::hamiltonian_from_system(Skate { m: 1.0, c: 0.1 }, 0.01)?;
     skate.set_input("u", 1.0)?;
     skate.start_from_momentum(vector![0.0, 0.0, 0.0], vector![0.0, 0.0, 1.0])?;

@@ -25,7 +25,8 @@ struct Mixed {
     d2: f64,
 }
 
-fn main() {
+#[test]
+fn compiles_and_runs() {
     let model = Mixed {
         m: 1.0,
         k: 2.0,

@@ -11,7 +11,8 @@ struct Pendulum {
     g: f64,
 }
 
-fn main() -> Result<(), DiracError> {
+#[test]
+fn compiles_and_runs() -> Result<(), DiracError> {
     let mut stepper = Stepper::hamiltonian(Pendulum { g: 9.81 }, Quadrature::midpoint(), 0.01)?;
     stepper.start_from_momentum(vector![1.0, 0.0], vector![0.0, 0.5])?;
     stepper.run(100)?;

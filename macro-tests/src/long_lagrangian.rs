@@ -1,9 +1,10 @@
-//! A model with a 10 000-term Lagrangian and a 10 000-term force one-form, written as a program
-//! that checks it (a pass case of `tests/ui.rs`): it compiles (the macro and rustc see no
-//! recursion as deep as the sum is long) and evaluates to the value computed term by term in
-//! plain Rust, and its momentum ∂L/∂v (through the stepper's dual numbers) to the closed form.
-//! `scripts/compile_times.sh` writes the same programs (through `write_programs` in
-//! `tests/ui.rs`) to time their builds.
+//! A model with a long Lagrangian and a force one-form of as many terms, written as a program
+//! whose `main` checks it: it compiles (the macro and rustc see no recursion as deep as the sum
+//! is long) and evaluates to the value computed term by term in plain Rust, and its momentum
+//! ∂L/∂v (through the stepper's dual numbers) to the closed form. The build script writes the
+//! 10 000-term program, which `tests/expansions/main.rs` compiles and runs;
+//! `scripts/compile_times.sh` writes programs of 100, 1 000 and 10 000 terms (through
+//! `write_programs` there) to time their builds.
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -28,7 +29,7 @@ fn lagrangian_term(i: usize) -> String {
 
 /// A program defining the model with `terms` terms and checking its Lagrangian and force at a
 /// point against the same sums evaluated in a loop.
-fn program(terms: usize) -> String {
+pub fn program(terms: usize) -> String {
     // A constant prefix before the first state-dependent term: the rewriter must reorder it.
     let mut lagrangian = String::from("0.5 - 0.25");
     let mut force = String::new();
@@ -91,10 +92,10 @@ fn main() {{
     )
 }
 
-/// Writes the program with `terms` terms into `directory`.
-pub fn write_program(directory: &Path, terms: usize) -> PathBuf {
-    std::fs::create_dir_all(directory).unwrap();
+/// Writes the program with `terms` terms into `directory`, as `terms_{terms}.rs`.
+pub fn write_program(directory: &Path, terms: usize) -> std::io::Result<PathBuf> {
+    std::fs::create_dir_all(directory)?;
     let path = directory.join(format!("terms_{terms}.rs"));
-    std::fs::write(&path, program(terms)).unwrap();
-    path
+    std::fs::write(&path, program(terms))?;
+    Ok(path)
 }

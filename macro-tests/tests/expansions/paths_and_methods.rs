@@ -17,8 +17,13 @@ struct Vortices {
     m: f64,
 }
 
-fn main() {
-    let system = Vortices { g0: 1.0, g1: 3.0, m: 0.5 };
+#[test]
+fn compiles_and_runs() {
+    let system = Vortices {
+        g0: 1.0,
+        g1: 3.0,
+        m: 0.5,
+    };
     let (x, y, vx, vy) = (0.5_f64, 0.25_f64, 1.5_f64, -0.5_f64);
     let expected = 0.5 * vx * vx
         + 3.0 / (4.0 * std::f64::consts::PI) * (x * x + 1.0).ln()

@@ -17,7 +17,8 @@ struct Everything {
     c: f64,
 }
 
-fn main() {
+#[test]
+fn compiles_and_runs() {
     let system = Everything { k: 1.0, c: 0.1 };
     assert_eq!(system.constraint_point(), ConstraintPoint::Start);
     assert_eq!(system.input_name(0), "u");
@@ -30,7 +31,9 @@ fn main() {
     assert_eq!(f, vector![-0.2, 0.0, 3.0, 0.0]);
     let mut stepper = Stepper::new(system, Quadrature::midpoint(), 0.01).unwrap();
     stepper.set_input("u", 1.0).unwrap();
-    stepper.start_from_velocity(vector![1.0, 0.0, 0.0, 0.0], vector![0.0, 0.5, 0.3, 1.0]).unwrap();
+    stepper
+        .start_from_velocity(vector![1.0, 0.0, 0.0, 0.0], vector![0.0, 0.5, 0.3, 1.0])
+        .unwrap();
     stepper.run(10).unwrap();
     assert!(stepper.constraint_violation() < 1e-12);
 }
