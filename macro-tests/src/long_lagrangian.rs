@@ -3,8 +3,8 @@
 //! is long) and evaluates to the value computed term by term in plain Rust, and its momentum
 //! ∂L/∂v (through the stepper's dual numbers) to the closed form. The build script writes the
 //! 10 000-term program, which `tests/expansions/main.rs` compiles and runs;
-//! `scripts/compile_times.sh` writes programs of 100, 1 000 and 10 000 terms (through
-//! `write_programs` there) to time their builds.
+//! `scripts/compile_times.sh` writes programs of 100, 1 000 and 10 000 terms (through the ignored
+//! test `write_programs` of `tests/ui.rs`) to time their builds.
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -29,7 +29,7 @@ fn lagrangian_term(i: usize) -> String {
 
 /// A program defining the model with `terms` terms and checking its Lagrangian and force at a
 /// point against the same sums evaluated in a loop.
-pub fn program(terms: usize) -> String {
+fn program(terms: usize) -> String {
     // A constant prefix before the first state-dependent term: the rewriter must reorder it.
     let mut lagrangian = String::from("0.5 - 0.25");
     let mut force = String::new();

@@ -27,3 +27,14 @@ fn ui() {
     };
     trybuild::TestCases::new().compile_fail("tests/ui/fail/*.rs");
 }
+
+/// For `scripts/compile_times.sh`: writes the programs for 100, 1 000 and 10 000 terms into
+/// `$DIRAC_PROGRAMS`.
+#[test]
+#[ignore = "run by scripts/compile_times.sh"]
+fn write_programs() {
+    let directory = std::env::var("DIRAC_PROGRAMS").expect("DIRAC_PROGRAMS names a directory");
+    for terms in [100, 1_000, 10_000] {
+        dirac_macro_tests::long_lagrangian::write_program(directory.as_ref(), terms).unwrap();
+    }
+}

@@ -1,7 +1,6 @@
 //! Checks the attribute and the struct, collecting every error with the span of the user's tokens.
 
 use std::borrow::Cow;
-use std::cell::RefCell;
 use std::collections::HashSet;
 
 use proc_macro2::{Span, TokenStream};
@@ -14,7 +13,7 @@ use crate::check::model::Model;
 use crate::internals::ast::{Arguments, Coordinate, Lagrangian, Length, Parameter, Shape};
 use crate::internals::errors::Errors;
 use crate::lower::expression::{
-    Context, Part, Rewriter, Scope, bounds, is_reserved, reserved_message,
+    Context, Hoisted, Rewriter, Scope, bounds, is_reserved, reserved_message,
 };
 use crate::lower::symbolic;
 use crate::lower::vector_algebra::{self, Algebra};
@@ -286,8 +285,7 @@ fn composite(
 /// Validates the arguments against the struct.
 pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     let mut errors = Errors::default();
-    let parts = RefCell::new(Vec::new());
-    let index_checks = RefCell::new(Vec::new());
+    let hoisted = Hoisted::default();
     repeated_attributes(&mut item, &mut errors);
     let mut e = entries(arguments, &mut errors);
     let krate = runtime_path(e.krate.take(), &mut errors);
@@ -313,7 +311,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     }
     let coordinates = match e.coordinates {
         Some((_, Some(list))) => {
-            check_coordinates(&list, &parameters, &item, &mut errors);
+            check_coordinates(&list, &parameters, &const_params, &mut errors);
             check_product(&list, e.holonomic.as_deref(), &mut errors);
             Some(list)
         }
@@ -385,7 +383,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 coordinates,
                 &parameters,
                 &const_params,
-                (&parts, &index_checks),
+                &hoisted,
                 rate,
                 &mut errors,
             );
@@ -445,8 +443,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 rate,
                 elsewhere: "",
                 context: Context::Positions,
-                parts: &parts,
-                index_checks: &index_checks,
+                hoisted: &hoisted,
                 atoms: product,
             };
             // On rotations and unit vectors, one-forms and forces are lowered to scalars first.
@@ -512,8 +509,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 rate,
                 elsewhere: "",
                 context: Context::Force,
-                parts: &parts,
-                index_checks: &index_checks,
+                hoisted: &hoisted,
                 atoms: product,
             };
             let forces = e
@@ -553,8 +549,8 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 inputs,
                 constraint_point,
                 closed_form,
-                parts: parts.into_inner(),
-                index_checks: index_checks.into_inner(),
+                parts: hoisted.parts.into_inner(),
+                index_checks: hoisted.index_checks.into_inner().into_values().collect(),
                 krate,
             }))
         }
@@ -662,7 +658,7 @@ fn lagrangian_of(
     coordinates: &[Coordinate],
     parameters: &[Parameter],
     const_params: &[Ident],
-    (parts, index_checks): (&RefCell<Vec<Part>>, &RefCell<Vec<TokenStream>>),
+    hoisted: &Hoisted,
     rate: &'static str,
     errors: &mut Errors,
 ) -> Option<Lagrangian> {
@@ -686,8 +682,7 @@ fn lagrangian_of(
         elsewhere: "; for other code write a generic function and give \
                     `lagrangian = path::to::function`",
         context: Context::Lagrangian,
-        parts,
-        index_checks,
+        hoisted,
         atoms: product,
     };
     let expr = match product {
@@ -792,7 +787,7 @@ fn check_product(coordinates: &[Coordinate], holonomic: Option<&[Expr]>, errors:
 fn check_coordinates(
     list: &[Coordinate],
     parameters: &[Parameter],
-    item: &syn::ItemStruct,
+    const_params: &[Ident],
     errors: &mut Errors,
 ) {
     let mut seen = HashSet::new();
@@ -820,7 +815,6 @@ fn check_coordinates(
         }
     }
     // A generic struct: the dimension must be one const parameter, not an expression of it.
-    let const_params = const_params(item);
     let generic_length = list.iter().find_map(|c| match &c.length {
         Some(Length::Named(n)) if const_params.contains(n) => Some(n.clone()),
         _ => None,

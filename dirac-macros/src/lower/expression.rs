@@ -9,6 +9,7 @@
 //! of the user's token it comes from, so type errors point at them.
 
 use std::cell::RefCell;
+use std::collections::BTreeMap;
 
 use proc_macro2::{Delimiter, Group, Literal, Span, TokenStream, TokenTree};
 use quote::{ToTokens, format_ident, quote, quote_spanned};
@@ -54,6 +55,15 @@ pub fn is_reserved(ident: &Ident) -> bool {
     ident.to_string().starts_with("__")
 }
 
+/// Whether `tokens`, groups included, hold an identifier `named` accepts.
+fn mentions(tokens: &TokenStream, named: &impl Fn(&Ident) -> bool) -> bool {
+    tokens.clone().into_iter().any(|t| match t {
+        TokenTree::Ident(i) => named(&i),
+        TokenTree::Group(g) => mentions(&g.stream(), named),
+        _ => false,
+    })
+}
+
 /// The error for a reserved name.
 pub fn reserved_message(ident: &Ident) -> String {
     format!("names starting with `__` are reserved for the generated code; rename `{ident}`")
@@ -87,14 +97,22 @@ pub struct Scope<'a> {
     pub elsewhere: &'static str,
     /// The generated method the expression is emitted into.
     pub context: Context,
-    /// The model's hoisted parts of long chains, shared by every expression of the model.
-    pub parts: &'a RefCell<Vec<Part>>,
-    /// Constant items asserting the model's indices that rustc checks (see
-    /// [`Rewriter::checked_index`]), shared by every expression of the model.
-    pub index_checks: &'a RefCell<Vec<TokenStream>>,
+    /// What the model's expressions hoist out of their methods.
+    pub hoisted: &'a Hoisted,
     /// Whether the expression was lowered from vectors and matrices (a model on rotations and
     /// unit vectors), so that its atoms are bound scalars (see `vector_algebra`).
     pub atoms: bool,
+}
+
+/// What a model's expressions hoist out of the methods they are emitted into, shared by every
+/// expression of the model.
+#[derive(Default)]
+pub struct Hoisted {
+    /// Continuations of long chains, each emitted as a method of its own.
+    pub parts: RefCell<Vec<Part>>,
+    /// Constant items asserting indices (see [`Rewriter::checked_index`]), emitted beside the
+    /// struct; keyed by their message, so that an index written many times is asserted once.
+    pub index_checks: RefCell<BTreeMap<String, TokenStream>>,
 }
 
 /// The generated method an expression is emitted into, which fixes what its hoisted parts are
@@ -452,14 +470,14 @@ impl<'a> Rewriter<'a> {
         }
     }
 
-    /// The tokens of `index` into the array `coordinate`, once [`index`](Self::index) accepted it.
-    /// A literal index into an array of literal length was checked here. Any other is checked by
-    /// rustc on the user's tokens: where neither the index nor the length names one of the
-    /// struct's const parameters (or `Self`), by a constant item pushed into the scope's `index_checks`
-    /// (emitted beside the struct, so that `cargo check` reports it: rustc's
-    /// `unconditional_panic` lint on an array index fires only when code is generated); else the
-    /// index goes through an array of the coordinate's length, which that lint rejects at build
-    /// time (and a run-time index would panic rather than land on another coordinate).
+    /// The tokens of `index` into the array `coordinate`, once [`index`](Self::index) accepted
+    /// it. A literal index into an array of literal length was checked by `index`; rustc checks
+    /// any other on the user's tokens (its `unconditional_panic` lint on an array index fires
+    /// only when code is generated, and not at all in generic code):
+    /// - where neither the index nor the length names one of the struct's const parameters or
+    ///   `Self`, a constant item beside the struct asserts the bound, so `cargo check` reports it;
+    /// - else an inline constant asserts it in the generated method, when the struct is used
+    ///   with its parameters (a build, not `cargo check`).
     pub fn checked_index(&self, coordinate: &Coordinate, index: &Expr) -> TokenStream {
         let Some(length) = &coordinate.length else {
             return index.to_token_stream();
@@ -469,44 +487,58 @@ impl<'a> Rewriter<'a> {
         }
         let (at, _) = bounds(index);
         let length = length.tokens();
-        // A const parameter, or an associated constant through `Self`, is out of a free item's
-        // reach.
-        let local = [index.to_token_stream(), length.clone()]
-            .into_iter()
-            .flatten()
-            .any(|t| {
-                matches!(&t, TokenTree::Ident(i) if i == "Self" || self.scope.const_params.contains(i))
-            });
-        if local {
-            return quote_spanned! {at=>
-                { let __k: usize = #index; let _: () = [(); #length][__k]; __k }
-            };
-        }
-        let compact = |tokens: TokenStream| tokens.to_string().replace(' ', "");
         let message = format!(
             "index `{}` is out of range: `{}` has `{}` elements",
-            compact(index.to_token_stream()),
+            index.to_token_stream(),
             coordinate.name,
-            compact(length.clone())
-        );
+            length
+        )
+        .replace('{', "{{")
+        .replace('}', "}}");
+        let assertion = quote_spanned!(at=> ::core::assert!((#index) < (#length), #message));
+        // A const parameter, or an associated constant through `Self`, is out of a free item's
+        // reach.
+        let local = |i: &Ident| i == "Self" || self.scope.const_params.contains(i);
+        if mentions(&index.to_token_stream(), &local) || mentions(&length, &local) {
+            return quote_spanned!(at=> { const { #assertion }; #index });
+        }
         self.scope
+            .hoisted
             .index_checks
             .borrow_mut()
-            .push(quote_spanned! {at=>
-                const _: () = ::core::assert!((#index) < (#length), #message);
-            });
+            .entry(message)
+            .or_insert_with(|| quote_spanned!(at=> const _: () = #assertion;));
         index.to_token_stream()
     }
 
+    /// `base[index]` for the element `ix` of the array `coordinate`, the index checked as by
+    /// [`checked_index`](Self::checked_index) and the brackets spanning the user's.
+    fn checked_element(
+        &self,
+        base: TokenStream,
+        coordinate: &Coordinate,
+        ix: &syn::ExprIndex,
+    ) -> TokenStream {
+        let mut bracket = Group::new(
+            Delimiter::Bracket,
+            self.checked_index(coordinate, &ix.index),
+        );
+        bracket.set_span(ix.bracket_token.span.join());
+        quote!(#base #bracket)
+    }
+
     /// Whether `expr` is an integer constant (integer literals, names that are not coordinates,
-    /// `+ - * / %`, unary minus, parentheses); reports `message` on it if not.
+    /// parameters or inputs, `+ - * / %`, unary minus, parentheses); reports `message` on it if
+    /// not.
     fn integer_constant(&mut self, expr: &Expr, message: &str) -> bool {
         let valid = subexpressions(expr).all(|e| match e {
             Expr::Lit(l) => matches!(&l.lit, Lit::Int(_)),
-            Expr::Path(p) => p
-                .path
-                .get_ident()
-                .is_none_or(|i| self.coordinate(i).is_none() && !is_reserved(i)),
+            Expr::Path(p) => p.path.get_ident().is_none_or(|i| {
+                self.coordinate(i).is_none()
+                    && !is_reserved(i)
+                    && !self.scope.fields.contains(i)
+                    && !self.scope.inputs.contains(i)
+            }),
             Expr::Paren(_) | Expr::Group(_) => true,
             Expr::Unary(u) => matches!(u.op, UnOp::Neg(_)),
             Expr::Binary(b) => matches!(
@@ -558,10 +590,8 @@ impl<'a> Rewriter<'a> {
                 if !self.index(coordinate, &ix.index) {
                     return Piece::invalid(ident.span());
                 }
-                let index = self.checked_index(coordinate, &ix.index);
-                let mut bracket = Group::new(Delimiter::Bracket, index);
-                bracket.set_span(ix.bracket_token.span.join());
-                Piece::atom(quote!(#velocity #bracket), Class::Dual, ident.span())
+                let element = self.checked_element(velocity.into_token_stream(), coordinate, ix);
+                Piece::atom(element, Class::Dual, ident.span())
             }
             (Some(_), None) => {
                 let message = format!("`{ident}` is a single coordinate, not an array");
@@ -817,20 +847,17 @@ impl<'a> Rewriter<'a> {
             return self.unsupported(expr);
         };
         let span = bounds(&ix.expr).0;
-        let class = match p.path.get_ident().and_then(|i| self.coordinate(i)) {
+        match p.path.get_ident().and_then(|i| self.coordinate(i)) {
             Some(coordinate) if coordinate.length.is_none() => {
                 let message = format!("`{}` is a single coordinate, not an array", coordinate.name);
-                return self.error_on(expr, message);
+                self.error_on(expr, message)
             }
             Some(coordinate) => {
                 if !self.index(coordinate, &ix.index) {
                     return Piece::invalid(span);
                 }
-                let index = self.checked_index(coordinate, &ix.index);
-                let mut bracket = Group::new(Delimiter::Bracket, index);
-                bracket.set_span(ix.bracket_token.span.join());
-                let base = &ix.expr;
-                return Piece::atom(quote!(#base #bracket), Class::Dual, span);
+                let element = self.checked_element(ix.expr.to_token_stream(), coordinate, ix);
+                Piece::atom(element, Class::Dual, span)
             }
             None => {
                 let reserved = |i: &&Ident| is_reserved(i) && !self.scope.fields.contains(i);
@@ -843,10 +870,9 @@ impl<'a> Rewriter<'a> {
                 ) {
                     return Piece::invalid(span);
                 }
-                Class::Constant
+                Piece::atom(ix.to_token_stream(), Class::Constant, span)
             }
-        };
-        Piece::atom(ix.to_token_stream(), class, span)
+        }
     }
 
     /// A binary operator other than `+ - * /`.
@@ -977,7 +1003,7 @@ impl Rewriter<'_> {
             Class::Constant => quote_spanned!(span=> f64),
         };
         let arguments = self.scope.context.arguments();
-        let mut parts = self.scope.parts.borrow_mut();
+        let mut parts = self.scope.hoisted.parts.borrow_mut();
         let mut chunks = sequence.chunks(CHUNK);
         let first = chunks.next().unwrap_or_default();
         let calls: Vec<TokenStream> = chunks
