@@ -129,7 +129,8 @@ fn chain_growth(c: &mut Criterion) {
 
 /// Constrained steps (midpoint, h = 0.01) beside the unconstrained double pendulum: the LC circuit
 /// (4 coordinates, 2 constant one-forms, KKT 6×6, its hidden constraint projected at each step's
-/// end), the knife edge (3 coordinates, one configuration-dependent one-form, KKT 4×4), and the
+/// end; linear, so one factorised Jacobian serves the run, and again with one per step), the
+/// knife edge (3 coordinates, one configuration-dependent one-form, KKT 4×4), and the
 /// Cartesian pendulum under SHAKE and RATTLE.
 fn constrained(c: &mut Criterion) {
     let mut group = c.benchmark_group("constrained_midpoint_step");
@@ -144,6 +145,22 @@ fn constrained(c: &mut Criterion) {
         .expect("consistent start");
     group.bench_function("lc_circuit", |b| {
         b.iter(|| black_box(lc.step()).expect("step"))
+    });
+    // The same steps with a Jacobian evaluated and factorised at each (Newton's method), against
+    // the one the linear circuit keeps by default.
+    let newton = NewtonOptions {
+        jacobian_reuse: Some(0.0),
+        ..Default::default()
+    };
+    let mut lc_newton = Stepper::new(scenes::circuit::LC, Quadrature::midpoint(), 0.01)
+        .expect("valid scene")
+        .with_newton_options(newton)
+        .expect("valid options");
+    lc_newton
+        .start_from_velocity(scenes::circuit::q0(), SVector::zeros())
+        .expect("consistent start");
+    group.bench_function("lc_circuit_jacobian_each_step", |b| {
+        b.iter(|| black_box(lc_newton.step()).expect("step"))
     });
     let mut knife =
         scenes::knife_edge::stepper(ConstraintPoint::Midpoint, 0.01).expect("valid scene");

@@ -23,6 +23,7 @@ mod interconnection;
 mod invariants;
 mod layers;
 mod lie_group;
+mod linear;
 mod modular;
 mod peers;
 mod rigid_components;

@@ -392,6 +392,11 @@ fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
             const SEPARABLE: bool = true;
         )
     });
+    let quadratic = closed.quadratic.then(|| {
+        quote!(
+            const QUADRATIC: bool = true;
+        )
+    });
     let any = closed.zeros.iter().flatten().flatten().any(|&zero| zero);
     let zeros = (closed.hessian.is_some() && any).then(|| {
         let [qq, qv, vv] = closed.zeros.clone().map(|block| {
@@ -406,6 +411,7 @@ fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
     quote! {
         #entire
         #separable
+        #quadratic
         #zeros
         #one_forms
 

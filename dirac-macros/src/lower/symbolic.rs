@@ -185,23 +185,24 @@ impl Graph {
         self.value(id) == Some(x)
     }
 
-    /// Whether `abs` or `signum` is applied to something that depends on a velocity (a kink
-    /// the closed-form derivatives step over).
-    fn kinks_in_velocity(&self) -> bool {
+    /// Whether `abs` or `signum` is applied to something that depends on a variable `of`
+    /// accepts (a kink the closed-form derivatives step over; variables `0..n` are positions,
+    /// `n..2n` velocities).
+    fn kinks(&self, of: impl Fn(usize) -> bool) -> bool {
         // Operands come before the nodes that use them: one pass in order.
-        let mut velocity = vec![false; self.nodes.len()];
+        let mut depends = vec![false; self.nodes.len()];
         for (id, node) in self.nodes.iter().enumerate() {
-            velocity[id] = match node {
+            depends[id] = match node {
                 Node::Number(_) | Node::Constant(_) => false,
-                Node::Variable(i) => *i >= self.n,
-                Node::Call(Function::Abs | Function::Signum, a) if velocity[*a] => return true,
-                Node::Neg(a) | Node::Call(_, a) | Node::Powi(a, _) => velocity[*a],
+                Node::Variable(i) => of(*i),
+                Node::Call(Function::Abs | Function::Signum, a) if depends[*a] => return true,
+                Node::Neg(a) | Node::Call(_, a) | Node::Powi(a, _) => depends[*a],
                 Node::Add(a, b)
                 | Node::Sub(a, b)
                 | Node::Mul(a, b)
                 | Node::Div(a, b)
                 | Node::Powf(a, b)
-                | Node::Atan2(a, b) => velocity[*a] || velocity[*b],
+                | Node::Atan2(a, b) => depends[*a] || depends[*b],
             };
         }
         false
@@ -874,6 +875,10 @@ pub struct ClosedForm {
     /// Whether `∂²L/∂q∂v` vanishes and `∂²L/∂v²` depends on nothing but numbers and parameters:
     /// `L = ½ vᵀ M v + bᵀ v − V(q)` with constant `M` and `b` (known with the Hessian).
     pub separable: bool,
+    /// Whether every second derivative depends on nothing but numbers and parameters and no
+    /// `abs` or `signum` reads the state: `L` is a quadratic polynomial in `(q, v)` (known with
+    /// the Hessian).
+    pub quadratic: bool,
 }
 
 /// Each coordinate's name, flat offset and literal length; `None` where a length is not a
@@ -947,6 +952,7 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
                     hessian: None,
                     zeros: Default::default(),
                     separable: false,
+                    quadratic: false,
                 });
             }
         }
@@ -989,12 +995,15 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
     // `abs` and `signum` of a velocity have derivatives that vanish almost everywhere but jump
     // (`c |v|` is linear in v on each side of 0 with a momentum offset that changes sign): not
     // separable, whatever the graph's second derivatives say.
-    let separable = !graph.kinks_in_velocity()
+    let separable = !graph.kinks(|i| i >= n)
         && second.iter().all(|&(i, j, id)| match (i < n, j < n) {
             (true, false) => graph.is(id, 0.0),
             (false, false) => !graph.state[id],
             _ => true,
         });
+    // Every second derivative free of the state, and no kink anywhere: `L` is a quadratic
+    // polynomial in `(q, v)`.
+    let quadratic = !graph.kinks(|_| true) && second.iter().all(|&(_, _, id)| !graph.state[id]);
     let zero = quote!(__dirac::nalgebra::SMatrix::<f64, #n, #n>::zeros());
     let hessian = quote! {
         #statements
@@ -1015,6 +1024,7 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
         hessian: Some(hessian),
         zeros,
         separable,
+        quadratic,
     })
 }
 

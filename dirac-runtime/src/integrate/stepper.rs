@@ -1298,6 +1298,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             NewtonReport::default()
         } else {
             self.newton.set_jacobian_cost(equations.jacobian_cost());
+            self.newton
+                .set_constant_jacobian(equations.constant_jacobian());
             let result = self.newton.solve(&mut self.unknowns, |x, r, j| {
                 equations.assemble(state, x, r, j)
             });

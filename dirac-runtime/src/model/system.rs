@@ -112,6 +112,30 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// ```
     const SEPARABLE: bool = false;
 
+    /// Whether `L` is a quadratic polynomial in `(q, v)`: every second derivative a constant
+    /// (circuits of linear elements, oscillators, linearised models). With constant one-forms,
+    /// no holonomic constraints and no forces the step equations are then linear with constant
+    /// coefficients, and a [`Stepper`](crate::Stepper) keeps their factorised Jacobian from one
+    /// step to the next rather than evaluating it at every step. `false` by default;
+    /// `#[dirac_system]` derives it from a Lagrangian written as an expression. A wrong claim
+    /// costs iterations, not accuracy: a kept Jacobian that is not the equations' converges
+    /// more slowly, and one that stops contracting is evaluated again.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Scalar};
+    /// use nalgebra::SVector;
+    /// /// An LC loop: inductor and capacitor on one charge.
+    /// struct Loop;
+    /// impl DiracSystem<1> for Loop {
+    ///     const QUADRATIC: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] * 0.5 - q[0] * q[0] * 0.5
+    ///     }
+    /// }
+    /// assert!(<Loop as DiracSystem<1>>::QUADRATIC);
+    /// ```
+    const QUADRATIC: bool = false;
+
     /// Whether the [`force`](Self::force) does not depend on the velocity: a function of the
     /// position, the time and the inputs alone (a potential force written as a force, a
     /// source, an actuator). The explicit step ([`Stepper::explicit`](crate::Stepper::explicit))

@@ -266,6 +266,9 @@ pub struct Newton<J: Jacobian = Dense> {
     jacobian_norm: f64,
     /// What an evaluation with the Jacobian costs, in evaluations of the residual alone.
     jacobian_cost: f64,
+    /// The equations are linear with constant coefficients (see
+    /// [`set_constant_jacobian`](Newton::set_constant_jacobian)).
+    constant_jacobian: bool,
     /// The factorisation a solve began with, kept aside while it evaluates its own: a failed
     /// solve puts it back, so that a failure changes nothing a later solve would see.
     kept: Kept<J>,
@@ -341,6 +344,7 @@ impl<J: Jacobian> Newton<J> {
             factorised: false,
             jacobian_norm: 0.0,
             jacobian_cost: 1.0,
+            constant_jacobian: false,
             parked: None,
             jacobian_at_root: false,
             iterate: DVector::zeros(n),
@@ -499,8 +503,16 @@ impl<J: Jacobian> Newton<J> {
         self.jacobian_cost = cost;
     }
 
+    /// Tells the solver that the equations are linear with constant coefficients (the same
+    /// Jacobian at every point and in every solve): by default it then keeps a factorised
+    /// Jacobian as long as it contracts by `max_contraction`.
+    pub(crate) fn set_constant_jacobian(&mut self, constant: bool) {
+        self.constant_jacobian = constant;
+    }
+
     /// The largest contraction ratio at which an earlier solve's Jacobian is kept: the option,
-    /// or, by default, none (Newton's method) where a Jacobian costs `c < 2` residuals and
+    /// or, by default, `max_contraction` for equations said linear, none (Newton's method)
+    /// where a Jacobian costs `c < 2` residuals and
     /// `exp(−20 / (c + 2))` otherwise (up to `max_contraction`). A solve that starts with a
     /// Jacobian of its own takes about `c + 2` residuals; one that keeps an older Jacobian
     /// contracting by `θ` takes about `ln(e₀/tol) / ln(1/θ)`, with `ln(e₀/tol) ≈ 20` from a
@@ -512,6 +524,7 @@ impl<J: Jacobian> Newton<J> {
         }
         let limit = match options.jacobian_reuse {
             Some(limit) => limit,
+            None if self.constant_jacobian => options.max_contraction,
             None if self.jacobian_cost < 2.0 => 0.0,
             None => (-20.0 / (self.jacobian_cost + 2.0)).exp(),
         };
@@ -713,13 +726,16 @@ impl<J: Jacobian> Newton<J> {
             // started from) below the step tolerance led to it, which leaves x about the square
             // of that step off (and that last step refines x: the midpoint rule keeps a stiff
             // spring's energy to round-off over 10⁶ steps only with it); or, with an older
-            // Jacobian (a linear rate), its own correction is at round-off.
+            // Jacobian (a linear rate), its own correction is at round-off. A kept Jacobian of
+            // linear equations is their Jacobian: as Newton's, its point is accepted only after
+            // a refining step (without it the stiff spring's energy drifts 20 times further).
             let round_off = round_off(amax(x));
+            let refined = previous.is_some_and(|before| before <= noise);
             let settled = at_x.residual == 0.0
                 || if current {
-                    previous.is_some_and(|before| before <= noise)
+                    refined
                 } else {
-                    update <= round_off
+                    update <= round_off && (refined || !self.constant_jacobian)
                 };
             if within && settled {
                 self.kept.pending = false;

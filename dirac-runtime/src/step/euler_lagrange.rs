@@ -1309,6 +1309,19 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         scale
     }
 
+    /// `L` quadratic with constant coefficients (`QUADRATIC`) on a translation chart, its
+    /// one-forms constant, and no holonomic constraint, force or coupling: every row is linear
+    /// in the unknowns with coefficients fixed by `h`.
+    fn constant_jacobian(&self) -> bool {
+        let system = self.discrete.system();
+        S::QUADRATIC
+            && C::TRANSLATION
+            && S::HOLONOMIC == 0
+            && !S::FORCES
+            && self.coupling.is_none()
+            && (0..S::ONE_FORMS).all(|a| system.one_form_is_constant(a))
+    }
+
     /// A Jacobian takes the hyper-dual Hessian of `L` (about `(N + 1)²` numbers per operation
     /// of `L`; three such passes per node beyond the midpoint rule) where the residual takes one
     /// or two first-order passes (`N + 1` numbers each): `(N + 1)/2` per pass is the cautious

@@ -182,6 +182,13 @@ pub trait StepEquations<const N: usize> {
         1.0
     }
 
+    /// Whether the equations are linear with constant coefficients, the same at every step (see
+    /// [`DiracSystem::QUADRATIC`](crate::DiracSystem::QUADRATIC)): Newton then keeps one
+    /// factorised Jacobian from step to step. `false` by default.
+    fn constant_jacobian(&self) -> bool {
+        false
+    }
+
     /// The state after the step from `state` solved by `x` (the point assembled last), without
     /// its time. `step` counts the steps before this one, for error messages.
     fn advance(
