@@ -3,8 +3,9 @@
 //! circuit) and steps as Newton's method does, to round-off; a wrong claim costs iterations,
 //! not accuracy.
 
+use dirac::StepEquations;
 use dirac::prelude::*;
-use scenes::{circuit, oscillator, pendulum};
+use scenes::{cartesian_pendulum, circuit, knife_edge, oscillator, pendulum};
 
 /// What the attribute declared: whether `S` is quadratic.
 fn quadratic<S: DiracSystem<N>, const N: usize>() -> bool {
@@ -20,6 +21,16 @@ struct Kinked {
 #[dirac_system(coordinates(x, y), lagrangian = 0.5 * dot(x) * dot(y) + 2.0 * x * y - x + 3.0)]
 struct Mixed;
 
+/// A damped oscillator: quadratic, but forced.
+#[dirac_system(
+    coordinates(x),
+    lagrangian = 0.5 * dot(x).powi(2) - 0.5 * x * x,
+    forces(-c * dot(x) * dx),
+)]
+struct Damped {
+    c: f64,
+}
+
 #[test]
 fn the_attribute_says_which_lagrangians_are_quadratic() {
     assert!(quadratic::<circuit::LcCircuit, 4>());
@@ -28,6 +39,24 @@ fn the_attribute_says_which_lagrangians_are_quadratic() {
     assert!(!quadratic::<pendulum::Pendulum, 1>());
     // |x| has no second derivative to speak of, but it is not a polynomial.
     assert!(!quadratic::<Kinked, 1>());
+}
+
+/// Only linear step equations keep their Jacobian: a quadratic `L` with constant one-forms and
+/// nothing else.
+#[test]
+fn only_linear_step_equations_say_their_jacobian_is_constant() {
+    let lc = Stepper::new(circuit::LC, Quadrature::midpoint(), 0.01).unwrap();
+    assert!(lc.equations().constant_jacobian());
+    let damped = Stepper::new(Damped { c: 0.1 }, Quadrature::midpoint(), 0.01).unwrap();
+    assert!(quadratic::<Damped, 1>() && !damped.equations().constant_jacobian());
+    // A one-form of the position (the knife edge's heading), a holonomic constraint, and a
+    // Lagrangian that is not quadratic.
+    let knife = knife_edge::stepper(ConstraintPoint::Midpoint, 0.01).unwrap();
+    assert!(!knife.equations().constant_jacobian());
+    let held = Stepper::new(cartesian_pendulum::SCENE, Quadrature::midpoint(), 0.01).unwrap();
+    assert!(!held.equations().constant_jacobian());
+    let swing = Stepper::new(pendulum::SCENE, Quadrature::midpoint(), 0.01).unwrap();
+    assert!(!swing.equations().constant_jacobian());
 }
 
 /// The LC circuit over 1 000 steps of `quadrature`: its positions, and the Jacobians evaluated

@@ -366,6 +366,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     pub fn with_constraint_point(mut self, point: ConstraintPoint) -> Self {
         self.settle_violation();
         self.equations.set_constraint_point(point);
+        // The constraint rows change: a Jacobian kept for linear equations no longer fits.
+        self.newton.forget_jacobian();
         self
     }
 

@@ -113,13 +113,14 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     const SEPARABLE: bool = false;
 
     /// Whether `L` is a quadratic polynomial in `(q, v)`: every second derivative a constant
-    /// (circuits of linear elements, oscillators, linearised models). With constant one-forms,
-    /// no holonomic constraints and no forces the step equations are then linear with constant
-    /// coefficients, and a [`Stepper`](crate::Stepper) keeps their factorised Jacobian from one
-    /// step to the next rather than evaluating it at every step. `false` by default;
+    /// (circuits of linear elements, oscillators, linearised models). On `Rⁿ`, with constant
+    /// one-forms, no holonomic constraints and no forces, the step equations are then linear with
+    /// constant coefficients, and a [`Stepper`](crate::Stepper) keeps their factorised Jacobian
+    /// from one step to the next rather than evaluating it at every step. `false` by default;
     /// `#[dirac_system]` derives it from a Lagrangian written as an expression. A wrong claim
-    /// costs iterations, not accuracy: a kept Jacobian that is not the equations' converges
-    /// more slowly, and one that stops contracting is evaluated again.
+    /// never gives a wrong answer: a kept Jacobian that is not the equations' is evaluated
+    /// again where it contracts too slowly, and a solve that still cannot converge fails as
+    /// any other.
     ///
     /// ```
     /// use dirac_runtime::{DiracSystem, Scalar};

@@ -63,7 +63,8 @@ pub struct NewtonOptions {
     /// Largest contraction ratio at which a Jacobian evaluated at an earlier iterate, or in an
     /// earlier solve, is kept (simplified Newton), in `[0, 1]` (above `max_contraction` it acts
     /// as `max_contraction`); `Some(0.0)` evaluates it at every iteration (Newton's method).
-    /// `None` (the default) decides from what a Jacobian costs against a residual alone (see
+    /// `None` (the default) decides from what a Jacobian costs against a residual alone, and
+    /// keeps one for step equations that are linear with constant coefficients (see
     /// [`Newton::solve`]).
     pub jacobian_reuse: Option<f64>,
 }
@@ -505,14 +506,16 @@ impl<J: Jacobian> Newton<J> {
 
     /// Tells the solver that the equations are linear with constant coefficients (the same
     /// Jacobian at every point and in every solve): by default it then keeps a factorised
-    /// Jacobian as long as it contracts by `max_contraction`.
+    /// Jacobian however cheap one is, for as long as it contracts as the cost rule asks (a
+    /// linear system's own Jacobian contracts to round-off), and accepts a point only after a
+    /// refining update, as Newton's method does.
     pub(crate) fn set_constant_jacobian(&mut self, constant: bool) {
         self.constant_jacobian = constant;
     }
 
     /// The largest contraction ratio at which an earlier solve's Jacobian is kept: the option,
-    /// or, by default, `max_contraction` for equations said linear, none (Newton's method)
-    /// where a Jacobian costs `c < 2` residuals and
+    /// or, by default, none (Newton's method) where a Jacobian costs `c < 2` residuals and the
+    /// equations are not said linear, and
     /// `exp(−20 / (c + 2))` otherwise (up to `max_contraction`). A solve that starts with a
     /// Jacobian of its own takes about `c + 2` residuals; one that keeps an older Jacobian
     /// contracting by `θ` takes about `ln(e₀/tol) / ln(1/θ)`, with `ln(e₀/tol) ≈ 20` from a
@@ -524,8 +527,7 @@ impl<J: Jacobian> Newton<J> {
         }
         let limit = match options.jacobian_reuse {
             Some(limit) => limit,
-            None if self.constant_jacobian => options.max_contraction,
-            None if self.jacobian_cost < 2.0 => 0.0,
+            None if self.jacobian_cost < 2.0 && !self.constant_jacobian => 0.0,
             None => (-20.0 / (self.jacobian_cost + 2.0)).exp(),
         };
         limit.min(options.max_contraction)
@@ -648,7 +650,8 @@ impl<J: Jacobian> Newton<J> {
     /// **Jacobians.** The closure is asked for the Jacobian (`Some`) only when one is due; with
     /// `None` it fills the residual alone. Where the reuse limit is 0
     /// ([`jacobian_reuse`](NewtonOptions::jacobian_reuse), or by default a Jacobian that costs
-    /// less than two residuals) every evaluation brings its Jacobian: Newton's method. Otherwise
+    /// less than two residuals, unless the equations are linear with constant coefficients)
+    /// every evaluation brings its Jacobian: Newton's method. Otherwise
     /// the factorised Jacobian is kept across iterations and across solves (simplified Newton:
     /// the solves of successive steps are nearby problems). A solve evaluates its own at its
     /// start when the last solve found the kept one contracting by more than the limit (or there
