@@ -15,8 +15,7 @@ mod runtime_path;
 mod scalar_coordinates;
 mod subsystems;
 
-/// A model with a 10 000-term Lagrangian and force (the program of
-/// `dirac_macro_tests::long_lagrangian`, written by the build script).
+/// A model with a 10 000-term Lagrangian and force (the program the build script writes).
 mod long_lagrangian {
     include!(concat!(env!("OUT_DIR"), "/terms_10000.rs"));
 
