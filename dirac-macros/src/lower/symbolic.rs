@@ -332,6 +332,12 @@ impl Graph {
         self.intern(Node::Div(a, b))
     }
 
+    /// `1/a`, one node for every use.
+    fn reciprocal(&mut self, a: Id) -> Id {
+        let one = self.number(1.0);
+        self.div(one, a)
+    }
+
     fn neg(&mut self, a: Id) -> Id {
         match self.nodes[a] {
             Node::Number(bits) => self.number(-f64::from_bits(bits)),
@@ -381,11 +387,14 @@ impl Graph {
                 self.add(l, r)
             }
             Node::Div(x, y) => {
-                // (x/y)' = x'/y − (x/y) y'/y
+                // (x/y)' = x' r − (x r)(y' r) with r = 1/y: one division for every derivative of
+                // every order (the node `1/y` is shared), where x'/y − (x/y) y'/y takes one for
+                // each variable. The value x/y keeps the user's division.
                 let (dx, dy) = (self.derivative(x, var), self.derivative(y, var));
-                let l = self.div(dx, y);
-                let ratio = self.div(dy, y);
-                let r = self.mul(a, ratio);
+                let r = self.reciprocal(y);
+                let l = self.mul(dx, r);
+                let (xr, dyr) = (self.mul(x, r), self.mul(dy, r));
+                let r = self.mul(xr, dyr);
                 self.sub(l, r)
             }
             Node::Neg(x) => {
@@ -509,8 +518,10 @@ impl Graph {
                 self.div(one, u)
             }
             Function::Sqrt => {
+                // ½ (1/√x): the reciprocal a quotient by √x shares.
                 let half = self.number(0.5);
-                self.div(half, fx)
+                let r = self.reciprocal(fx);
+                self.mul(half, r)
             }
             Function::Cbrt => {
                 let three = self.number(3.0);

@@ -1291,6 +1291,15 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let Some(state) = &self.state else {
             return Err(DiracError::NotStarted);
         };
+        if let Some(taken) = self.equations.explicit_step(state, self.steps) {
+            let (mut next, work) = taken?;
+            next.t = self.start + (self.steps + 1) as f64 * self.equations.h();
+            return Ok(Proposal {
+                next,
+                report: NewtonReport::default(),
+                work,
+            });
+        }
         // The last solutions extrapolated (see `predictor`).
         let predictor = self.predictor.predict();
         let equations = &mut self.equations;

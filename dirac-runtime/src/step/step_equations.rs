@@ -198,6 +198,21 @@ pub trait StepEquations<const N: usize> {
         step: u64,
     ) -> Result<State<N, Self::Manifold>, DiracError>;
 
+    /// The step from `state` taken in closed form, where the equations have no unknowns: the
+    /// state [`advance`](Self::advance) would return after [`predict`](Self::predict), with the
+    /// step's [`work`](Self::work), or the error `advance` would give. The stepper then takes
+    /// no predictor and keeps no proposal (an explicit step costs its arithmetic). `None`, the
+    /// default: the step is predicted, solved and advanced.
+    #[allow(clippy::type_complexity)]
+    fn explicit_step(
+        &mut self,
+        state: &State<N, Self::Manifold>,
+        step: u64,
+    ) -> Option<Result<(State<N, Self::Manifold>, Option<StepWork<N>>), DiracError>> {
+        let _ = (state, step);
+        None
+    }
+
     /// The constraint violation of the step from `from` to `to` that `x` solved (`to` as
     /// [`advance`](Self::advance) returned it): 0 for equations without constraints. A
     /// [`Stepper`](crate::Stepper) measures it only when asked

@@ -37,7 +37,6 @@ use crate::model::legendre;
 use crate::model::system::DiracSystem;
 use crate::quadrature::Quadrature;
 use crate::solve::newton::{Newton, NewtonFailure};
-use crate::space::configuration_space::compensated_add;
 use crate::space::manifold::Vectors;
 use crate::step::composition::Composition;
 use crate::step::dense_output::Sample;
@@ -98,6 +97,19 @@ struct Kinetic<const N: usize> {
     mass: SMatrix<f64, N, N>,
     inverse_mass: SMatrix<f64, N, N>,
     offset: SVector<f64, N>,
+    /// `M = I` and `b = 0` exactly: `v = p`.
+    unit: bool,
+}
+
+impl<const N: usize> Kinetic<N> {
+    /// `v = M⁻¹ (p − b)`.
+    #[inline]
+    fn velocity(&self, p: &SVector<f64, N>) -> SVector<f64, N> {
+        match self.unit {
+            true => *p,
+            false => self.inverse_mass * (p - self.offset),
+        }
+    }
 }
 
 impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
@@ -266,6 +278,7 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
                 ))
             })?;
         Ok(Kinetic {
+            unit: mass == SMatrix::<f64, N, N>::identity() && offset == SVector::<f64, N>::zeros(),
             mass,
             inverse_mass,
             offset,
@@ -273,7 +286,8 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
     }
 
     /// The step from `state` with the run's kinetic terms, starting from the gradient `first`
-    /// at `state.q` where it is known.
+    /// at `state.q` where it is known. The last half kick of a stage and the first of the next
+    /// act at the same point: they are one kick `(γ_i + γ_{i+1}) h/2`.
     fn take_step(
         &self,
         state: &State<N>,
@@ -281,17 +295,27 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
         first: Option<SVector<f64, N>>,
     ) -> Taken<N> {
         let h = self.discrete.h();
+        let coefficients = self.composition.coefficients();
         let mut next = *state;
         let mut g = first.unwrap_or_else(|| self.gradient(&state.q));
         let mut t = state.t;
         let mut force = self.force(&state.q, t);
         let mut work = SVector::zeros();
-        for &gamma in self.composition.coefficients() {
-            let half = 0.5 * gamma * h;
-            compensated_add(&mut next.p, &mut next.p_carry, &((g + force) * half));
-            let v = kinetic.inverse_mass * (next.p - kinetic.offset);
-            let increment = v * (gamma * h);
-            compensated_add(&mut next.q, &mut next.q_carry, &increment);
+        // `∂L/∂q + F`: the force's zeros are not added where there is none.
+        let pull = |g: &SVector<f64, N>, force: &SVector<f64, N>| match S::FORCES {
+            true => g + force,
+            false => *g,
+        };
+        // Within the step each sum is held in two parts, `x + lo` (the state's carry is `−lo`):
+        // the rounding error of every addition into `x` is found exactly (TwoSum) and gathered
+        // in `lo`, folded back at the step's end. On the chain from one stage's gradient to the
+        // next there is then one addition per sum, where compensating each addition puts two.
+        let (mut p_lo, mut q_lo) = (-next.p_carry, -next.q_carry);
+        let mut kick = 0.5 * coefficients[0] * h;
+        for (i, &gamma) in coefficients.iter().enumerate() {
+            two_sum_add(&mut next.p, &mut p_lo, &(pull(&g, &force) * kick));
+            let increment = kinetic.velocity(&next.p) * (gamma * h);
+            two_sum_add(&mut next.q, &mut q_lo, &increment);
             t += gamma * h;
             g = self.gradient(&next.q);
             if S::FORCES {
@@ -299,14 +323,32 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
                 work += ((force + end) * 0.5).component_mul(&increment);
                 force = end;
             }
-            compensated_add(&mut next.p, &mut next.p_carry, &((g + force) * half));
+            kick = match coefficients.get(i + 1) {
+                Some(&following) => 0.5 * gamma * h + 0.5 * following * h,
+                None => 0.5 * gamma * h,
+            };
         }
-        next.velocity = kinetic.inverse_mass * (next.p - kinetic.offset);
+        two_sum_add(&mut next.p, &mut p_lo, &(pull(&g, &force) * kick));
+        (next.p, next.p_carry) = folded(&next.p, &p_lo);
+        (next.q, next.q_carry) = folded(&next.q, &q_lo);
+        next.velocity = kinetic.velocity(&next.p);
         Taken {
             next,
             gradient: g,
             work,
         }
+    }
+
+    /// `next` where its position and momentum are finite, else the error naming the first
+    /// coordinate that is not.
+    fn finite(&self, next: State<N>, step: u64) -> Result<State<N>, DiracError> {
+        for (what, x) in [("position", &next.q), ("momentum", &next.p)] {
+            // The message is written only for a step that left the finite numbers.
+            if !x.iter().all(|v| v.is_finite()) {
+                check_finite(self.system(), &format!("the {what} after step {step}"), x)?;
+            }
+        }
+        Ok(next)
     }
 
     /// The step from `state`: the one [`predict`](StepEquations::predict) took, or taken again.
@@ -324,6 +366,34 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
             None => self.kinetic(&state.q, &state.velocity),
         }
     }
+}
+
+/// `x += increment` with the rounding error of each component's addition added to `lo`
+/// (Knuth's TwoSum: `x_new + e = x + increment` exactly).
+#[inline(always)]
+fn two_sum_add<const N: usize>(
+    x: &mut SVector<f64, N>,
+    lo: &mut SVector<f64, N>,
+    increment: &SVector<f64, N>,
+) {
+    for i in 0..N {
+        let (a, b) = (x[i], increment[i]);
+        let sum = a + b;
+        let b_part = sum - a;
+        lo[i] += (a - (sum - b_part)) + (b - b_part);
+        x[i] = sum;
+    }
+}
+
+/// `x + lo` as a rounded sum and the carry of a compensated sum (the sum's excess over
+/// `x + lo`, which the next addition takes back, as a Kahan sum does).
+fn folded<const N: usize>(
+    x: &SVector<f64, N>,
+    lo: &SVector<f64, N>,
+) -> (SVector<f64, N>, SVector<f64, N>) {
+    let (mut sum, mut error) = (*x, SVector::zeros());
+    two_sum_add(&mut sum, &mut error, lo);
+    (sum, -error)
 }
 
 impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
@@ -415,14 +485,32 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
         _x: &DVector<f64>,
         step: u64,
     ) -> Result<State<N>, DiracError> {
-        let next = self.taken(state)?.next;
-        for (what, x) in [("position", &next.q), ("momentum", &next.p)] {
-            // The message is written only for a step that left the finite numbers.
-            if !x.iter().all(|v| v.is_finite()) {
-                check_finite(self.system(), &format!("the {what} after step {step}"), x)?;
-            }
-        }
-        Ok(next)
+        self.finite(self.taken(state)?.next, step)
+    }
+
+    /// The step in closed form: the same step as [`predict`](Self::predict) then
+    /// [`advance`](Self::advance), with its work.
+    fn explicit_step(
+        &mut self,
+        state: &State<N>,
+        step: u64,
+    ) -> Option<Result<(State<N>, Option<StepWork<N>>), DiracError>> {
+        let kinetic = match self.kinetic_at(state) {
+            Ok(kinetic) => kinetic,
+            Err(error) => return Some(Err(error)),
+        };
+        let first = self.memo.filter(|(q, _)| *q == state.q).map(|(_, g)| g);
+        let taken = self.take_step(state, &kinetic, first);
+        let next = match self.finite(taken.next, step) {
+            Ok(next) => next,
+            Err(error) => return Some(Err(error)),
+        };
+        self.memo = Some((next.q, taken.gradient));
+        let work = StepWork {
+            forces: taken.work,
+            constraints: Some(SVector::zeros()),
+        };
+        Some(Ok((next, Some(work))))
     }
 
     fn violation(&self, _from: &State<N>, _to: &State<N>, _x: &DVector<f64>) -> f64 {
