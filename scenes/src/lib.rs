@@ -32,6 +32,7 @@ pub mod rigid_chain;
 pub mod rlc_ladder;
 pub mod rolling_ball;
 pub mod rolling_disk;
+pub mod roundoff;
 pub mod satellite;
 pub mod shafted_body;
 pub mod spherical_pendulum;

@@ -27,6 +27,7 @@ mod linear;
 mod modular;
 mod peers;
 mod rigid_components;
+mod roundoff;
 mod run;
 mod step_derivatives;
 mod step_equations;

@@ -66,6 +66,24 @@ struct NodeWeights {
     d: [f64; MAX_DEGREE + 1],
     /// No zero among `a[0], a[1], d[0], d[1]`: a degree-1 step's seeds take plain products.
     pair_without_zeros: bool,
+    /// With internal points, what rounding left of row 0's weights `a[0] = 1 − Σ_{j≥1} a[j]`
+    /// and `d[0] = −Σ_{j≥1} d[j]` (zero for a degree-1 step, whose weights are exact).
+    a0_rest: f64,
+    d0_rest: f64,
+}
+
+/// `first + Σ terms` summed in two parts (each addition's rounding error kept), as the
+/// rounded sum and its remainder: `sum + rest` is the exact sum to far below an ulp of `sum`.
+fn rounded_sum(first: f64, terms: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (mut sum, mut error) = (first, 0.0);
+    for term in terms {
+        let next = sum + term;
+        let part = next - sum;
+        error += (sum - (next - part)) + (term - part);
+        sum = next;
+    }
+    let rounded = sum + error;
+    (rounded, (sum - rounded) + error)
 }
 
 impl NodeWeights {
@@ -198,10 +216,21 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                     a: [0.0; MAX_DEGREE + 1],
                     d: [0.0; MAX_DEGREE + 1],
                     pair_without_zeros: false,
+                    a0_rest: 0.0,
+                    d0_rest: 0.0,
                 };
                 for j in 0..=s {
                     node.a[j] = quadrature.ell(i, j);
                     node.d[j] = quadrature.ell_prime(i, j) / h;
+                }
+                if s > 1 {
+                    // The path in the chart at `q_k` is `q_k + Σ_{j≥1} a_j ξ_j`: its derivative
+                    // in `q_k` weighs the node by `1 − Σ_{j≥1} a_j` and `−Σ_{j≥1} d_j`, not by
+                    // the basis at point 0 evaluated apart (a few ulps off them). Row 0 takes
+                    // those weights, rounded, and what rounding left of them: the step is then
+                    // the flow of the discrete Lagrangian it evaluates.
+                    (node.a[0], node.a0_rest) = rounded_sum(1.0, node.a[1..=s].iter().map(|a| -a));
+                    (node.d[0], node.d0_rest) = rounded_sum(0.0, node.d[1..=s].iter().map(|d| -d));
                 }
                 node.pair_without_zeros =
                     ![node.a[0], node.a[1], node.d[0], node.d[1]].contains(&0.0);
@@ -547,6 +576,11 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         };
         for (row, (&a, &d)) in sums.rows[..s].iter_mut().zip(a.iter().zip(d)) {
             *row += (lq * a + lv * d) * w;
+        }
+        if s > 1 {
+            // Below an ulp of the row's terms: it moves the row's rounding on average only,
+            // which is what keeps the energy's round-off from drifting (examples/brouwer.rs).
+            sums.rows[0] += (lq * node.a0_rest + lv * node.d0_rest) * w;
         }
     }
 

@@ -1,0 +1,96 @@
+//! Brouwer's law on Kepler's problem (e = 0.5): where the method's own energy error is far below
+//! round-off, what is left of the energy error in a long run is round-off, and with compensated
+//! sums it should grow like a random walk, `√t`, not like `t`.
+//!
+//! The energy error of one run is one walk; the law is a statement about their spread. An
+//! ensemble of runs whose starts differ only by a rotation of the orbit (the same energy and
+//! the same exact motion, turned; different roundings) gives the root mean square of `E − E_0`
+//! at checkpoints spaced evenly in `log t`, and a least-squares line through
+//! `(log t, log rms)` its exponent.
+
+use dirac::nalgebra::Matrix2;
+use dirac::prelude::*;
+use dirac::{StepEquations, Vectors};
+use rayon::prelude::*;
+
+use super::kepler;
+
+/// Kepler's start turned by `angle` about the origin: the same orbit, rotated.
+pub fn turned_start(angle: f64) -> (SVector<f64, 2>, SVector<f64, 2>) {
+    let turn = Matrix2::new(angle.cos(), -angle.sin(), angle.sin(), angle.cos());
+    (turn * kepler::q0(), turn * kepler::p0())
+}
+
+/// Step counts spaced evenly in `log n`, `per_decade` to a decade, from `first` to `last`.
+pub fn checkpoints(first: u64, last: u64, per_decade: u32) -> Vec<u64> {
+    let (a, b) = ((first as f64).log10(), (last as f64).log10());
+    let count = ((b - a) * f64::from(per_decade)).round() as u32;
+    let mut steps: Vec<u64> = (0..=count)
+        .map(|k| 10f64.powf(a + (b - a) * f64::from(k) / f64::from(count.max(1))))
+        .map(|n| n.round() as u64)
+        .collect();
+    steps.dedup();
+    steps
+}
+
+/// The root mean square of `E(t_n) − E(0)` at the step counts `at` over `runs` runs from turned
+/// starts (angles spread over the circle), run in parallel: `(t_n, rms)` pairs. `started` builds
+/// a stepper started from a `(q0, p0)`.
+pub fn rms_energy_error<E, F>(
+    started: F,
+    runs: usize,
+    at: &[u64],
+) -> Result<Vec<(f64, f64)>, DiracError>
+where
+    E: StepEquations<2, System = kepler::Kepler, Manifold = Vectors> + Send,
+    F: Fn(SVector<f64, 2>, SVector<f64, 2>) -> Result<Stepper<kepler::Kepler, 2, E>, DiracError>
+        + Sync,
+{
+    let walks: Vec<Vec<f64>> = (0..runs)
+        .into_par_iter()
+        .map(|run| {
+            // Turns of an irrational fraction of the circle: no two starts alike.
+            let angle = std::f64::consts::TAU * (run as f64 * 0.618_033_988_749_895).fract();
+            let (q0, p0) = turned_start(angle);
+            let mut stepper = started(q0, p0)?;
+            let e0 = stepper.energy()?;
+            let mut errors = Vec::with_capacity(at.len());
+            for &n in at {
+                while stepper.steps() < n {
+                    stepper.step()?;
+                }
+                errors.push(stepper.energy()? - e0);
+            }
+            Ok(errors)
+        })
+        .collect::<Result<_, DiracError>>()?;
+    let h = {
+        let (q0, p0) = turned_start(0.0);
+        started(q0, p0)?.h()
+    };
+    Ok(at
+        .iter()
+        .enumerate()
+        .map(|(k, &n)| {
+            let mean_square = walks.iter().map(|w| w[k] * w[k]).sum::<f64>() / runs as f64;
+            (n as f64 * h, mean_square.sqrt())
+        })
+        .collect())
+}
+
+/// The slope of the least-squares line through `(log t, log e)`: the exponent `α` of `e ∝ t^α`.
+pub fn exponent(points: &[(f64, f64)]) -> f64 {
+    let logs: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(_, e)| *e > 0.0)
+        .map(|&(t, e)| (t.ln(), e.ln()))
+        .collect();
+    let n = logs.len() as f64;
+    let (mx, my) = (
+        logs.iter().map(|p| p.0).sum::<f64>() / n,
+        logs.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let sxy: f64 = logs.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = logs.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
+    sxy / sxx
+}
