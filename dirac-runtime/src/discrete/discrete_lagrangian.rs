@@ -58,7 +58,9 @@ pub struct DiscreteLagrangian<S, const N: usize, C = Euclidean> {
 }
 
 /// Node `i` of a step of degree `s`: its weight `w = h b_i`, the path's basis
-/// `a[j] = ℓ_j(c_i)` and its rates `d[j] = ℓ'_j(c_i)/h` (`j = 0..=s`; zero beyond).
+/// `a[j] = ℓ_j(c_i)` and its rates `d[j] = ℓ'_j(c_i)/h` (`j = 0..=s`; zero beyond), where with
+/// internal points row 0's `a[0]` and `d[0]` are `1 − Σ_{j≥1} a[j]` and `−Σ_{j≥1} d[j]` (see
+/// `DiscreteLagrangian::on_space`).
 #[derive(Debug, Clone, Copy)]
 struct NodeWeights {
     w: f64,
@@ -67,7 +69,9 @@ struct NodeWeights {
     /// No zero among `a[0], a[1], d[0], d[1]`: a degree-1 step's seeds take plain products.
     pair_without_zeros: bool,
     /// With internal points, what rounding left of row 0's weights `a[0] = 1 − Σ_{j≥1} a[j]`
-    /// and `d[0] = −Σ_{j≥1} d[j]` (zero for a degree-1 step, whose weights are exact).
+    /// and `d[0] = −Σ_{j≥1} d[j]`; zero for a degree-1 step. The midpoint and trapezoidal
+    /// rules' weights are exact; a degree-1 step on several Gauss nodes keeps the basis at
+    /// point 0, a few ulps off (its round-off is not measured for drift).
     a0_rest: f64,
     d0_rest: f64,
 }

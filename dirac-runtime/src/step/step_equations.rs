@@ -79,8 +79,9 @@ impl<const N: usize> std::ops::Add for StepWork<N> {
 /// [`Stepper`](crate::Stepper) drives any implementation ([`Stepper::with_equations`]) with the
 /// same Newton solve, error handling, trajectories and guarantees (a failed step changes
 /// nothing). `tests/suite/step_equations.rs` drives the implicit midpoint rule of a Hamiltonian this
-/// way. The guarantee holds as long as `predict` and `assemble` keep only per-step scratch in
-/// `&mut self`: anything that must survive a step belongs in the [`State`].
+/// way. The guarantee holds as long as `predict`, `assemble` and `explicit_step` keep only
+/// per-step scratch (or caches keyed by the state) in `&mut self`: anything that must survive a
+/// step belongs in the [`State`].
 ///
 /// [`Stepper::with_equations`]: crate::Stepper::with_equations
 pub trait StepEquations<const N: usize> {
@@ -198,11 +199,12 @@ pub trait StepEquations<const N: usize> {
         step: u64,
     ) -> Result<State<N, Self::Manifold>, DiracError>;
 
-    /// The step from `state` taken in closed form, where the equations have no unknowns: the
-    /// state [`advance`](Self::advance) would return after [`predict`](Self::predict), with the
+    /// The step from `state` taken in closed form, for equations without unknowns: the state
+    /// [`advance`](Self::advance) would return after [`predict`](Self::predict), with the
     /// step's [`work`](Self::work), or the error `advance` would give. The stepper then takes
     /// no predictor and keeps no proposal (an explicit step costs its arithmetic). `None`, the
-    /// default: the step is predicted, solved and advanced.
+    /// default: the step is predicted, solved and advanced. The stepper asks for it first, so
+    /// equations with unknowns keep the default.
     #[allow(clippy::type_complexity)]
     fn explicit_step(
         &mut self,

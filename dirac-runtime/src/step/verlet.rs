@@ -316,6 +316,11 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
             two_sum_add(&mut next.p, &mut p_lo, &(pull(&g, &force) * kick));
             let increment = kinetic.velocity(&next.p) * (gamma * h);
             two_sum_add(&mut next.q, &mut q_lo, &increment);
+            if i + 1 == coefficients.len() {
+                // The end position is the state's: the gradient and force carried to the next
+                // step's first kick are taken at it, so a step depends on its state alone.
+                (next.q, next.q_carry) = folded(&next.q, &q_lo);
+            }
             t += gamma * h;
             g = self.gradient(&next.q);
             if S::FORCES {
@@ -330,7 +335,6 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
         }
         two_sum_add(&mut next.p, &mut p_lo, &(pull(&g, &force) * kick));
         (next.p, next.p_carry) = folded(&next.p, &p_lo);
-        (next.q, next.q_carry) = folded(&next.q, &q_lo);
         next.velocity = kinetic.velocity(&next.p);
         Taken {
             next,
