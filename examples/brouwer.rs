@@ -69,11 +69,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let composition = Composition::kahan_li_8();
     let start = Instant::now();
     let points = rms_energy_error(
-        |q0, p0| {
-            let mut stepper = Stepper::explicit(kepler::SCENE, composition.clone(), h)?;
-            stepper.start_from_momentum(q0, p0)?;
-            Ok(stepper)
-        },
+        || Stepper::explicit(kepler::SCENE, composition.clone(), h),
         runs,
         &checkpoints(100, steps, per_decade as u32),
     )?;
@@ -86,11 +82,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let gauss = Quadrature::galerkin(4)?;
         let start = Instant::now();
         let points = rms_energy_error(
-            |q0, p0| {
-                let mut stepper = Stepper::new(kepler::SCENE, gauss.clone(), h)?;
-                stepper.start_from_momentum(q0, p0)?;
-                Ok(stepper)
-            },
+            || Stepper::new(kepler::SCENE, gauss.clone(), h),
             runs,
             &checkpoints(100, implicit_steps, per_decade as u32),
         )?;

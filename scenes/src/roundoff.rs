@@ -34,17 +34,16 @@ pub fn checkpoints(first: u64, last: u64, per_decade: u32) -> Vec<u64> {
 }
 
 /// The root mean square of `E(t_n) − E(0)` at the step counts `at` over `runs` runs from turned
-/// starts (angles spread over the circle), run in parallel: `(t_n, rms)` pairs. `started` builds
-/// a stepper started from a `(q0, p0)`.
+/// starts (angles spread over the circle), run in parallel: `(t_n, rms)` pairs. `stepper`
+/// builds a stepper for each run, which is started from its turned start.
 pub fn rms_energy_error<E, F>(
-    started: F,
+    stepper: F,
     runs: usize,
     at: &[u64],
 ) -> Result<Vec<(f64, f64)>, DiracError>
 where
     E: StepEquations<2, System = kepler::Kepler, Manifold = Vectors> + Send,
-    F: Fn(SVector<f64, 2>, SVector<f64, 2>) -> Result<Stepper<kepler::Kepler, 2, E>, DiracError>
-        + Sync,
+    F: Fn() -> Result<Stepper<kepler::Kepler, 2, E>, DiracError> + Sync,
 {
     let walks: Vec<Vec<f64>> = (0..runs)
         .into_par_iter()
@@ -52,7 +51,8 @@ where
             // Turns of an irrational fraction of the circle: no two starts alike.
             let angle = std::f64::consts::TAU * (run as f64 * 0.618_033_988_749_895).fract();
             let (q0, p0) = turned_start(angle);
-            let mut stepper = started(q0, p0)?;
+            let mut stepper = stepper()?;
+            stepper.start_from_momentum(q0, p0)?;
             let e0 = stepper.energy()?;
             let mut errors = Vec::with_capacity(at.len());
             for &n in at {
@@ -64,10 +64,7 @@ where
             Ok(errors)
         })
         .collect::<Result<_, DiracError>>()?;
-    let h = {
-        let (q0, p0) = turned_start(0.0);
-        started(q0, p0)?.h()
-    };
+    let h = stepper()?.h();
     Ok(at
         .iter()
         .enumerate()
