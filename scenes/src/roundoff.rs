@@ -35,15 +35,16 @@ pub fn checkpoints(first: u64, last: u64, per_decade: u32) -> Vec<u64> {
 
 /// The root mean square of `E(t_n) − E(0)` at the step counts `at` over `runs` runs from turned
 /// starts (angles spread over the circle), run in parallel: `(t_n, rms)` pairs. `stepper`
-/// builds a stepper for each run, which is started from its turned start.
+/// builds a stepper for each run of a Kepler model (Lagrangian or Hamiltonian), which is
+/// started from its turned start.
 pub fn rms_energy_error<E, F>(
     stepper: F,
     runs: usize,
     at: &[u64],
 ) -> Result<Vec<(f64, f64)>, DiracError>
 where
-    E: StepEquations<2, System = kepler::Kepler, Manifold = Vectors> + Send,
-    F: Fn() -> Result<Stepper<kepler::Kepler, 2, E>, DiracError> + Sync,
+    E: StepEquations<2, Manifold = Vectors> + Send,
+    F: Fn() -> Result<Stepper<E::System, 2, E>, DiracError> + Sync,
 {
     let walks: Vec<Vec<f64>> = (0..runs)
         .into_par_iter()
