@@ -12,12 +12,24 @@
 //! and 16 runs, the implicit method a tenth of the steps: about a minute on two cores;
 //! `IMPLICIT_STEPS = 0` leaves it out).
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use dirac::plot::{Series, line_chart};
 use dirac::prelude::*;
+use dirac::{StepEquations, Vectors};
 use scenes::kepler;
 use scenes::roundoff::{checkpoints, exponent, rms_energy_error};
+
+/// `rms_energy_error` of the steppers `stepper` builds, with the wall time it took.
+fn timed<E: StepEquations<2, Manifold = Vectors> + Send>(
+    stepper: impl Fn() -> Result<Stepper<E::System, 2, E>, DiracError> + Sync,
+    runs: usize,
+    at: &[u64],
+) -> Result<(Vec<(f64, f64)>, Duration), DiracError> {
+    let start = Instant::now();
+    let points = rms_energy_error(stepper, runs, at)?;
+    Ok((points, start.elapsed()))
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
@@ -28,7 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let per_decade = 10;
     let mut series = Vec::new();
     let mut csv = String::from("method,t,rms_energy_error\n");
-    let mut record = |name: String, points: Vec<(f64, f64)>, wall: std::time::Duration| {
+    let mut record = |name: String, points: Vec<(f64, f64)>, wall: Duration| {
         let (first, last) = (points[0], points[points.len() - 1]);
         let walk: Vec<(f64, f64)> = points
             .iter()
@@ -66,31 +78,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .collect(),
         });
     };
+    let spread = |steps: u64| checkpoints(100, steps, per_decade as u32);
     let composition = Composition::kahan_li_8();
-    let start = Instant::now();
-    let points = rms_energy_error(
+    let (points, wall) = timed(
         || Stepper::explicit(kepler::SCENE, composition.clone(), h),
         runs,
-        &checkpoints(100, steps, per_decade as u32),
+        &spread(steps),
     )?;
-    record(
-        format!("explicit {}", composition.name()),
-        points,
-        start.elapsed(),
-    );
+    record(format!("explicit {}", composition.name()), points, wall);
     if implicit_steps > 0 {
         let gauss = Quadrature::galerkin(4)?;
-        let start = Instant::now();
-        let points = rms_energy_error(
+        let (points, wall) = timed(
             || Stepper::new(kepler::SCENE, gauss.clone(), h),
             runs,
-            &checkpoints(100, implicit_steps, per_decade as u32),
+            &spread(implicit_steps),
         )?;
-        record(
-            format!("implicit Gauss {}", gauss.name()),
-            points,
-            start.elapsed(),
-        );
+        record(format!("implicit Gauss {}", gauss.name()), points, wall);
     }
     // Guides from the first point: slopes 1/2 (a walk) and 1 (a drift).
     let (t0, e0) = series[0].points[0];

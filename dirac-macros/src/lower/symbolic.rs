@@ -392,10 +392,10 @@ impl Graph {
                 // each variable. The value x/y keeps the user's division.
                 let (dx, dy) = (self.derivative(x, var), self.derivative(y, var));
                 let r = self.reciprocal(y);
-                let l = self.mul(dx, r);
+                let left = self.mul(dx, r);
                 let (xr, dyr) = (self.mul(x, r), self.mul(dy, r));
-                let r = self.mul(xr, dyr);
-                self.sub(l, r)
+                let right = self.mul(xr, dyr);
+                self.sub(left, right)
             }
             Node::Neg(x) => {
                 let dx = self.derivative(x, var);
@@ -447,7 +447,7 @@ impl Graph {
         // 1 / sqrt(s · (1 − x²)) or similar: `reciprocal_root(u)` = 1/√u.
         let reciprocal_root = |g: &mut Graph, u: Id| {
             let root = g.call(Function::Sqrt, u);
-            g.div(one, root)
+            g.reciprocal(root)
         };
         match f {
             Function::Sin => self.call(Function::Cos, x),
@@ -473,7 +473,7 @@ impl Graph {
             Function::Atan => {
                 let x2 = self.square(x);
                 let u = self.add(one, x2);
-                self.div(one, u)
+                self.reciprocal(u)
             }
             Function::Sinh => self.call(Function::Cosh, x),
             Function::Cosh => self.call(Function::Sinh, x),
@@ -494,7 +494,7 @@ impl Graph {
             Function::Atanh => {
                 let x2 = self.square(x);
                 let u = self.sub(one, x2);
-                self.div(one, u)
+                self.reciprocal(u)
             }
             Function::Exp => fx,
             Function::Exp2 => {
@@ -502,20 +502,20 @@ impl Graph {
                 self.mul(fx, ln2)
             }
             Function::ExpM1 => self.call(Function::Exp, x),
-            Function::Ln => self.div(one, x),
+            Function::Ln => self.reciprocal(x),
             Function::Ln1p => {
                 let u = self.add(one, x);
-                self.div(one, u)
+                self.reciprocal(u)
             }
             Function::Log2 => {
                 let ln2 = self.number(std::f64::consts::LN_2);
                 let u = self.mul(x, ln2);
-                self.div(one, u)
+                self.reciprocal(u)
             }
             Function::Log10 => {
                 let ln10 = self.number(std::f64::consts::LN_10);
                 let u = self.mul(x, ln10);
-                self.div(one, u)
+                self.reciprocal(u)
             }
             Function::Sqrt => {
                 // ½ (1/√x): the reciprocal a quotient by √x shares.

@@ -9,6 +9,15 @@ pub(crate) fn exceeds(x: f64, bound: f64) -> bool {
     x.is_nan() || bound.is_nan() || x > bound
 }
 
+/// `a + b` rounded and its rounding error, exactly: `sum + error = a + b` (Knuth's TwoSum,
+/// whichever operand is larger).
+#[inline(always)]
+pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let sum = a + b;
+    let b_part = sum - a;
+    (sum, (a - (sum - b_part)) + (b - b_part))
+}
+
 /// The largest magnitude among `values`, or NaN where one is NaN (which `f64::max` and
 /// nalgebra's `amax` pass over): an error measure that a NaN cannot make look small.
 pub(crate) fn largest(values: impl IntoIterator<Item = f64>) -> f64 {

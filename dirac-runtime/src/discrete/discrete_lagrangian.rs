@@ -16,6 +16,7 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::base::error::DiracError;
+use crate::base::float::two_sum;
 use crate::discrete::state::State;
 use crate::model::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};
 use crate::model::derivatives::{
@@ -81,13 +82,10 @@ struct NodeWeights {
 fn rounded_sum(first: f64, terms: impl Iterator<Item = f64>) -> (f64, f64) {
     let (mut sum, mut error) = (first, 0.0);
     for term in terms {
-        let next = sum + term;
-        let part = next - sum;
-        error += (sum - (next - part)) + (term - part);
-        sum = next;
+        let (next, rounding) = two_sum(sum, term);
+        (sum, error) = (next, error + rounding);
     }
-    let rounded = sum + error;
-    (rounded, (sum - rounded) + error)
+    two_sum(sum, error)
 }
 
 impl NodeWeights {

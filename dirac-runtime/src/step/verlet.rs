@@ -30,6 +30,7 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::base::error::DiracError;
+use crate::base::float::two_sum;
 use crate::discrete::discrete_lagrangian::DiscreteLagrangian;
 use crate::discrete::state::State;
 use crate::model::derivatives::{self, Seed};
@@ -89,6 +90,16 @@ struct Taken<const N: usize> {
     next: State<N>,
     gradient: SVector<f64, N>,
     work: SVector<f64, N>,
+}
+
+impl<const N: usize> Taken<N> {
+    /// The step's work: its forces', by stage; no constraints.
+    fn step_work(&self) -> StepWork<N> {
+        StepWork {
+            forces: self.work,
+            constraints: Some(SVector::zeros()),
+        }
+    }
 }
 
 /// The constant kinetic terms: `v = M⁻¹ (p − b)`.
@@ -355,6 +366,17 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
         Ok(next)
     }
 
+    /// The step from `state` with the run's kinetic terms, its first gradient the last one
+    /// taken where the step before ended at `state.q`; that step's last gradient is kept for
+    /// the next.
+    fn step_from(&mut self, state: &State<N>) -> Result<Taken<N>, DiracError> {
+        let kinetic = self.kinetic_at(state)?;
+        let first = self.memo.filter(|(q, _)| *q == state.q).map(|(_, g)| g);
+        let taken = self.take_step(state, &kinetic, first);
+        self.memo = Some((taken.next.q, taken.gradient));
+        Ok(taken)
+    }
+
     /// The step from `state`: the one [`predict`](StepEquations::predict) took, or taken again.
     fn taken(&self, state: &State<N>) -> Result<Taken<N>, DiracError> {
         match &self.proposal {
@@ -373,7 +395,7 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
 }
 
 /// `x += increment` with the rounding error of each component's addition added to `lo`
-/// (Knuth's TwoSum: `x_new + e = x + increment` exactly).
+/// (`x_new + e = x + increment` exactly).
 #[inline(always)]
 fn two_sum_add<const N: usize>(
     x: &mut SVector<f64, N>,
@@ -381,10 +403,8 @@ fn two_sum_add<const N: usize>(
     increment: &SVector<f64, N>,
 ) {
     for i in 0..N {
-        let (a, b) = (x[i], increment[i]);
-        let sum = a + b;
-        let b_part = sum - a;
-        lo[i] += (a - (sum - b_part)) + (b - b_part);
+        let (sum, error) = two_sum(x[i], increment[i]);
+        lo[i] += error;
         x[i] = sum;
     }
 }
@@ -464,13 +484,9 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
         _x: &mut DVector<f64>,
     ) {
         // A state the run's check refused: advance reports it again.
-        let Ok(kinetic) = self.kinetic_at(state) else {
-            return;
-        };
-        let first = self.memo.filter(|(q, _)| *q == state.q).map(|(_, g)| g);
-        let taken = self.take_step(state, &kinetic, first);
-        self.memo = Some((taken.next.q, taken.gradient));
-        self.proposal = Some((*state, taken));
+        if let Ok(taken) = self.step_from(state) {
+            self.proposal = Some((*state, taken));
+        }
     }
 
     fn assemble(
@@ -499,22 +515,10 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
         state: &State<N>,
         step: u64,
     ) -> Option<Result<(State<N>, Option<StepWork<N>>), DiracError>> {
-        let kinetic = match self.kinetic_at(state) {
-            Ok(kinetic) => kinetic,
-            Err(error) => return Some(Err(error)),
-        };
-        let first = self.memo.filter(|(q, _)| *q == state.q).map(|(_, g)| g);
-        let taken = self.take_step(state, &kinetic, first);
-        let next = match self.finite(taken.next, step) {
-            Ok(next) => next,
-            Err(error) => return Some(Err(error)),
-        };
-        self.memo = Some((next.q, taken.gradient));
-        let work = StepWork {
-            forces: taken.work,
-            constraints: Some(SVector::zeros()),
-        };
-        Some(Ok((next, Some(work))))
+        let step = self
+            .step_from(state)
+            .and_then(|taken| Ok((self.finite(taken.next, step)?, Some(taken.step_work()))));
+        Some(step)
     }
 
     fn violation(&self, _from: &State<N>, _to: &State<N>, _x: &DVector<f64>) -> f64 {
@@ -603,11 +607,7 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
 
     /// The forces' work, stage by stage `½ (F(q_a) + F(q_b)) · (q_b − q_a)`; no constraints.
     fn work(&self, state: &State<N>, _x: &DVector<f64>) -> Option<StepWork<N>> {
-        let taken = self.taken(state).ok()?;
-        Some(StepWork {
-            forces: taken.work,
-            constraints: Some(SVector::zeros()),
-        })
+        Some(self.taken(state).ok()?.step_work())
     }
 
     fn inputs(&self) -> &[f64] {
