@@ -18,6 +18,17 @@ pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
     (sum, (a - (sum - b_part)) + (b - b_part))
 }
 
+/// `first + Σ terms` summed in two parts (each addition's rounding error kept), as the
+/// rounded sum and its remainder: `sum + rest` is the exact sum to far below an ulp of `sum`.
+pub(crate) fn rounded_sum(first: f64, terms: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (mut sum, mut error) = (first, 0.0);
+    for term in terms {
+        let (next, rounding) = two_sum(sum, term);
+        (sum, error) = (next, error + rounding);
+    }
+    two_sum(sum, error)
+}
+
 /// The largest magnitude among `values`, or NaN where one is NaN (which `f64::max` and
 /// nalgebra's `amax` pass over): an error measure that a NaN cannot make look small.
 pub(crate) fn largest(values: impl IntoIterator<Item = f64>) -> f64 {

@@ -16,7 +16,7 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::base::error::DiracError;
-use crate::base::float::two_sum;
+use crate::base::float::rounded_sum;
 use crate::discrete::state::State;
 use crate::model::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};
 use crate::model::derivatives::{
@@ -75,17 +75,6 @@ struct NodeWeights {
     /// point 0, a few ulps off (its round-off is not measured for drift).
     a0_rest: f64,
     d0_rest: f64,
-}
-
-/// `first + Σ terms` summed in two parts (each addition's rounding error kept), as the
-/// rounded sum and its remainder: `sum + rest` is the exact sum to far below an ulp of `sum`.
-fn rounded_sum(first: f64, terms: impl Iterator<Item = f64>) -> (f64, f64) {
-    let (mut sum, mut error) = (first, 0.0);
-    for term in terms {
-        let (next, rounding) = two_sum(sum, term);
-        (sum, error) = (next, error + rounding);
-    }
-    two_sum(sum, error)
 }
 
 impl NodeWeights {

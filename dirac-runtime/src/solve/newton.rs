@@ -642,7 +642,9 @@ impl<J: Jacobian> Newton<J> {
     ///
     /// A point is accepted when its residual is within tolerance and the correction at it (the
     /// update the factorised Jacobian gives there, the estimate of its distance from the root)
-    /// is at round-off or has stopped shrinking below the step tolerance. Accepting needs no
+    /// is at round-off or has stopped shrinking below the step tolerance; with a Jacobian older
+    /// than the iterate before, the update that led to the point must have been at round-off
+    /// too (a chord iteration's last correction, left out, would bias every step alike). Accepting needs no
     /// Jacobian at the point itself: after an update below the step tolerance the next point is
     /// evaluated without one. The returned point is the one whose residual was
     /// evaluated last, so whatever the closure computed alongside belongs to it.
@@ -729,16 +731,24 @@ impl<J: Jacobian> Newton<J> {
             // started from) below the step tolerance led to it, which leaves x about the square
             // of that step off (and that last step refines x: the midpoint rule keeps a stiff
             // spring's energy to round-off over 10⁶ steps only with it); or, with an older
-            // Jacobian (a linear rate), its own correction is at round-off. A kept Jacobian of
-            // linear equations is their Jacobian: as Newton's, its point is accepted only after
-            // a refining step (without it the stiff spring's energy drifts 20 times further).
+            // Jacobian (a linear rate), its own correction is at round-off and so was the update
+            // that led to it. A chord iteration nears its root from one side, alike step after
+            // step: a correction left out, though at round-off of the largest unknown, is
+            // hundreds of ulps of a small one and biases every step the same way (the energy's
+            // round-off then drifts like t^0.9 on Kepler's Gauss steps of order 8), so the point
+            // a round-off correction gives is taken, a contraction factor nearer the root. A
+            // kept Jacobian of linear equations is their Jacobian: as Newton's, its point is
+            // accepted after a refining step (without it the stiff spring's energy drifts 20
+            // times further).
             let round_off = round_off(amax(x));
             let refined = previous.is_some_and(|before| before <= noise);
             let settled = at_x.residual == 0.0
                 || if current {
                     refined
+                } else if self.constant_jacobian {
+                    update <= round_off && refined
                 } else {
-                    update <= round_off && (refined || !self.constant_jacobian)
+                    update <= round_off && previous.is_some_and(|before| before <= round_off)
                 };
             if within && settled {
                 self.kept.pending = false;

@@ -65,7 +65,7 @@ use num_dual::Dual64;
 
 use crate::base::constraint_point::ConstraintPoint;
 use crate::base::error::DiracError;
-use crate::base::float::exceeds;
+use crate::base::float::{exceeds, rounded_sum};
 use crate::model::derivatives::{self, Dual, Hamiltonian};
 use crate::model::hamiltonian_system::HamiltonianSystem;
 use crate::quadrature::{Quadrature, Rule};
@@ -76,14 +76,48 @@ use crate::space::manifold::Vectors;
 use crate::step::step_derivatives::StepDerivatives;
 use crate::step::step_equations::{State, StepEquations, StepWork};
 
+/// The path's basis at quadrature node `c_i`: `position_j = ℓ_j(c_i)` and `rate_j = ℓ'_j(c_i)`
+/// (`j = 0..=s`). The path is `q_k + Σ_{j≥1} position_j ξ_j`, so its derivative in `q_k` weighs
+/// the node by `1 − Σ_{j≥1} position_j` and `−Σ_{j≥1} rate_j`, not by the basis at point 0
+/// evaluated apart (a few ulps off them, which lets the energy's round-off drift). With internal
+/// points, point 0's entries are those sums rounded and the `rest`s what rounding left of them;
+/// a degree-1 step keeps its two entries (the rests are zero).
+#[derive(Debug, Clone, PartialEq)]
+struct Basis {
+    position: Vec<f64>,
+    rate: Vec<f64>,
+    position_rest: f64,
+    rate_rest: f64,
+}
+
+impl Basis {
+    /// The basis at node `i` of `quadrature`.
+    fn at(quadrature: &Quadrature, i: usize) -> Self {
+        let s = quadrature.degree();
+        let mut basis = Self {
+            position: (0..=s).map(|j| quadrature.ell(i, j)).collect(),
+            rate: (0..=s).map(|j| quadrature.ell_prime(i, j)).collect(),
+            position_rest: 0.0,
+            rate_rest: 0.0,
+        };
+        if s > 1 {
+            let (position, rate) = (&basis.position[1..], &basis.rate[1..]);
+            (basis.position[0], basis.position_rest) = rounded_sum(1.0, position.iter().map(|a| -a));
+            (basis.rate[0], basis.rate_rest) = rounded_sum(0.0, rate.iter().map(|d| -d));
+        }
+        basis
+    }
+}
+
 /// Where a step holds the constraint one-forms: the point `Q_c = Σ_j position_j Q_j`, the
 /// velocity `Q̇_c = Σ_j rate_j Q_j / h` and the weights `w_j` of the constraint's force on the
-/// rows of `Q_0 … Q_s`.
+/// rows of `Q_0 … Q_s`, with what rounding left of `w_0` (see [`Basis`]).
 #[derive(Debug, Clone, PartialEq)]
 struct Site {
     position: Vec<f64>,
     rate: Vec<f64>,
     weight: Vec<f64>,
+    weight_rest: f64,
 }
 
 /// The discrete Hamilton's equations of the Galerkin discrete Hamiltonian `H_d⁺` of a
@@ -111,6 +145,8 @@ pub struct Hamilton<S, const N: usize> {
     system: S,
     quadrature: Quadrature,
     h: f64,
+    /// The path's basis at each node.
+    bases: Vec<Basis>,
     sites: Vec<Site>,
     inputs: Vec<f64>,
     /// `p_{k+1} − p_k` at the point assembled last.
@@ -137,12 +173,16 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
                 value,
             });
         }
-        let sites = Self::sites(&system, &quadrature, h)?;
+        let bases: Vec<Basis> = (0..quadrature.nodes().len())
+            .map(|i| Basis::at(&quadrature, i))
+            .collect();
+        let sites = Self::sites(&system, &quadrature, &bases, h)?;
         crate::discrete::constraint::check_holonomic_degree(S::HOLONOMIC, &quadrature)?;
         Ok(Self {
             system,
             quadrature,
             h,
+            bases,
             sites,
             inputs: vec![0.0; S::INPUTS],
             impulse: SVector::zeros(),
@@ -150,7 +190,12 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
     }
 
     /// Where the one-forms are held (none without one-forms).
-    fn sites(system: &S, quadrature: &Quadrature, h: f64) -> Result<Vec<Site>, DiracError> {
+    fn sites(
+        system: &S,
+        quadrature: &Quadrature,
+        bases: &[Basis],
+        h: f64,
+    ) -> Result<Vec<Site>, DiracError> {
         let s = quadrature.degree();
         let point = system.constraint_point();
         if S::ONE_FORMS == 0 {
@@ -162,6 +207,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
                 position: vec![1.0 - theta, theta],
                 rate: vec![-1.0, 1.0],
                 weight: vec![sigma, 1.0 - sigma],
+                weight_rest: 0.0,
             }]);
         }
         if quadrature.rule() != Rule::GaussLegendre(s) || point != ConstraintPoint::Midpoint {
@@ -172,14 +218,14 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
                 quadrature.name()
             )));
         }
-        Ok((0..quadrature.nodes().len())
-            .map(|i| {
-                let b = quadrature.weights()[i];
-                Site {
-                    position: (0..=s).map(|j| quadrature.ell(i, j)).collect(),
-                    rate: (0..=s).map(|j| quadrature.ell_prime(i, j)).collect(),
-                    weight: (0..=s).map(|j| h * b * quadrature.ell(i, j)).collect(),
-                }
+        Ok(bases
+            .iter()
+            .zip(quadrature.weights())
+            .map(|(basis, &b)| Site {
+                position: basis.position.clone(),
+                rate: basis.rate.clone(),
+                weight: basis.position.iter().map(|&a| h * b * a).collect(),
+                weight_rest: h * b * basis.position_rest,
             })
             .collect())
     }
@@ -230,28 +276,19 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         })
     }
 
-    /// Node `i` of the step from `state` solved by `x`: the path's weights `ℓ_j(c_i)` and
-    /// `ℓ'_j(c_i)`, its position `Q(c_i)` and rate `Q̇(c_i)` there, and the node's momentum `P_i`.
-    #[allow(clippy::type_complexity)]
+    /// Node `i` of the step from `state` solved by `x`: the path's basis there, its position
+    /// `Q(c_i)` and rate `Q̇(c_i)`, and the node's momentum `P_i`.
     fn node(
         &self,
         state: &State<N>,
         x: &DVector<f64>,
         i: usize,
-    ) -> (
-        Vec<f64>,
-        Vec<f64>,
-        SVector<f64, N>,
-        SVector<f64, N>,
-        SVector<f64, N>,
-    ) {
-        let s = self.degree();
-        let position: Vec<f64> = (0..=s).map(|j| self.quadrature.ell(i, j)).collect();
-        let velocity: Vec<f64> = (0..=s).map(|j| self.quadrature.ell_prime(i, j)).collect();
-        let q = state.q + self.combination(x, &position);
-        let v = self.combination(x, &velocity) / self.h;
+    ) -> (&Basis, SVector<f64, N>, SVector<f64, N>, SVector<f64, N>) {
+        let basis = &self.bases[i];
+        let q = state.q + self.combination(x, &basis.position);
+        let v = self.combination(x, &basis.rate) / self.h;
         let p = x.fixed_rows::<N>(self.node_momentum(i)).into_owned();
-        (position, velocity, q, v, p)
+        (basis, q, v, p)
     }
 
     /// The force at node values `(q, p)` at time `t`, with its Jacobians in `q` and `p` when
@@ -312,7 +349,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         let identity = SMatrix::<f64, N, N>::identity();
         for i in 0..self.nodes() {
             let (c, b) = (self.quadrature.nodes()[i], self.quadrature.weights()[i]);
-            let (position, velocity, q, v, p) = self.node(state, x, i);
+            let (basis, q, v, p) = self.node(state, x, i);
+            let (position, velocity) = (&basis.position, &basis.rate);
             let column = self.node_momentum(i);
             let t = state.t + c * h;
             let second = jacobian
@@ -324,11 +362,21 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
             };
             let (f, f_q, f_p) = self.force(&q, &p, t, jacobian.is_some());
             let generalised = f - h_q;
+            // The node's terms weighed first and spread over the rows by the basis after: the
+            // rows are then exactly `ℓ_j(c_i)` and `ℓ'_j(c_i)` times one vector each, the
+            // derivatives of one discrete action (a constant product `h b_i ℓ_j(c_i)` rounds
+            // differently in each row, a bias of an ulp a step that lets the energy drift).
+            let (momentum, impulse_i) = (p * b, generalised * (h * b));
             for j in 0..=last {
                 let mut target = rows.fixed_rows_mut::<N>(row_of(j));
-                target += p * (b * velocity[j]) + generalised * (h * b * position[j]);
+                target += momentum * velocity[j] + impulse_i * position[j];
             }
-            impulse += generalised * (h * b);
+            if s > 1 {
+                // Below an ulp of the row's terms: it moves the row's rounding on average only.
+                let mut target = rows.fixed_rows_mut::<N>(0);
+                target += momentum * basis.rate_rest + impulse_i * basis.position_rest;
+            }
+            impulse += impulse_i;
             rows.fixed_rows_mut::<N>(column).copy_from(&(v - h_p));
             scale = scale
                 .max(p.amax())
@@ -372,6 +420,10 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
                 for j in 0..=last {
                     let mut target = rows.fixed_rows_mut::<N>(row_of(j));
                     target += form * (site.weight[j] * mu);
+                }
+                if s > 1 {
+                    let mut target = rows.fixed_rows_mut::<N>(0);
+                    target += form * (site.weight_rest * mu);
                 }
                 impulse += form * (total * mu);
                 rows[column] = form.dot(&v);
@@ -461,8 +513,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
         }
         for i in 0..self.nodes() {
             let (c, b) = (self.quadrature.nodes()[i], self.quadrature.weights()[i]);
-            let position: Vec<f64> = (0..=s).map(|j| self.quadrature.ell(i, j)).collect();
-            let q = (state.q + self.combination(x, &position)).map(Dual64::from);
+            let position = &self.bases[i].position;
+            let q = (state.q + self.combination(x, position)).map(Dual64::from);
             let p = x.fixed_rows::<N>(self.node_momentum(i)).map(Dual64::from);
             for m in 0..inputs {
                 let seeded: Vec<Dual64> = (0..inputs)
@@ -930,7 +982,7 @@ impl<S: HamiltonianSystem<N>, const N: usize> StepEquations<N> for Hamilton<S, N
         if S::FORCES {
             for i in 0..self.nodes() {
                 let (c, b) = (self.quadrature.nodes()[i], self.quadrature.weights()[i]);
-                let (_, _, q, v, p) = self.node(state, x, i);
+                let (_, q, v, p) = self.node(state, x, i);
                 let (f, _, _) = self.force(&q, &p, state.t + c * h, false);
                 forces += f.component_mul(&v) * (h * b);
             }
