@@ -102,7 +102,8 @@ impl Basis {
         };
         if s > 1 {
             let (position, rate) = (&basis.position[1..], &basis.rate[1..]);
-            (basis.position[0], basis.position_rest) = rounded_sum(1.0, position.iter().map(|a| -a));
+            (basis.position[0], basis.position_rest) =
+                rounded_sum(1.0, position.iter().map(|a| -a));
             (basis.rate[0], basis.rate_rest) = rounded_sum(0.0, rate.iter().map(|d| -d));
         }
         basis
