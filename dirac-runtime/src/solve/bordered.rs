@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use crate::base::error::DiracError;
 use crate::base::float::largest;
+use crate::base::runs::{Runs, in_runs};
 use crate::solve::banded::Banded;
 use crate::solve::jacobian::Jacobian;
 use crate::solve::lu::{self, SingularPivot};
@@ -54,8 +55,10 @@ pub struct Bordered {
     schur: Banded,
     /// Blocks per parallel task (`usize::MAX`: one after another).
     grain: usize,
-    /// The coupling rows' absolute sums (scratch of the norm).
-    coupling_sums: Vec<f64>,
+    /// The blocks each coupling touches, `(block, its row in the block's touching)`, coupling
+    /// after coupling (`starts[j]..starts[j + 1]`), the blocks in order.
+    touched: Vec<(usize, usize)>,
+    starts: Vec<usize>,
 }
 
 /// What a diagonal block keeps beside its matrix.
@@ -71,6 +74,8 @@ struct Block {
     g: DMatrix<f64>,
     /// `J_c⁻¹ E_c` after factorising.
     y: DMatrix<f64>,
+    /// `G_c J_c⁻¹ E_c`, its part of the Schur complement, after factorising.
+    gy: DMatrix<f64>,
     pivots: Vec<usize>,
     scales: Vec<f64>,
 }
@@ -138,6 +143,7 @@ impl Bordered {
                 let block = Block {
                     offset,
                     y: DMatrix::zeros(n, touching.len()),
+                    gy: DMatrix::zeros(touching.len(), touching.len()),
                     touching,
                     e,
                     g,
@@ -159,9 +165,26 @@ impl Bordered {
                 if in_e[j] { "G" } else { "E" }
             ));
         }
+        let mut starts = vec![0; couplings + 1];
+        for &j in blocks.iter().flat_map(|b| &b.touching) {
+            starts[j + 1] += 1;
+        }
+        for j in 0..couplings {
+            starts[j + 1] += starts[j];
+        }
+        let mut touched = vec![(0, 0); starts[couplings]];
+        let mut next = starts.clone();
+        for (c, block) in blocks.iter().enumerate() {
+            for (a, &j) in block.touching.iter().enumerate() {
+                touched[next[j]] = (c, a);
+                next[j] += 1;
+            }
+        }
         Ok(Self {
             diagonal: sizes.iter().map(|&n| DMatrix::zeros(n, n)).collect(),
             blocks,
+            touched,
+            starts,
             couplings,
             size: offset + couplings,
             schur: Banded::within_memory(
@@ -170,16 +193,22 @@ impl Bordered {
                 spread,
                 "the junctions' Schur complement",
             )?,
-            coupling_sums: vec![0.0; couplings],
             grain: usize::MAX,
         })
     }
 
-    /// Factorises and solves the blocks across rayon's threads, `grain` blocks or more per
-    /// task (`usize::MAX`, the default: one after another). The result is the same bit for bit.
+    /// Measures, factorises and solves the blocks, and forms the coupling rows, across rayon's
+    /// threads, `grain` blocks or couplings per task (`usize::MAX`, the default: one after
+    /// another); the Schur complement's band is factorised and solved on one thread. The result
+    /// is the same bit for bit.
     pub fn parallel(mut self, grain: usize) -> Self {
         self.grain = grain.max(1);
         self
+    }
+
+    /// Whether the blocks are worked on across threads.
+    fn in_parallel(&self) -> bool {
+        self.grain < self.blocks.len()
     }
 
     /// The half-width of the Schur complement's band.
@@ -232,34 +261,41 @@ impl Jacobian for Bordered {
 
     fn norm(&mut self) -> f64 {
         // The largest row sum, NaN where a sum is (a NaN entry), as `row_sum_norm`.
-        let mut sums: Vec<f64> = std::mem::take(&mut self.coupling_sums);
-        sums.iter_mut().for_each(|s| *s = 0.0);
-        let mut norm: f64 = 0.0;
-        for (j, block) in self.diagonal.iter().zip(&self.blocks) {
+        let most = |a: f64, b: f64| largest([a, b]);
+        let block_rows = |(j, block): (&DMatrix<f64>, &Block)| {
             let n = j.nrows();
-            let (a, e, g) = (j.as_slice(), block.e.as_slice(), block.g.as_slice());
-            let t = block.touching.len();
-            for i in 0..n {
-                let mut sum = 0.0;
-                for k in 0..n {
-                    sum += a[i + k * n].abs();
-                }
-                for c in 0..t {
-                    sum += e[i + c * n].abs();
-                }
-                norm = largest([norm, sum]);
-            }
-            for (c, &coupling) in block.touching.iter().enumerate() {
-                for k in 0..n {
-                    sums[coupling] += g[c + k * t].abs();
-                }
-            }
+            let (a, e) = (j.as_slice(), block.e.as_slice());
+            let rows = (0..n).map(|i| {
+                let own: f64 = (0..n).map(|k| a[i + k * n].abs()).sum();
+                own + (0..block.touching.len())
+                    .map(|c| e[i + c * n].abs())
+                    .sum::<f64>()
+            });
+            largest(rows)
+        };
+        // A coupling's row: its entries in the blocks it touches, block after block.
+        let coupling_row = |j: usize| {
+            let touched = &self.touched[self.starts[j]..self.starts[j + 1]];
+            let entries = touched.iter().map(|&(c, a)| {
+                let g = &self.blocks[c].g;
+                (0..g.ncols()).map(|k| g[(a, k)].abs()).sum::<f64>()
+            });
+            entries.sum::<f64>()
+        };
+        let pairs = || self.diagonal.iter().zip(&self.blocks);
+        if self.in_parallel() {
+            let blocks = self.diagonal.par_iter().zip(&self.blocks);
+            let blocks = blocks.with_min_len(self.grain).map(block_rows);
+            let couplings = (0..self.couplings).into_par_iter().with_min_len(self.grain);
+            let (blocks, couplings) = rayon::join(
+                || blocks.reduce(|| 0.0, most),
+                || couplings.map(coupling_row).reduce(|| 0.0, most),
+            );
+            most(blocks, couplings)
+        } else {
+            let blocks = largest(pairs().map(block_rows));
+            most(blocks, largest((0..self.couplings).map(coupling_row)))
         }
-        for &sum in &sums {
-            norm = largest([norm, sum]);
-        }
-        self.coupling_sums = sums;
-        norm
     }
 
     fn is_finite(&self) -> bool {
@@ -281,6 +317,17 @@ impl Jacobian for Bordered {
             for column in block.y.as_mut_slice().chunks_exact_mut(n.max(1)) {
                 lu::solve(j, &block.pivots, column);
             }
+            // Its part of the Schur complement, G_c Y_c, without a temporary.
+            let t = block.touching.len();
+            for a in 0..t {
+                for b in 0..t {
+                    let mut entry = 0.0;
+                    for i in 0..n {
+                        entry += block.g[(a, i)] * block.y[(i, b)];
+                    }
+                    block.gy[(a, b)] = entry;
+                }
+            }
             Ok(())
         };
         // The first singular block (by column) whichever thread met it.
@@ -289,7 +336,7 @@ impl Jacobian for Bordered {
             (Err(e), Ok(())) | (Ok(()), Err(e)) => Err(e),
             (Ok(()), Ok(())) => Ok(()),
         };
-        if self.grain < self.blocks.len() {
+        if self.in_parallel() {
             self.diagonal
                 .par_iter_mut()
                 .zip(self.blocks.par_iter_mut())
@@ -300,17 +347,12 @@ impl Jacobian for Bordered {
             let pairs = self.diagonal.iter_mut().zip(self.blocks.iter_mut());
             pairs.map(factorise).try_for_each(|r| r)?;
         }
-        // Σ_c G_c Y_c into the Schur complement, without a temporary.
+        // Σ_c G_c Y_c into the Schur complement, block after block.
         self.schur.clear();
         for block in &self.blocks {
-            let n = block.y.nrows();
             for (a, &row) in block.touching.iter().enumerate() {
                 for (b, &column) in block.touching.iter().enumerate() {
-                    let mut entry = 0.0;
-                    for i in 0..n {
-                        entry += block.g[(a, i)] * block.y[(i, b)];
-                    }
-                    self.schur.add(row, column, entry);
+                    self.schur.add(row, column, block.gy[(a, b)]);
                 }
             }
         }
@@ -324,54 +366,90 @@ impl Jacobian for Bordered {
     fn solve(&self, b: &mut [f64]) {
         let first = self.first_coupling();
         let (own, coupling) = b.split_at_mut(first);
-        let (diagonal, blocks, grain) = (&self.diagonal, &self.blocks, self.grain);
-        each_block(diagonal, blocks, own, grain, &|j, block, z| {
-            lu::solve(j, &block.pivots, z)
-        });
-        // s − Σ G_c z_c, negated.
-        for block in blocks {
-            let z = &own[block.offset..block.offset + block.y.nrows()];
-            for (a, &c) in block.touching.iter().enumerate() {
+        let runs = BlockRuns {
+            diagonal: &self.diagonal,
+            blocks: &self.blocks,
+        };
+        let nothing = |(), ()| ();
+        let solve = |piece: BlockRuns<'_>, run: &mut [f64]| {
+            piece.each(run, |j, block, z| lu::solve(j, &block.pivots, z));
+        };
+        in_runs(runs, own, self.grain, &solve, &nothing);
+        // s − Σ G_c z_c, negated: coupling by coupling, over the blocks it touches in order.
+        let z = &*own;
+        let row = |(j, value): (usize, &mut f64)| {
+            for &(c, a) in &self.touched[self.starts[j]..self.starts[j + 1]] {
+                let block = &self.blocks[c];
+                let z = &z[block.offset..block.offset + block.y.nrows()];
                 let g = block.g.row(a);
-                coupling[c] -= g.iter().zip(z).map(|(g, z)| g * z).sum::<f64>();
+                *value -= g.iter().zip(z).map(|(g, z)| g * z).sum::<f64>();
             }
+            *value = -*value;
+        };
+        if self.grain < self.couplings {
+            let rows = coupling.par_iter_mut().enumerate().with_min_len(self.grain);
+            rows.for_each(row);
+        } else {
+            coupling.iter_mut().enumerate().for_each(row);
         }
-        coupling.iter_mut().for_each(|v| *v = -*v);
         self.schur.solve(coupling);
-        // x_c = z_c − Y_c μ: a few operations a block, not worth a parallel pass.
-        for block in blocks {
-            let z = &mut own[block.offset..block.offset + block.y.nrows()];
-            for (a, &c) in block.touching.iter().enumerate() {
-                for (i, zi) in z.iter_mut().enumerate() {
-                    *zi -= block.y[(i, a)] * coupling[c];
+        // x_c = z_c − Y_c μ.
+        let mu = &*coupling;
+        let back = |piece: BlockRuns<'_>, run: &mut [f64]| {
+            piece.each(run, |_, block, z| {
+                for (a, &c) in block.touching.iter().enumerate() {
+                    for (i, zi) in z.iter_mut().enumerate() {
+                        *zi -= block.y[(i, a)] * mu[c];
+                    }
                 }
-            }
-        }
+            });
+        };
+        in_runs(runs, own, self.grain, &back, &nothing);
     }
 }
 
-/// Applies `f` to each block with its rows of `b` (which begins at the first block's rows),
-/// halving the blocks across rayon's threads while more than `grain` remain.
-fn each_block<F>(diagonal: &[DMatrix<f64>], blocks: &[Block], b: &mut [f64], grain: usize, f: &F)
-where
-    F: Fn(&DMatrix<f64>, &Block, &mut [f64]) + Sync,
-{
-    let Some(start) = blocks.first().map(|block| block.offset) else {
-        return;
-    };
-    if blocks.len() <= grain {
-        for (j, block) in diagonal.iter().zip(blocks) {
-            let at = block.offset - start;
-            f(j, block, &mut b[at..at + j.nrows()]);
-        }
-        return;
+/// Blocks with their matrices, each owning its rows of a vector.
+#[derive(Clone, Copy)]
+struct BlockRuns<'a> {
+    diagonal: &'a [DMatrix<f64>],
+    blocks: &'a [Block],
+}
+
+impl Runs for BlockRuns<'_> {
+    fn count(&self) -> usize {
+        self.blocks.len()
     }
-    let mid = blocks.len() / 2;
-    let (left, right) = b.split_at_mut(blocks[mid].offset - start);
-    rayon::join(
-        || each_block(&diagonal[..mid], &blocks[..mid], left, grain, f),
-        || each_block(&diagonal[mid..], &blocks[mid..], right, grain, f),
-    );
+
+    fn start(&self, i: usize) -> usize {
+        self.blocks[i].offset
+    }
+
+    fn halve(self, mid: usize) -> (Self, Self) {
+        let (diagonal, blocks) = (self.diagonal.split_at(mid), self.blocks.split_at(mid));
+        (
+            Self {
+                diagonal: diagonal.0,
+                blocks: blocks.0,
+            },
+            Self {
+                diagonal: diagonal.1,
+                blocks: blocks.1,
+            },
+        )
+    }
+}
+
+impl BlockRuns<'_> {
+    /// `f(J_c, block, its rows of run)` for each block, `run` beginning at the first one's rows.
+    fn each(self, run: &mut [f64], f: impl Fn(&DMatrix<f64>, &Block, &mut [f64])) {
+        let Some(start) = self.blocks.first().map(|b| b.offset) else {
+            return;
+        };
+        for (j, block) in self.diagonal.iter().zip(self.blocks) {
+            let at = block.offset - start;
+            f(j, block, &mut run[at..at + j.nrows()]);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -429,6 +507,21 @@ mod tests {
             dense.solve(y.as_mut_slice());
             assert!((&x - &y).amax() < 1e-13 * y.amax(), "k {k}, n {n}");
         }
+    }
+
+    #[test]
+    fn across_threads_the_same_bit_for_bit() {
+        let (mut one, _) = chain(40, 3);
+        let mut many = one.clone().parallel(1);
+        assert_eq!(one.norm(), many.norm());
+        assert!(many.is_finite());
+        one.factorise(1e-13).unwrap();
+        many.factorise(1e-13).unwrap();
+        let b = DVector::from_fn(one.size(), |i, _| (i as f64).cos());
+        let (mut x, mut y) = (b.clone(), b.clone());
+        one.solve(x.as_mut_slice());
+        many.solve(y.as_mut_slice());
+        assert_eq!(x, y);
     }
 
     #[test]

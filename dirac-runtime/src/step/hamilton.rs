@@ -401,8 +401,8 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
             }
             for l in first..=s {
                 let mut block = jacobian.fixed_view_mut::<N, N>(column, column_of(l));
-                block += identity * (rate(velocity, l) / h)
-                    - second.qv.transpose() * moved(position, l);
+                block +=
+                    identity * (rate(velocity, l) / h) - second.qv.transpose() * moved(position, l);
             }
             let mut block = jacobian.fixed_view_mut::<N, N>(column, column);
             block -= second.vv;

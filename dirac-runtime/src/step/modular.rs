@@ -15,8 +15,8 @@
 //! and `p_{k+1}^c` gains `(1 − σ) Σ_j μ_j a_j^c`: exactly the monolithic equations. Newton's
 //! method solves them with a [`Bordered`] Jacobian: each `∂R_c/∂x_c` is factorised on its own
 //! and the junctions' Schur complement, a band matrix along a chain, couples them, so a chain
-//! of `K` components costs `O(K)` per step. The components can be assembled and factorised in
-//! parallel (rayon, [`Modular::with_parallel`]). Hidden constraints across the components
+//! of `K` components costs `O(K)` per step. The components can be assembled, factorised and
+//! solved in parallel (rayon, [`Modular::with_parallel`]). Hidden constraints across the components
 //! (parallel capacitors in different components) are held at every step's end as a model holds
 //! its own (see `hidden`).
 //!
@@ -59,6 +59,7 @@ use rayon::prelude::*;
 use crate::base::constraint_point::ConstraintPoint;
 use crate::base::error::DiracError;
 use crate::base::float::{exceeds, largest};
+use crate::base::runs::{Runs, in_runs};
 use crate::discrete::discrete_lagrangian::DiscreteLagrangian;
 use crate::model::interconnection::Junction;
 use crate::model::system::DiracSystem;
@@ -107,6 +108,8 @@ pub struct Modular {
     total_positions: usize,
     /// The run (boxed: a step takes it out and puts it back).
     run: Option<Box<Running>>,
+    /// Whether the components hold the states of a run (or of a start under way).
+    begun: bool,
 }
 
 /// A named component and where it sits.
@@ -148,6 +151,10 @@ struct Running {
     steps: u64,
     /// The junctions' multipliers (impulses) of the last step.
     multipliers: Vec<f64>,
+    /// The junctions' rows in the order of their multipliers: `(unknown, coefficient)` of the
+    /// step's end point, row `k`'s at `row_starts[k]..row_starts[k + 1]`.
+    row_terms: Vec<(usize, f64)>,
+    row_starts: Vec<usize>,
     violation: f64,
     report: Option<NewtonReport>,
     /// The hidden constraints across the components, held at every step's end.
@@ -227,6 +234,7 @@ impl Modular {
             total: 0,
             total_positions: 0,
             run: None,
+            begun: false,
         })
     }
 
@@ -239,10 +247,12 @@ impl Modular {
     }
 
     /// Whether the components are assembled, factorised, solved and advanced in parallel
-    /// (rayon); by default not. The steps are the same bit for bit. On a 2-core machine it paid
-    /// 1.26× once on 10 000 tethered masses and nothing in another run, and cost more below
-    /// thousands of components (see the `modular_step` table of `docs/performance.md`): each step makes about seven
-    /// parallel passes, and a pass costs tens of microseconds.
+    /// (rayon): each pass splits the components into runs of consecutive ones, each with its
+    /// unknowns, and the junctions' rows likewise; the junctions' band (the Schur complement)
+    /// is factorised and solved on one thread. By default not. The steps are the same bit for
+    /// bit. `examples/modular_scaling.rs` measures it on a chain of tethered masses: on 16
+    /// cores 2.2× at 10⁴ masses, 3.2× at 10⁵ and 3.1× at 10⁶; on 2 cores about 1.5× at 10⁴ and
+    /// 10⁵; below a few thousand components it costs more than it gains.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = Some(parallel);
         self.end_run();
@@ -817,6 +827,7 @@ impl Modular {
         let hidden = Hidden::find(&self.components, &self.junctions, (q, v), tolerance)?;
         // From here a failure leaves no run (the components begin afresh).
         self.run = None;
+        self.begun = true;
         for (component, state) in self.components.iter_mut().zip(started) {
             component.part.begin(state);
         }
@@ -850,6 +861,13 @@ impl Modular {
                 self.components[c].couplings.push((junction.rank, i, a));
             }
         }
+        // The step's end point is a component's first unknowns (degree 1).
+        let (mut row_terms, mut row_starts) = (Vec::new(), vec![0]);
+        for &j in &order {
+            let terms = self.junctions[j].terms.iter();
+            row_terms.extend(terms.map(|&(c, i, a)| (self.components[c].offset + i, a)));
+            row_starts.push(row_terms.len());
+        }
         let jacobian = match self.bordered() {
             Ok(jacobian) => jacobian,
             Err(error) => {
@@ -864,6 +882,8 @@ impl Modular {
             predictor: Predictor::new(unknowns),
             steps: 0,
             multipliers: vec![0.0; self.junctions.len()],
+            row_terms,
+            row_starts,
             violation: 0.0,
             report: None,
             hidden,
@@ -889,10 +909,13 @@ impl Modular {
         Ok(())
     }
 
-    /// Ends the run (a change of the model): the components forget their states.
+    /// Ends the run (a change of the model): the components forget their states. Without a
+    /// run it touches nothing, so that building a model of `K` components costs `O(K)`.
     fn end_run(&mut self) {
         self.run = None;
-        self.components.iter_mut().for_each(|c| c.part.stop());
+        if std::mem::take(&mut self.begun) {
+            self.components.iter_mut().for_each(|c| c.part.stop());
+        }
     }
 
     /// Whether the components are stepped in parallel.
@@ -953,78 +976,73 @@ impl Modular {
     fn solve(&mut self, run: &mut Running, trial: bool) -> Result<(NewtonReport, f64), DiracError> {
         let first = run.unknowns.len() - self.junctions.len();
         let previous = run.predictor.predict();
-        let parallel = self.parallel();
-        let predict = |component: &mut Component| {
-            let range = component.offset..component.offset + component.part.unknowns();
-            component
-                .part
-                .predict(previous.map(|p| &p.as_slice()[range]));
+        let grain = if self.parallel() { GRAIN } else { usize::MAX };
+        let (unknowns, multipliers) = run.unknowns.as_mut_slice().split_at_mut(first);
+        let predict = |parts: Parts<'_>, run: &mut [f64]| {
+            parts.each(run, |component, _, own| {
+                let range = component.offset..component.offset + own.len();
+                component
+                    .part
+                    .predict(previous.map(|p| &p.as_slice()[range]));
+                own.copy_from_slice(component.part.unknowns_of_step());
+            });
         };
-        if parallel {
-            let components = self.components.par_iter_mut().with_min_len(GRAIN);
-            components.for_each(predict);
-        } else {
-            self.components.iter_mut().for_each(predict);
-        }
-        for component in &self.components {
-            let range = component.offset..component.offset + component.part.unknowns();
-            run.unknowns.as_mut_slice()[range].copy_from_slice(component.part.unknowns_of_step());
-        }
+        let parts = Parts {
+            components: &mut self.components,
+            blocks: None,
+        };
+        in_runs(parts, unknowns, grain, &predict, &|(), ()| ());
         match previous {
-            Some(p) => run.unknowns.as_mut_slice()[first..].copy_from_slice(&p.as_slice()[first..]),
-            None => run.unknowns.as_mut_slice()[first..].fill(0.0),
+            Some(p) => multipliers.copy_from_slice(&p.as_slice()[first..]),
+            None => multipliers.fill(0.0),
         }
         let share = self.junction_point().share();
-        let (components, junctions) = (&mut self.components, &self.junctions);
-        let evaluate =
-            |x: &DVector<f64>, r: &mut DVector<f64>, blocks: Option<&mut Vec<DMatrix<f64>>>| {
-                let x = x.as_slice();
-                let mu = &x[first..];
-                let assemble = |component: &mut Component, block: Option<&mut DMatrix<f64>>| {
+        let components = &mut self.components;
+        let (row_terms, row_starts) = (&run.row_terms, &run.row_starts);
+        let evaluate = |x: &DVector<f64>,
+                        r: &mut DVector<f64>,
+                        blocks: Option<&mut Vec<DMatrix<f64>>>| {
+            let x = x.as_slice();
+            let mu = &x[first..];
+            let (own, rows) = r.as_mut_slice().split_at_mut(first);
+            let assemble = |parts: Parts<'_>, run: &mut [f64]| {
+                let mut scale: f64 = 0.0;
+                parts.each(run, |component, block, own| {
                     component.impulse.fill(0.0);
                     for &(j, i, a) in &component.couplings {
                         component.impulse[i] += a * mu[j];
                     }
-                    let range = component.offset..component.offset + component.part.unknowns();
-                    component.scale =
-                        component
-                            .part
-                            .assemble(&component.impulse, share, &x[range], block);
-                };
-                match (blocks, parallel) {
-                    (Some(blocks), true) => components
-                        .par_iter_mut()
-                        .zip(blocks.par_iter_mut())
-                        .with_min_len(GRAIN)
-                        .for_each(|(c, b)| assemble(c, Some(b))),
-                    (None, true) => components
-                        .par_iter_mut()
-                        .with_min_len(GRAIN)
-                        .for_each(|c| assemble(c, None)),
-                    (Some(blocks), false) => components
-                        .iter_mut()
-                        .zip(blocks.iter_mut())
-                        .for_each(|(c, b)| assemble(c, Some(b))),
-                    (None, false) => components.iter_mut().for_each(|c| assemble(c, None)),
-                }
-                let mut scale: f64 = 0.0;
-                for component in components.iter() {
-                    let residual = component.part.residual();
-                    r.as_mut_slice()[component.offset..component.offset + residual.len()]
-                        .copy_from_slice(residual);
+                    let range = component.offset..component.offset + own.len();
+                    let part = &mut component.part;
+                    component.scale = part.assemble(&component.impulse, share, &x[range], block);
+                    own.copy_from_slice(part.residual());
                     scale = scale.max(component.scale);
-                }
-                for junction in junctions {
-                    let terms = junction.terms.iter().map(|&(c, i, a)| {
-                        // The step's end point is a component's first unknowns (degree 1).
-                        a * x[components[c].offset + i]
-                    });
-                    let (row, size) = sum_and_size(terms);
-                    r[first + junction.rank] = row;
-                    scale = scale.max(size);
-                }
+                });
                 scale
             };
+            let parts = Parts {
+                components: &mut components[..],
+                blocks: blocks.map(|b| &mut b[..]),
+            };
+            let scale = in_runs(parts, own, grain, &assemble, &f64::max);
+            // The junctions' rows, in the order of their multipliers.
+            let junction = |(k, row): (usize, &mut f64)| {
+                let terms = &row_terms[row_starts[k]..row_starts[k + 1]];
+                let (value, size) = sum_and_size(terms.iter().map(|&(u, a)| a * x[u]));
+                *row = value;
+                size
+            };
+            let size = if grain < rows.len() {
+                let each = rows.par_iter_mut().enumerate().with_min_len(grain);
+                each.map(junction).reduce(|| 0.0, f64::max)
+            } else {
+                rows.iter_mut()
+                    .enumerate()
+                    .map(junction)
+                    .fold(0.0, f64::max)
+            };
+            scale.max(size)
+        };
         let report = run.newton.solve(&mut run.unknowns, evaluate);
         let names = |column: usize| self.unknown_name(column, first);
         let report = report.map_err(|failure| match failure {
@@ -1053,7 +1071,7 @@ impl Modular {
             component.part.advance(&x[range], run.steps)
         };
         // Each component's violation, or the first component's error.
-        let advanced: Result<f64, (usize, DiracError)> = if parallel {
+        let advanced: Result<f64, (usize, DiracError)> = if grain < self.components.len() {
             let components = self.components.par_iter_mut().with_min_len(GRAIN);
             let each = components
                 .enumerate()
@@ -1122,8 +1140,12 @@ impl Modular {
             }
         };
         let t = (run.steps + 1) as f64 * self.h;
-        for component in &mut self.components {
-            component.part.accept(t);
+        let accept = |component: &mut Component| component.part.accept(t);
+        if self.parallel() && GRAIN < self.components.len() {
+            let components = self.components.par_iter_mut().with_min_len(GRAIN);
+            components.for_each(accept);
+        } else {
+            self.components.iter_mut().for_each(accept);
         }
         let first = run.unknowns.len() - self.junctions.len();
         run.predictor.record(&run.unknowns);
@@ -1392,6 +1414,64 @@ fn in_component(name: &str, error: DiracError) -> DiracError {
             value,
         },
         other => other,
+    }
+}
+
+/// Components, with their Jacobian blocks where they are assembled, each owning its unknowns'
+/// run of a step's vectors.
+struct Parts<'a> {
+    components: &'a mut [Component],
+    blocks: Option<&'a mut [DMatrix<f64>]>,
+}
+
+impl Runs for Parts<'_> {
+    fn count(&self) -> usize {
+        self.components.len()
+    }
+
+    fn start(&self, i: usize) -> usize {
+        self.components[i].offset
+    }
+
+    fn halve(self, mid: usize) -> (Self, Self) {
+        let (left, right) = self.components.split_at_mut(mid);
+        let (first, second) = match self.blocks {
+            Some(blocks) => {
+                let (first, second) = blocks.split_at_mut(mid);
+                (Some(first), Some(second))
+            }
+            None => (None, None),
+        };
+        let left = Self {
+            components: left,
+            blocks: first,
+        };
+        let right = Self {
+            components: right,
+            blocks: second,
+        };
+        (left, right)
+    }
+}
+
+impl Parts<'_> {
+    /// `f(component, its block, its unknowns' run of run)` for each component, `run` beginning
+    /// at the first one's unknowns.
+    fn each(
+        self,
+        run: &mut [f64],
+        mut f: impl FnMut(&mut Component, Option<&mut DMatrix<f64>>, &mut [f64]),
+    ) {
+        let Some(start) = self.components.first().map(|c| c.offset) else {
+            return;
+        };
+        let mut blocks = self.blocks.map(|b| b.iter_mut());
+        for component in self.components {
+            let at = component.offset - start;
+            let own = &mut run[at..at + component.part.unknowns()];
+            let block = blocks.as_mut().and_then(|b| b.next());
+            f(component, block, own);
+        }
     }
 }
 
