@@ -34,8 +34,10 @@ fn timed(chain: &mut Modular, steps: u64) -> Result<(Duration, Vec<f64>), Failur
 }
 
 fn main() -> Result<(), Failure> {
-    let sizes: Vec<usize> = match std::env::args().skip(1).map(|a| a.parse()).collect() {
-        Ok(sizes) if !Vec::<usize>::is_empty(&sizes) => sizes,
+    let parsed: Result<Vec<usize>, _> = std::env::args().skip(1).map(|a| a.parse()).collect();
+    let sizes = match parsed {
+        Ok(sizes) if sizes.contains(&0) => return Err("a chain needs at least one mass".into()),
+        Ok(sizes) if !sizes.is_empty() => sizes,
         Ok(_) => vec![1_000, 10_000, 100_000],
         Err(e) => return Err(format!("cells must be whole numbers: {e}").into()),
     };

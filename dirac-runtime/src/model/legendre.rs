@@ -126,9 +126,8 @@ fn newton_velocity<F: PhaseFunction<N>, const N: usize>(
 /// `L` has closed-form second derivatives: exact for a Lagrangian quadratic in the velocities
 /// (any mechanical one), it costs a Hessian and a gradient where the general solve adds its
 /// dynamic-size bookkeeping (recorded samples solve a velocity each). The point it reaches is
-/// returned only where `newton` accepts it as it accepts a point in its own solves with a
-/// Jacobian from an earlier iterate: the residual within tolerance and the correction there at
-/// round-off. A Hessian whose condition number `‖H‖∞‖H⁻¹‖∞` exceeds the inverse of the
+/// returned only where `newton` accepts it (`Newton::accepts`): the residual within tolerance
+/// and the correction there at round-off. A Hessian whose condition number `‖H‖∞‖H⁻¹‖∞` exceeds the inverse of the
 /// solver's singular tolerance is left to the general solve, which refuses it as singular.
 /// `None` sends the caller to the general solve. With the velocity comes the energy there,
 /// `⟨∂L/∂v, v⟩ − L`, from the gradient the acceptance test evaluated.

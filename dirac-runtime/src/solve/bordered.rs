@@ -11,6 +11,10 @@ use crate::solve::banded::Banded;
 use crate::solve::jacobian::Jacobian;
 use crate::solve::lu::{self, SingularPivot};
 
+/// Entries per parallel task of a solver's passes over its vectors when the blocks are worked
+/// on across threads: a copy or a norm of this many entries takes a few microseconds.
+const VECTOR_GRAIN: usize = 1 << 14;
+
 /// A block-bordered Jacobian, solved by its diagonal blocks and a Schur complement.
 ///
 /// ```text
@@ -198,8 +202,8 @@ impl Bordered {
     }
 
     /// Measures, factorises and solves the blocks, and forms the coupling rows, across rayon's
-    /// threads, `grain` blocks or couplings per task (`usize::MAX`, the default: one after
-    /// another); the Schur complement's band is factorised and solved on one thread. The result
+    /// threads in pieces of about `grain` blocks or couplings (`usize::MAX`, the default: one
+    /// after another); the Schur complement's band is factorised and solved on one thread. The result
     /// is the same bit for bit.
     pub fn parallel(mut self, grain: usize) -> Self {
         self.grain = grain.max(1);
@@ -238,7 +242,13 @@ impl Jacobian for Bordered {
     }
 
     fn clear(&mut self) {
-        self.diagonal.iter_mut().for_each(|j| j.fill(0.0));
+        let zero = |j: &mut DMatrix<f64>| j.fill(0.0);
+        if self.in_parallel() {
+            let blocks = self.diagonal.par_iter_mut().with_min_len(self.grain);
+            blocks.for_each(zero);
+        } else {
+            self.diagonal.iter_mut().for_each(zero);
+        }
     }
 
     fn fits(&self, n: usize) -> bool {
@@ -299,9 +309,21 @@ impl Jacobian for Bordered {
     }
 
     fn is_finite(&self) -> bool {
-        self.diagonal
-            .iter()
-            .all(|j| j.iter().all(|v| v.is_finite()))
+        let finite = |j: &DMatrix<f64>| j.iter().all(|v| v.is_finite());
+        if self.in_parallel() {
+            let blocks = self.diagonal.par_iter().with_min_len(self.grain);
+            blocks.all(finite)
+        } else {
+            self.diagonal.iter().all(finite)
+        }
+    }
+
+    fn vector_grain(&self) -> usize {
+        if self.in_parallel() {
+            VECTOR_GRAIN
+        } else {
+            usize::MAX
+        }
     }
 
     fn factorise(&mut self, tolerance: f64) -> Result<(), SingularPivot> {

@@ -53,6 +53,13 @@ pub trait Jacobian: Clone + std::fmt::Debug {
 
     /// Solves `J y = b` in place of `b` with the factorisation.
     fn solve(&self, b: &mut [f64]);
+
+    /// Entries per parallel task of the solver's passes over its vectors (copies, norms,
+    /// updates), where the Jacobian itself works across threads; `usize::MAX` (the default):
+    /// on one thread. The passes' results do not depend on it.
+    fn vector_grain(&self) -> usize {
+        usize::MAX
+    }
 }
 
 /// A dense Jacobian, factorised by one LU with partial pivoting.

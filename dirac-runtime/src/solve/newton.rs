@@ -1,6 +1,7 @@
 //! Newton's method with an exact Jacobian and an LU solve, on a preallocated workspace.
 
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 
 use crate::base::error::DiracError;
 use crate::solve::jacobian::{Dense, Jacobian};
@@ -422,7 +423,8 @@ impl<J: Jacobian> Newton<J> {
             return Err(NewtonFailure::Dimension { expected: n, got });
         }
         // `amax` skips a NaN that a later entry follows: test every entry.
-        if !self.residual.as_slice().iter().all(|r| r.is_finite()) {
+        let grain = self.jacobian.vector_grain();
+        if !all_finite(&self.residual, grain) {
             return Err(NewtonFailure::NonFinite);
         }
         if with_jacobian {
@@ -437,8 +439,8 @@ impl<J: Jacobian> Newton<J> {
             self.factorised = true;
         }
         Ok(Evaluation {
-            residual: amax(&self.residual),
-            tolerance: self.tolerance(scale, self.jacobian_norm, amax(x)),
+            residual: amax(&self.residual, grain),
+            tolerance: self.tolerance(scale, self.jacobian_norm, amax(x, grain)),
         })
     }
 
@@ -452,10 +454,11 @@ impl<J: Jacobian> Newton<J> {
 
     /// Whether a point of size `x_max` is accepted as a root where its residual has norm
     /// `residual` (terms of size `scale`) and the correction a Jacobian evaluated at another
-    /// point (of norm `jacobian_norm`) gives there has norm `update`: as [`solve`](Self::solve)
-    /// accepts a point with a Jacobian from an earlier iterate, the residual within tolerance and
-    /// the correction at round-off. For solves that take such a step outside the solver (a
-    /// chord step in fixed size).
+    /// point (of norm `jacobian_norm`) gives there has norm `update`: the residual within
+    /// tolerance and the correction at round-off. [`solve`](Self::solve) asks that much and,
+    /// with a Jacobian from an earlier iterate, that the update that led to the point was at
+    /// round-off too (its correction left out would bias every step alike); this test is for a
+    /// single solve outside the solver (a chord step in fixed size), not a step's.
     pub(crate) fn accepts(
         &self,
         residual: f64,
@@ -479,8 +482,8 @@ impl<J: Jacobian> Newton<J> {
     ) -> Result<Option<(Evaluation, f64)>, NewtonFailure> {
         let mut length = 1.0;
         while length >= 1e-10 {
-            self.trial.copy_from_slice(x.as_slice());
-            subtract(&mut self.trial, length, &self.update);
+            let grain = self.jacobian.vector_grain();
+            subtracted(&mut self.trial, x, length, &self.update, grain);
             let trial = std::mem::take(&mut self.trial);
             let at_trial = self.evaluate(&trial, evaluate, true);
             self.trial = trial;
@@ -716,14 +719,16 @@ impl<J: Jacobian> Newton<J> {
         let mut kept_ratio: f64 = 0.0;
         loop {
             // The correction at x, with the factorised Jacobian: x's distance from the root.
-            self.update.copy_from_slice(self.residual.as_slice());
+            let grain = self.jacobian.vector_grain();
+            copy(&mut self.update, &self.residual, grain);
             self.jacobian.solve(self.update.as_mut_slice());
-            if !self.update.as_slice().iter().all(|u| u.is_finite()) {
+            if !all_finite(&self.update, grain) {
                 return Err(self.failed(NewtonFailure::NonFinite));
             }
-            let update = amax(&self.update);
+            let update = amax(&self.update, grain);
+            let x_max = amax(x, grain);
             // Below this an update is round-off: never asked for, never measured.
-            let noise = options.step_tolerance.max(64.0 * f64::EPSILON) * (1.0 + amax(x));
+            let noise = options.step_tolerance.max(64.0 * f64::EPSILON) * (1.0 + x_max);
             let within = at_x.residual <= at_x.tolerance;
             // The Jacobian of the iterate before the last update, or of this one.
             let current = jacobian_at.is_some_and(|at| at + 1 >= updates);
@@ -740,7 +745,7 @@ impl<J: Jacobian> Newton<J> {
             // kept Jacobian of linear equations is their Jacobian: as Newton's, its point is
             // accepted after a refining step (without it the stiff spring's energy drifts 20
             // times further).
-            let round_off = round_off(amax(x));
+            let round_off = round_off(x_max);
             let refined = previous.is_some_and(|before| before <= noise);
             let settled = at_x.residual == 0.0
                 || if current {
@@ -814,7 +819,7 @@ impl<J: Jacobian> Newton<J> {
                 jacobian_at = Some(updates + 1);
                 length
             } else {
-                subtract(x, 1.0, &self.update);
+                subtract(x, 1.0, &self.update, grain);
                 evaluations += 1;
                 // After an update below the step tolerance the next point is the root to
                 // round-off: its correction needs no Jacobian of its own.
@@ -826,7 +831,7 @@ impl<J: Jacobian> Newton<J> {
                     {
                         // An update of an older Jacobian left the residual's domain: back to
                         // the iterate it came from, with its own Jacobian.
-                        subtract(x, -1.0, &self.update);
+                        subtract(x, -1.0, &self.update, grain);
                         at_x = self.refresh(x, evaluate)?;
                         (jacobian_at, previous) = (Some(updates), None);
                         (jacobians, evaluations) = (jacobians + 1, evaluations + 1);
@@ -874,15 +879,68 @@ impl<J: Jacobian> Newton<J> {
 }
 
 /// `max |x_i|` (nalgebra's `amax`, over the slice: the iterations here are on every solve's path).
-fn amax(x: &DVector<f64>) -> f64 {
-    x.as_slice().iter().fold(0.0, |m: f64, x| m.max(x.abs()))
+fn amax(x: &DVector<f64>, grain: usize) -> f64 {
+    let largest = |x: &[f64]| x.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
+    match grain < x.len() {
+        true => x
+            .as_slice()
+            .par_chunks(grain)
+            .map(largest)
+            .reduce(|| 0.0, f64::max),
+        false => largest(x.as_slice()),
+    }
+}
+
+/// Whether every entry of `x` is finite (`amax` skips a NaN that a later entry follows).
+fn all_finite(x: &DVector<f64>, grain: usize) -> bool {
+    let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+    match grain < x.len() {
+        true => x.as_slice().par_chunks(grain).all(finite),
+        false => finite(x.as_slice()),
+    }
+}
+
+/// `to = from`, entry by entry.
+fn copy(to: &mut DVector<f64>, from: &DVector<f64>, grain: usize) {
+    match grain < to.len() {
+        true => {
+            let pieces = to.as_mut_slice().par_chunks_mut(grain);
+            pieces
+                .zip(from.as_slice().par_chunks(grain))
+                .for_each(|(to, from)| to.copy_from_slice(from));
+        }
+        false => to.copy_from_slice(from.as_slice()),
+    }
 }
 
 /// `x − length · update`, entry by entry.
-fn subtract(x: &mut DVector<f64>, length: f64, update: &DVector<f64>) {
-    for (x, u) in x.as_mut_slice().iter_mut().zip(update.as_slice()) {
-        *x -= length * u;
+fn subtract(x: &mut DVector<f64>, length: f64, update: &DVector<f64>, grain: usize) {
+    let step = |(x, u): (&mut [f64], &[f64])| {
+        for (x, u) in x.iter_mut().zip(u) {
+            *x -= length * u;
+        }
+    };
+    match grain < x.len() {
+        true => {
+            let pieces = x.as_mut_slice().par_chunks_mut(grain);
+            pieces
+                .zip(update.as_slice().par_chunks(grain))
+                .for_each(step);
+        }
+        false => step((x.as_mut_slice(), update.as_slice())),
     }
+}
+
+/// `to = x − length · update`, entry by entry.
+fn subtracted(
+    to: &mut DVector<f64>,
+    x: &DVector<f64>,
+    length: f64,
+    update: &DVector<f64>,
+    grain: usize,
+) {
+    copy(to, x, grain);
+    subtract(to, length, update, grain);
 }
 
 /// Below this an update of a point of size `x_max` is round-off.

@@ -364,9 +364,9 @@ impl<S: HamiltonianSystem<N>, const N: usize> Hamilton<S, N> {
             let (f, f_q, f_p) = self.force(&q, &p, t, jacobian.is_some());
             let generalised = f - h_q;
             // The node's terms weighed first and spread over the rows by the basis after: the
-            // rows are then exactly `ℓ_j(c_i)` and `ℓ'_j(c_i)` times one vector each, the
-            // derivatives of one discrete action (a constant product `h b_i ℓ_j(c_i)` rounds
-            // differently in each row, a bias of an ulp a step that lets the energy drift).
+            // rows are then `ℓ_j(c_i)` and `ℓ'_j(c_i)` times one vector each (row 0 with its
+            // rest), the derivatives of one discrete action (a constant product `h b_i ℓ_j(c_i)`
+            // rounds differently in each row, a bias of an ulp a step that lets the energy drift).
             let (momentum, impulse_i) = (p * b, generalised * (h * b));
             for j in 0..=last {
                 let mut target = rows.fixed_rows_mut::<N>(row_of(j));

@@ -155,6 +155,8 @@ struct Running {
     /// step's end point, row `k`'s at `row_starts[k]..row_starts[k + 1]`.
     row_terms: Vec<(usize, f64)>,
     row_starts: Vec<usize>,
+    /// Each component's proposed step in its chart, laid out as its unknowns (scratch).
+    moved: Vec<f64>,
     violation: f64,
     report: Option<NewtonReport>,
     /// The hidden constraints across the components, held at every step's end.
@@ -248,11 +250,12 @@ impl Modular {
 
     /// Whether the components are assembled, factorised, solved and advanced in parallel
     /// (rayon): each pass splits the components into runs of consecutive ones, each with its
-    /// unknowns, and the junctions' rows likewise; the junctions' band (the Schur complement)
-    /// is factorised and solved on one thread. By default not. The steps are the same bit for
-    /// bit. `examples/modular_scaling.rs` measures it on a chain of tethered masses: on 16
-    /// cores 2.2× at 10⁴ masses, 3.2× at 10⁵ and 3.1× at 10⁶; on 2 cores about 1.5× at 10⁴ and
-    /// 10⁵; below a few thousand components it costs more than it gains.
+    /// unknowns, and the junctions' rows and Newton's passes over its vectors likewise; the
+    /// junctions' band (the Schur complement) is factorised and solved on one thread. By default
+    /// not. The steps are the same bit for bit. `examples/modular_scaling.rs` measures it on a
+    /// chain of tethered masses: on 16 cores 1.9× at 10⁴ masses, 5.5× at 10⁵ and 4.6× at 10⁶;
+    /// on 2 cores about 1.4–1.5× at 10⁴ and 10⁵; below a few thousand components it costs more
+    /// than it gains.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = Some(parallel);
         self.end_run();
@@ -884,6 +887,7 @@ impl Modular {
             multipliers: vec![0.0; self.junctions.len()],
             row_terms,
             row_starts,
+            moved: vec![0.0; unknowns - self.junctions.len()],
             violation: 0.0,
             report: None,
             hidden,
@@ -1097,17 +1101,33 @@ impl Modular {
                 return Err(error);
             }
         }
-        let junction_violation = self.junctions.iter().map(|junction| {
-            let moved = junction.terms.iter().map(|&(c, i, a)| {
-                let component = &self.components[c];
-                a * component.part.proposed_step(i)
+        // The junctions' violation by the proposed steps (as moved by the projection).
+        let steps = |parts: Parts<'_>, run: &mut [f64]| {
+            parts.each(run, |component, _, own| {
+                let coordinates = component.part.coordinates();
+                for (i, moved) in own[..coordinates].iter_mut().enumerate() {
+                    *moved = component.part.proposed_step(i);
+                }
             });
-            moved.sum::<f64>().abs()
-        });
-        Ok((
-            report,
-            largest(std::iter::once(violation).chain(junction_violation)),
-        ))
+        };
+        let parts = Parts {
+            components: &mut self.components,
+            blocks: None,
+        };
+        in_runs(parts, &mut run.moved, grain, &steps, &|(), ()| ());
+        let (moved, row_terms, row_starts) = (&run.moved, &run.row_terms, &run.row_starts);
+        let junction = |k: usize| {
+            let terms = &row_terms[row_starts[k]..row_starts[k + 1]];
+            terms.iter().map(|&(u, a)| a * moved[u]).sum::<f64>().abs()
+        };
+        let junctions = self.junctions.len();
+        let violations = if grain < junctions {
+            let each = (0..junctions).into_par_iter().with_min_len(grain);
+            each.map(junction).reduce(|| 0.0, |a, b| largest([a, b]))
+        } else {
+            largest((0..junctions).map(junction))
+        };
+        Ok((report, largest([violation, violations])))
     }
 
     /// The name of unknown `column` of a step (`first`: the junctions' first).
