@@ -594,7 +594,10 @@ fn a_long_chain_steps_alike_in_parallel_and_one_component_after_another() {
     });
     assert_eq!(runs[0].q(), runs[1].q());
     assert_eq!(runs[0].p(), runs[1].p());
-    assert_eq!(runs[0].multipliers().unwrap(), runs[1].multipliers().unwrap());
+    assert_eq!(
+        runs[0].multipliers().unwrap(),
+        runs[1].multipliers().unwrap()
+    );
     assert_ne!(runs[0].q().as_slice(), q0.as_slice());
 }
 
