@@ -551,24 +551,29 @@ fn the_order_of_joining_does_not_change_the_steps() {
     assert_eq!(runs[0].multipliers().unwrap(), &reversed[..]);
 }
 
+/// The open chain of `cells` tethered masses at `x_j = 0.01 sin(κ j)` (each spring's end at the
+/// next mass), at rest, after `steps` steps in parallel (first) and one component after
+/// another (second).
+fn both_ways(cells: usize, kappa: f64, steps: u64) -> [Modular; 2] {
+    let x = |j: usize| 0.01 * (kappa * j as f64).sin();
+    let q0: Vec<f64> = (0..cells).flat_map(|j| [x(j), x(j + 1)]).collect();
+    let v0 = vec![0.0; 2 * cells];
+    [true, false].map(|parallel| {
+        let mut chain = ladder::modular_chain(1.0, 1.0, cells, false, 0.05)
+            .unwrap()
+            .with_parallel(parallel);
+        chain.start_from_velocity(&q0, &v0).unwrap();
+        chain.run(steps).unwrap();
+        chain
+    })
+}
+
 /// Stepped in parallel (rayon) or one component after another, the open chain of 200 cells
 /// steps bit for bit alike (each component's equations are its own; the Schur complement is
 /// summed in one order).
 #[test]
 fn parallel_and_sequential_steps_agree_bit_for_bit() {
-    let cells = 200;
-    // Masses x_j = 0.01 sin j, each spring's end at the next mass.
-    let x = |j: usize| 0.01 * (j as f64).sin();
-    let q0: Vec<f64> = (0..cells).flat_map(|j| [x(j), x(j + 1)]).collect();
-    let v0 = vec![0.0; 2 * cells];
-    let mut runs = [true, false].map(|parallel| {
-        let mut chain = ladder::modular_chain(1.0, 1.0, cells, false, 0.05)
-            .unwrap()
-            .with_parallel(parallel);
-        chain.start_from_velocity(&q0, &v0).unwrap();
-        chain.run(50).unwrap();
-        chain
-    });
+    let mut runs = both_ways(200, 1.0, 50);
     assert_eq!(runs[0].q(), runs[1].q());
     assert_eq!(runs[0].p(), runs[1].p());
     assert!(runs[0].q().amax() > 0.0);
@@ -577,28 +582,17 @@ fn parallel_and_sequential_steps_agree_bit_for_bit() {
 }
 
 /// A chain long enough (6 000 cells, 18 000 unknowns) that Newton's passes over its vectors
-/// are split across threads too: still the same steps bit for bit.
+/// are split across threads too: still the same steps bit for bit, and moved.
 #[test]
 fn a_long_chain_steps_alike_in_parallel_and_one_component_after_another() {
-    let cells = 6_000;
-    let x = |j: usize| 0.01 * (j as f64 * 0.3).sin();
-    let q0: Vec<f64> = (0..cells).flat_map(|j| [x(j), x(j + 1)]).collect();
-    let v0 = vec![0.0; 2 * cells];
-    let runs = [true, false].map(|parallel| {
-        let mut chain = ladder::modular_chain(1.0, 1.0, cells, false, 0.05)
-            .unwrap()
-            .with_parallel(parallel);
-        chain.start_from_velocity(&q0, &v0).unwrap();
-        chain.run(5).unwrap();
-        chain
-    });
+    let runs = both_ways(6_000, 0.3, 5);
     assert_eq!(runs[0].q(), runs[1].q());
     assert_eq!(runs[0].p(), runs[1].p());
     assert_eq!(
         runs[0].multipliers().unwrap(),
         runs[1].multipliers().unwrap()
     );
-    assert_ne!(runs[0].q().as_slice(), q0.as_slice());
+    assert!(runs[0].p().amax() > 0.0);
 }
 
 /// The series RLC from three components, two of them (the resistor and the capacitor) without
