@@ -162,6 +162,25 @@ fn constrained(c: &mut Criterion) {
     group.bench_function("lc_circuit_jacobian_each_step", |b| {
         b.iter(|| black_box(lc_newton.step()).expect("step"))
     });
+    // A driven RLC ladder of components (10 coordinates, resistors' forces affine): the kept
+    // Jacobian against one at each step.
+    for (name, options) in [
+        ("rlc_ladder", NewtonOptions::default()),
+        ("rlc_ladder_jacobian_each_step", newton),
+    ] {
+        let ladder = scenes::rlc_ladder::ladder(0.5, 0.3, 0.2);
+        let mut stepper = Stepper::new(ladder, Quadrature::midpoint(), 0.01)
+            .expect("valid scene")
+            .with_newton_options(options)
+            .expect("valid options");
+        stepper
+            .start_from_velocity(SVector::zeros(), SVector::zeros())
+            .expect("consistent start");
+        stepper.set_input("v.u", 1.0).expect("the source's input");
+        group.bench_function(name, |b| {
+            b.iter(|| black_box(stepper.step()).expect("step"))
+        });
+    }
     let mut knife =
         scenes::knife_edge::stepper(ConstraintPoint::Midpoint, 0.01).expect("valid scene");
     group.bench_function("knife_edge", |b| {

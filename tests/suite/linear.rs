@@ -1,15 +1,23 @@
-//! Linear models pay once: the attribute says which Lagrangians are quadratic in `(q, v)`, and a
-//! stepper then keeps one factorised Jacobian for a run of linear step equations (the LC
-//! circuit) and steps as Newton's method does, to round-off; a wrong claim costs iterations,
-//! not accuracy.
+//! Linear models pay once: the attribute says which Lagrangians are quadratic in `(q, v)` and
+//! which forces are affine with constant coefficients, and a stepper then keeps one factorised
+//! Jacobian for a run of linear step equations (the LC circuit, a driven RLC ladder, a driven
+//! damped oscillator) and steps as Newton's method does, to round-off; a wrong claim costs
+//! iterations, not accuracy.
 
 use dirac::StepEquations;
 use dirac::prelude::*;
-use scenes::{cartesian_pendulum, circuit, knife_edge, oscillator, pendulum};
+use scenes::{
+    cartesian_pendulum, circuit, components, knife_edge, oscillator, pendulum, rlc_ladder,
+};
 
 /// What the attribute declared: whether `S` is quadratic.
 fn quadratic<S: DiracSystem<N>, const N: usize>() -> bool {
     S::QUADRATIC
+}
+
+/// What the attribute declared: whether the forces of `S` are affine with constant coefficients.
+fn forces_affine<S: DiracSystem<N>, const N: usize>() -> bool {
+    S::FORCES_AFFINE
 }
 
 #[dirac_system(coordinates(x), lagrangian = 0.5 * m * dot(x).powi(2) - c * abs(x))]
@@ -31,6 +39,62 @@ struct Damped {
     c: f64,
 }
 
+/// A damped oscillator driven by an input and a sinusoid: affine forces.
+#[dirac_system(
+    coordinates(x),
+    lagrangian = 0.5 * dot(x).powi(2) - 0.5 * x * x,
+    forces((u + sin(2.0 * t) - c * dot(x) - k * x) * dx),
+    inputs(u),
+)]
+#[derive(Clone, Copy)]
+struct Driven {
+    c: f64,
+    k: f64,
+}
+
+/// Two coordinates of one array, a damper between them and a source scaled by a parameter.
+#[dirac_system(
+    coordinates(x[2]),
+    lagrangian = 0.5 * (dot(x[0]).powi(2) + dot(x[1]).powi(2)) - 0.5 * (x[0] - x[1]).powi(2),
+    forces(-c * (dot(x[0]) - dot(x[1])) * (dx[0] - dx[1]) + g * u * dx[0]),
+    inputs(u),
+)]
+struct Pair {
+    c: f64,
+    g: f64,
+}
+
+/// Forces whose derivatives move with the state, an input or the time.
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), forces(-c * dot(x).powi(3) * dx))]
+struct Cubic {
+    c: f64,
+}
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), forces(u * dot(x) * dx), inputs(u))]
+struct Gained;
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), forces(-t * x * dx))]
+struct Ageing;
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), forces(-c * abs(dot(x)) * dx))]
+struct Friction {
+    c: f64,
+}
+
+#[test]
+fn the_attribute_says_which_forces_are_affine() {
+    assert!(forces_affine::<Damped, 1>());
+    assert!(forces_affine::<Driven, 1>());
+    assert!(forces_affine::<components::Resistor, 1>());
+    assert!(forces_affine::<components::DcMotor, 2>());
+    assert!(forces_affine::<Pair, 2>());
+    assert!(!forces_affine::<Cubic, 1>());
+    assert!(!forces_affine::<Gained, 1>());
+    assert!(!forces_affine::<Ageing, 1>());
+    // c |v| is linear on each side of 0, with a slope that jumps.
+    assert!(!forces_affine::<Friction, 1>());
+    // A model of subsystems sums its components' Lagrangians and forces.
+    assert!(quadratic::<rlc_ladder::RlcLadder, 10>());
+    assert!(forces_affine::<rlc_ladder::RlcLadder, 10>());
+}
+
 #[test]
 fn the_attribute_says_which_lagrangians_are_quadratic() {
     assert!(quadratic::<circuit::LcCircuit, 4>());
@@ -48,7 +112,9 @@ fn only_linear_step_equations_say_their_jacobian_is_constant() {
     let lc = Stepper::new(circuit::LC, Quadrature::midpoint(), 0.01).unwrap();
     assert!(lc.equations().constant_jacobian());
     let damped = Stepper::new(Damped { c: 0.1 }, Quadrature::midpoint(), 0.01).unwrap();
-    assert!(quadratic::<Damped, 1>() && !damped.equations().constant_jacobian());
+    assert!(damped.equations().constant_jacobian());
+    let cubic = Stepper::new(Cubic { c: 0.1 }, Quadrature::midpoint(), 0.01).unwrap();
+    assert!(quadratic::<Cubic, 1>() && !cubic.equations().constant_jacobian());
     // A one-form of the position (the knife edge's heading), a holonomic constraint, and a
     // Lagrangian that is not quadratic.
     let knife = knife_edge::stepper(ConstraintPoint::Midpoint, 0.01).unwrap();
@@ -94,6 +160,69 @@ fn a_linear_model_keeps_one_jacobian_and_steps_as_newtons_method_does() {
         assert!(gap <= 1e-13, "{name}: the runs differ by {gap:e}");
         // And both are the circuit: q_c2(10) against its closed form.
         assert!((kept[2] - circuit::lc_q_c2(10.0)).abs() < 1e-3, "{name}");
+    }
+}
+
+/// The positions after 1 000 steps of `stepper` from rest at `q0`, its input `input` set before
+/// each step to a voltage that changes every step, and the Jacobians evaluated after the first.
+fn driven_run<S: DiracSystem<N>, const N: usize>(
+    mut stepper: Stepper<S, N>,
+    q0: SVector<f64, N>,
+    input: &str,
+) -> (SVector<f64, N>, usize) {
+    stepper.start_from_velocity(q0, SVector::zeros()).unwrap();
+    let mut jacobians = 0;
+    for k in 0..1_000 {
+        stepper
+            .set_input(input, 1.0 + (0.01 * k as f64).sin())
+            .unwrap();
+        stepper.step().unwrap();
+        if k > 0 {
+            jacobians += stepper.last_report().unwrap().jacobians;
+        }
+    }
+    (stepper.q(), jacobians)
+}
+
+#[test]
+fn driven_linear_models_keep_one_jacobian_and_step_as_newtons_method_does() {
+    let newton = NewtonOptions {
+        jacobian_reuse: Some(0.0),
+        ..Default::default()
+    };
+    let ladder = rlc_ladder::ladder(0.5, 0.3, 0.2);
+    let with = |options: NewtonOptions| {
+        Stepper::new(ladder, Quadrature::midpoint(), 0.01)
+            .unwrap()
+            .with_newton_options(options)
+            .unwrap()
+    };
+    let (kept, kept_jacobians) =
+        driven_run(with(NewtonOptions::default()), SVector::zeros(), "v.u");
+    let (fresh, fresh_jacobians) = driven_run(with(newton), SVector::zeros(), "v.u");
+    assert_eq!(kept_jacobians, 0);
+    assert!(fresh_jacobians >= 999, "{fresh_jacobians}");
+    let gap = (kept - fresh).amax();
+    assert!(
+        gap <= 1e-13 * fresh.amax(),
+        "the ladder's runs differ by {gap:e}"
+    );
+    let oscillator = Driven { c: 0.3, k: 0.5 };
+    for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
+        let name = quadrature.name();
+        let with = |options: NewtonOptions| {
+            Stepper::new(oscillator, quadrature.clone(), 0.01)
+                .unwrap()
+                .with_newton_options(options)
+                .unwrap()
+        };
+        let q0 = SVector::from([1.0]);
+        let (kept, kept_jacobians) = driven_run(with(NewtonOptions::default()), q0, "u");
+        let (fresh, fresh_jacobians) = driven_run(with(newton), q0, "u");
+        assert_eq!(kept_jacobians, 0, "{name}");
+        assert!(fresh_jacobians >= 999, "{name}: {fresh_jacobians}");
+        let gap = (kept - fresh).amax();
+        assert!(gap <= 1e-13, "{name}: the runs differ by {gap:e}");
     }
 }
 

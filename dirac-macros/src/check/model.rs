@@ -33,6 +33,9 @@ pub struct Model {
     /// Whether no force reads a velocity (`dot(x)`, `omega(R)`): the forces are functions of
     /// the positions, the time and the inputs alone.
     pub forces_free_of_velocity: bool,
+    /// Whether the forces are affine in the positions and velocities with constant
+    /// coefficients (`F = K q + D v + f(t, u)`): their part of a step's Jacobian never changes.
+    pub forces_affine: bool,
     pub inputs: Vec<Ident>,
     /// `__dirac::ConstraintPoint::...` when `constraint_at` is given.
     pub constraint_point: Option<TokenStream>,

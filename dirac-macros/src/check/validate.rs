@@ -424,6 +424,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
     let fields: Vec<Ident> = parameters.iter().map(|p| p.name.clone()).collect();
     let mut constant_one_forms = Vec::new();
     let mut one_form_derivatives = None;
+    let mut forces_affine = false;
     let one_form_names: Vec<String> = e
         .constraints
         .iter()
@@ -458,6 +459,19 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
             let (positions_algebra, state_algebra) = (algebra(Some(NO_VELOCITIES)), algebra(None));
             // Closed-form derivatives where every one-form has them (not on the Hamiltonian
             // route, whose trait has no such method).
+            // The forces affine with constant coefficients (not on the Hamiltonian route, whose
+            // trait has no such constant, nor on rotations and unit vectors, whose steps solve
+            // with Newton's method throughout).
+            forces_affine = !product
+                && !hamiltonian
+                && !e.input_array
+                && literal_dimension(coordinates).is_some_and(|n| {
+                    let varying: Vec<String> = std::iter::once("t".to_string())
+                        .chain(inputs.iter().map(|u| u.to_string()))
+                        .collect();
+                    let forms = e.forces.as_deref().unwrap_or_default();
+                    !forms.is_empty() && symbolic::forces_affine(forms, coordinates, n, &varying)
+                });
             one_form_derivatives = literal_dimension(coordinates)
                 .filter(|_| !product && !hamiltonian)
                 .and_then(|n| {
@@ -546,6 +560,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 holonomic,
                 forces,
                 forces_free_of_velocity,
+                forces_affine,
                 inputs,
                 constraint_point,
                 closed_form,

@@ -581,9 +581,15 @@ fn dirac_items(
                 const FORCES_FREE_OF_VELOCITY: bool = true;
             )
         });
+        let affine = model.forces_affine.then(|| {
+            quote!(
+                const FORCES_AFFINE: bool = true;
+            )
+        });
         items.extend(quote! {
             const FORCES: bool = true;
             #free
+            #affine
 
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
             fn force<__D: __dirac::Scalar>(

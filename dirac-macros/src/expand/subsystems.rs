@@ -149,6 +149,10 @@ pub fn expand(model: &Composite) -> TokenStream {
             const HOLONOMIC: usize = __END.holonomic;
             const FORCES: bool = false #(|| #systems::FORCES)*;
             const INPUTS: usize = __END.input;
+            // The sum of the components' Lagrangians and forces: quadratic, and affine, where
+            // every component's is.
+            const QUADRATIC: bool = true #(&& #systems::QUADRATIC)*;
+            const FORCES_AFFINE: bool = true #(&& (!#systems::FORCES || #systems::FORCES_AFFINE))*;
 
             fn lagrangian<__D: __dirac::Scalar>(&self, __q: &#dual, __v: &#dual) -> __D {
                 let mut __l = #zero;

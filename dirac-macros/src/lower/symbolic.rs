@@ -546,6 +546,9 @@ struct Reader<'a> {
     n: usize,
     /// Whether a differential `dx`, `dtheta[i]` reads as the rate of its coordinate (a one-form).
     differentials: bool,
+    /// A force one-form's reading: velocities `dot(x)` are variables `n..2n`, differentials
+    /// `2n..3n`, and the names in `varying` (the time, the inputs) `3n..`.
+    forces: Option<Vec<String>>,
 }
 
 impl Reader<'_> {
@@ -577,7 +580,18 @@ impl Reader<'_> {
             }
             _ => return None,
         };
-        Some(self.graph.intern(Node::Variable(self.n + i)))
+        let rates = if self.forces.is_some() {
+            2 * self.n
+        } else {
+            self.n
+        };
+        Some(self.graph.intern(Node::Variable(rates + i)))
+    }
+
+    /// Which of a force's varying names (the time, an input) `p` is.
+    fn varying(&self, p: &syn::ExprPath) -> Option<usize> {
+        let name = p.path.get_ident()?.to_string();
+        self.forces.as_ref()?.iter().position(|v| *v == name)
     }
 
     /// The flat index of `x` or `theta[i]` (literal `i`).
@@ -627,7 +641,10 @@ impl Reader<'_> {
             }
             Expr::Path(p) => match p.path.get_ident().and_then(|i| self.coordinate(i)) {
                 Some(_) => Some(self.graph.intern(Node::Variable(self.flat_index(expr)?))),
-                None => Some(self.graph.constant(p.to_token_stream())),
+                None => match self.varying(p) {
+                    Some(k) => Some(self.graph.intern(Node::Variable(3 * self.n + k))),
+                    None => Some(self.graph.constant(p.to_token_stream())),
+                },
             },
             Expr::Index(ix) => {
                 let Expr::Path(p) = &*ix.expr else {
@@ -670,7 +687,7 @@ impl Reader<'_> {
                 };
                 let name = p.path.get_ident()?.to_string();
                 let arguments: Vec<&Expr> = call.args.iter().collect();
-                if name == "dot" && !self.differentials {
+                if name == "dot" && (!self.differentials || self.forces.is_some()) {
                     let [arg] = arguments[..] else {
                         return None;
                     };
@@ -923,9 +940,63 @@ fn graph_of(
         coordinates: layout(coordinates, n)?,
         n,
         differentials,
+        forces: None,
     }
     .read(expr)?;
     Some((graph, id))
+}
+
+/// Whether the force one-forms `Σ_i F_i(q, v, t, u) dq_i` are affine in the state with
+/// constant coefficients, `F = K q + D v + f(t, u)`: each form linear in the differentials, every
+/// derivative of a coefficient in a position or a velocity free of the state, the time and the
+/// inputs (`varying`), and no `abs` or `signum` of the state. The forces' part of a step's
+/// Jacobian is then the same at every step. `false` where a form leaves the graph's language
+/// (a function of the runtime, an index not written as a literal).
+pub fn forces_affine(
+    forms: &[Expr],
+    coordinates: &[Coordinate],
+    n: usize,
+    varying: &[String],
+) -> bool {
+    let Some(layout) = layout(coordinates, n) else {
+        return false;
+    };
+    let mut graph = Graph::new(n);
+    for form in forms {
+        let Some(form) = (Reader {
+            graph: &mut graph,
+            coordinates: layout.clone(),
+            n,
+            differentials: true,
+            forces: Some(varying.to_vec()),
+        })
+        .read(form) else {
+            return false;
+        };
+        if graph.kinks(|i| i < 2 * n) {
+            return false;
+        }
+        for i in 0..n {
+            let coefficient = graph.derivative(form, 2 * n + i);
+            for x in 0..2 * n {
+                let slope = graph.derivative(coefficient, x);
+                if graph.state[slope] {
+                    return false;
+                }
+            }
+            // Linear in the differentials.
+            for k in 0..n {
+                let moved = graph.derivative(coefficient, 2 * n + k);
+                if !graph.is(moved, 0.0) {
+                    return false;
+                }
+            }
+            if graph.nodes.len() > MAX_GRAPH {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// The closed forms of `L`, or `None` where the expression leaves the graph's language.

@@ -550,6 +550,10 @@ where
     const HOLONOMIC: usize = A::HOLONOMIC + B::HOLONOMIC;
     const FORCES: bool = A::FORCES || B::FORCES;
     const INPUTS: usize = A::INPUTS + B::INPUTS;
+    // L = L_A + L_B, F = F_A + F_B: quadratic, and affine, where both are.
+    const QUADRATIC: bool = A::QUADRATIC && B::QUADRATIC;
+    const FORCES_AFFINE: bool =
+        (!A::FORCES || A::FORCES_AFFINE) && (!B::FORCES || B::FORCES_AFFINE);
 
     fn lagrangian<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D {
         Self::A.lagrangian(&self.a, q, v) + Self::B.lagrangian(&self.b, q, v)

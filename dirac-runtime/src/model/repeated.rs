@@ -136,6 +136,8 @@ impl<S: DiracSystem<M>, const K: usize, const M: usize, const N: usize, const C:
     const HOLONOMIC: usize = K * S::HOLONOMIC;
     const FORCES: bool = S::FORCES;
     const INPUTS: usize = K * S::INPUTS;
+    const QUADRATIC: bool = S::QUADRATIC;
+    const FORCES_AFFINE: bool = S::FORCES_AFFINE;
 
     fn lagrangian<D: Scalar>(&self, q: &SVector<D, N>, v: &SVector<D, N>) -> D {
         (0..K).fold(D::from(0.0), |sum, i| {

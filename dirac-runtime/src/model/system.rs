@@ -114,8 +114,9 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
 
     /// Whether `L` is a quadratic polynomial in `(q, v)`: every second derivative a constant
     /// (circuits of linear elements, oscillators, linearised models). On `Rⁿ`, with constant
-    /// one-forms, no holonomic constraints and no forces, the step equations are then linear with
-    /// constant coefficients, and a [`Stepper`](crate::Stepper) keeps their factorised Jacobian
+    /// one-forms, no holonomic constraints, and no forces or forces affine with constant
+    /// coefficients ([`FORCES_AFFINE`](Self::FORCES_AFFINE)), the step equations are then
+    /// linear with constant coefficients, and a [`Stepper`](crate::Stepper) keeps their factorised Jacobian
     /// from one step to the next rather than evaluating it at every step. `false` by default;
     /// `#[dirac_system]` derives it from a Lagrangian written as an expression. A wrong claim
     /// never gives a wrong answer: a kept Jacobian that is not the equations' is evaluated
@@ -144,6 +145,42 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// (no `dot(x)` or `omega(R)` in `forces(...)`), and the explicit step checks the claim at
     /// the start of every run.
     const FORCES_FREE_OF_VELOCITY: bool = false;
+
+    /// Whether the [`force`](Self::force) is affine in the position and the velocity with
+    /// constant coefficients, `F = K q + D v + f(t, u)` (resistors, dampers, linear springs
+    /// written as forces, sources): its part of a step's Jacobian is the same at every step, so
+    /// with a [`QUADRATIC`](Self::QUADRATIC) Lagrangian the step equations stay linear with
+    /// constant coefficients. `false` by default; `#[dirac_system]` derives it from the forces'
+    /// expressions (no product of the state with itself, the time or an input, and no
+    /// `abs` or `signum` of the state). As for `QUADRATIC`, a wrong claim costs iterations,
+    /// never the answer.
+    ///
+    /// ```
+    /// use dirac_runtime::{DiracSystem, Scalar};
+    /// use nalgebra::SVector;
+    /// /// An RL loop driven by a voltage `u`: L = ½ l q̇², F = u − r q̇.
+    /// struct Rl;
+    /// impl DiracSystem<1> for Rl {
+    ///     const QUADRATIC: bool = true;
+    ///     const FORCES: bool = true;
+    ///     const FORCES_AFFINE: bool = true;
+    ///     const INPUTS: usize = 1;
+    ///     fn lagrangian<D: Scalar>(&self, _q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] * 0.5
+    ///     }
+    ///     fn force<D: Scalar>(
+    ///         &self,
+    ///         _q: &SVector<D, 1>,
+    ///         v: &SVector<D, 1>,
+    ///         _t: f64,
+    ///         u: &[D],
+    ///     ) -> SVector<D, 1> {
+    ///         SVector::from([u[0] - v[0] * 2.0])
+    ///     }
+    /// }
+    /// assert!(<Rl as DiracSystem<1>>::FORCES_AFFINE);
+    /// ```
+    const FORCES_AFFINE: bool = false;
 
     /// Whether [`one_form_with_derivative`](Self::one_form_with_derivative) gives the one-forms'
     /// derivatives in closed form (`false` by default: dual numbers take them).

@@ -1310,14 +1310,15 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     }
 
     /// `L` quadratic with constant coefficients (`QUADRATIC`) on a translation chart, its
-    /// one-forms constant, and no holonomic constraint, force or coupling: every row is linear
-    /// in the unknowns with coefficients fixed by `h`.
+    /// one-forms constant, its forces (if any) affine with constant coefficients
+    /// (`FORCES_AFFINE`), and no holonomic constraint or coupling: every row is linear in the
+    /// unknowns with coefficients fixed by `h`.
     fn constant_jacobian(&self) -> bool {
         let system = self.discrete.system();
         S::QUADRATIC
             && C::TRANSLATION
             && S::HOLONOMIC == 0
-            && !S::FORCES
+            && (!S::FORCES || S::FORCES_AFFINE)
             && self.coupling.is_none()
             && (0..S::ONE_FORMS).all(|a| system.one_form_is_constant(a))
     }
