@@ -3,9 +3,9 @@
 //! no code generated) against the `dirac` library this test was built with, and its diagnostics
 //! must equal the `.stderr` file beside it, paths outside the case normalised (see
 //! [`normalise`]). Nothing is built again: the cases need only the workspace's own artifacts in
-//! this test's target directory. `DIRAC_BLESS=1 cargo test -p dirac-macro-tests --test ui` writes the `.stderr`
-//! files anew from rustc's output (read the diff before committing it). The valid inputs are
-//! `tests/expansions/main.rs`.
+//! this test's target directory. `DIRAC_BLESS=1 cargo test -p dirac-macro-tests --test ui`
+//! writes the `.stderr` files anew from rustc's output (read the diff before committing it).
+//! The valid inputs are `tests/expansions/main.rs`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
