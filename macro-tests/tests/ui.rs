@@ -40,7 +40,7 @@ fn ui() {
         .parent()
         .expect("a test binary lies in a folder")
         .to_path_buf();
-    let dirac = newest_library(&deps, "dirac");
+    let dirac = linked_library(&deps, "dirac");
     let mut cases: Vec<PathBuf> = std::fs::read_dir(package.join(CASES))
         .expect("tests/ui/fail is readable")
         .map(|entry| entry.expect("a readable entry").path())
@@ -79,8 +79,16 @@ fn ui() {
                     let stderr = String::from_utf8_lossy(&output.stderr);
                     let actual = normalise(&stderr, relative);
                     let snapshot = case.with_extension("stderr");
+                    let setup = SETUP_ERRORS.iter().find(|code| stderr.contains(*code));
                     let failure = if output.status.success() {
                         Some(format!("{name}: compiled without an error\n{stderr}"))
+                    } else if let Some(code) = setup {
+                        Some(format!(
+                            "{name}: rustc could not load the workspace's crates ({code}): a \
+                             stale or foreign build in {}? `cargo clean -p dirac` rebuilds it\n\
+                             {stderr}",
+                            deps.display()
+                        ))
                     } else if bless {
                         std::fs::write(&snapshot, &actual).expect("the snapshot is writable");
                         None
@@ -119,26 +127,47 @@ fn rustc() -> std::ffi::OsString {
     std::env::var_os("RUSTC").unwrap_or_else(|| "rustc".into())
 }
 
-/// The most recently built `lib{name}-*.rlib` in `deps`: cargo builds it (again, where a source
-/// changed) before this test, so an older one there is another feature set's or a stale build's.
-fn newest_library(deps: &Path, name: &str) -> PathBuf {
+/// Errors that say rustc could not load the workspace's crates (not found, several candidates,
+/// built by another rustc or against other dependencies), not a diagnostic of the case.
+const SETUP_ERRORS: &[&str] = &[
+    "E0460", "E0461", "E0462", "E0463", "E0464", "E0514", "E0519",
+];
+
+/// The `lib{name}-*.rlib` in `deps` that this test was linked with: the newest one built no later
+/// than the test binary (cargo builds a dependency before the test it links, and several builds
+/// of one crate, with other features, may share the folder).
+fn linked_library(deps: &Path, name: &str) -> PathBuf {
     let prefix = format!("lib{name}-");
-    std::fs::read_dir(deps)
+    let built = |path: &Path| std::fs::metadata(path).and_then(|m| m.modified()).ok();
+    let test = std::env::current_exe().ok().and_then(|exe| built(&exe));
+    let candidates: Vec<(PathBuf, Option<std::time::SystemTime>)> = std::fs::read_dir(deps)
         .expect("the test's folder is readable")
         .filter_map(|entry| entry.ok())
-        .filter(|entry| {
-            let file = entry.file_name();
-            let file = file.to_string_lossy();
+        .map(|entry| entry.path())
+        .filter(|path| {
+            let file = path.file_name().unwrap_or_default().to_string_lossy();
             file.starts_with(&prefix) && file.ends_with(".rlib")
         })
-        .max_by_key(|entry| entry.metadata().and_then(|m| m.modified()).ok())
-        .map(|entry| entry.path())
+        .map(|path| {
+            let time = built(&path);
+            (path, time)
+        })
+        .collect();
+    let newest = |before: Option<std::time::SystemTime>| {
+        candidates
+            .iter()
+            .filter(|(_, time)| before.is_none() || *time <= before)
+            .max_by_key(|(_, time)| *time)
+            .map(|(path, _)| path.clone())
+    };
+    newest(test)
+        .or_else(|| newest(None))
         .unwrap_or_else(|| panic!("no {prefix}*.rlib in {}", deps.display()))
 }
 
-/// A fresh folder for the cases' metadata, removed at the end.
+/// A fresh folder for the cases' metadata (one per process), removed at the end.
 fn tempdir() -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("ui");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("ui-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("the target's temporary folder is writable");
     dir
@@ -161,6 +190,9 @@ fn normalise(stderr: &str, package: &Path) -> String {
             || line.starts_with("Some errors have detailed explanations")
         {
             continue;
+        }
+        if line.starts_with("error") || line.starts_with("warning") {
+            outside = false;
         }
         let trimmed = line.trim_start();
         let indent = &line[..line.len() - trimmed.len()];
@@ -267,20 +299,25 @@ fn without_line_and_column(location: &str) -> &str {
     path
 }
 
-/// A path outside the case: `$CARGO/crate-$VERSION/…` for a registry's source, else
-/// `$WORKSPACE/…` (rustc names the workspace's files relative to its root).
+/// A path outside the case: `$CARGO/crate-$VERSION/…` for a registry's source, `$RUST/…` for
+/// the standard library's, else `$WORKSPACE/…` (rustc names the workspace's files relative to
+/// its root).
 fn outside_path(path: &str) -> String {
     if let Some((_, after)) = path.split_once("/registry/src/")
         && let Some((_, in_index)) = after.split_once('/')
     {
         let (krate, rest) = in_index.split_once('/').unwrap_or((in_index, ""));
-        let name = match krate.rfind('-') {
-            Some(dash) if krate[dash + 1..].starts_with(|c: char| c.is_ascii_digit()) => {
-                &krate[..dash]
-            }
-            _ => krate,
-        };
+        // The version begins at the first `-` before a digit (`num-dual-0.15.1`, `x-1.0.0-rc.1`).
+        let dash = krate
+            .char_indices()
+            .find(|&(i, c)| c == '-' && krate[i + 1..].starts_with(|d: char| d.is_ascii_digit()));
+        let name = dash.map_or(krate, |(i, _)| &krate[..i]);
         return format!("$CARGO/{name}-$VERSION/{rest}");
+    }
+    if (path.starts_with("/rustc/") || path.contains("/lib/rustlib/src/rust/"))
+        && let Some((_, library)) = path.split_once("/library/")
+    {
+        return format!("$RUST/{library}");
     }
     format!("$WORKSPACE/{path}")
 }

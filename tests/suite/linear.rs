@@ -74,8 +74,25 @@ struct Gained;
 #[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), forces(-t * x * dx))]
 struct Ageing;
 #[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), forces(-c * abs(dot(x)) * dx))]
+#[derive(Clone, Copy)]
 struct Friction {
     c: f64,
+}
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), forces(-x * dot(x) * dx))]
+struct VanDerPol;
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), forces(-sin(x) * dx))]
+#[derive(Clone, Copy)]
+struct Swinging;
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), forces(-x / t * dx))]
+struct Relaxing;
+#[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2), forces(-x.powi(2) * dx))]
+struct Stiffening;
+
+/// A model of subsystems with one component whose forces are not affine.
+#[dirac_system(subsystems(r, f), junctions(series = r.dq - f.dx))]
+struct Rubbing {
+    r: components::Resistor,
+    f: Friction,
 }
 
 #[test]
@@ -88,11 +105,66 @@ fn the_attribute_says_which_forces_are_affine() {
     assert!(!forces_affine::<Cubic, 1>());
     assert!(!forces_affine::<Gained, 1>());
     assert!(!forces_affine::<Ageing, 1>());
+    assert!(!forces_affine::<VanDerPol, 1>());
+    assert!(!forces_affine::<Swinging, 1>());
+    assert!(!forces_affine::<Relaxing, 1>());
+    assert!(!forces_affine::<Stiffening, 1>());
     // c |v| is linear on each side of 0, with a slope that jumps.
     assert!(!forces_affine::<Friction, 1>());
+    assert!(!forces_affine::<Rubbing, 2>());
     // A model of subsystems sums its components' Lagrangians and forces.
     assert!(quadratic::<rlc_ladder::RlcLadder, 10>());
     assert!(forces_affine::<rlc_ladder::RlcLadder, 10>());
+}
+
+/// Whether a model is quadratic, and its forces affine, read from a value.
+fn declared<S: DiracSystem<N>, const N: usize>(_: &S) -> (bool, bool) {
+    (S::QUADRATIC, S::FORCES_AFFINE)
+}
+
+#[test]
+fn interconnections_and_repeated_components_are_linear_where_every_component_is() {
+    use dirac::interconnection::{Interconnection, Junction};
+    let series = |a: &str, b: &str| [Junction::new("series").flow(a, 1.0).flow(b, -1.0)];
+    let rl = Interconnection::new(
+        ("l", components::Inductor { l: 1.0 }),
+        ("r", components::Resistor { r: 0.5 }),
+        series("l.q", "r.q"),
+    )
+    .unwrap();
+    assert_eq!(declared::<_, 2>(&rl), (true, true));
+    let rubbing = Interconnection::new(
+        ("r", components::Resistor { r: 0.5 }),
+        ("f", Friction { c: 0.1 }),
+        series("r.q", "f.x"),
+    )
+    .unwrap();
+    assert_eq!(declared::<_, 2>(&rubbing), (true, false));
+    let swinging = Interconnection::new(
+        ("l", components::Inductor { l: 1.0 }),
+        (
+            "arm",
+            components::Arm {
+                inertia: 1.0,
+                mgd: 1.0,
+            },
+        ),
+        series("l.q", "arm.phi"),
+    )
+    .unwrap();
+    assert_eq!(declared::<_, 2>(&swinging), (false, true));
+    let free = Junction::new("shaft")
+        .flow("motor[0].theta", 1.0)
+        .flow("motor[1].theta", -1.0);
+    let motors = Repeated::<components::DcMotor, 2, 2, 4, 1>::new(
+        "motor",
+        [scenes::motor::MOTOR; 2],
+        [free],
+    )
+    .unwrap();
+    assert_eq!(declared::<_, 4>(&motors), (true, true));
+    let swings = Repeated::<Swinging, 2, 1, 2, 0>::new("s", [Swinging, Swinging], []).unwrap();
+    assert_eq!(declared::<_, 2>(&swings), (true, false));
 }
 
 #[test]

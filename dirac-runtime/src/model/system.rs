@@ -116,8 +116,9 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// (circuits of linear elements, oscillators, linearised models). On `Rⁿ`, with constant
     /// one-forms, no holonomic constraints, and no forces or forces affine with constant
     /// coefficients ([`FORCES_AFFINE`](Self::FORCES_AFFINE)), the step equations are then
-    /// linear with constant coefficients, and a [`Stepper`](crate::Stepper) keeps their factorised Jacobian
-    /// from one step to the next rather than evaluating it at every step. `false` by default;
+    /// linear with constant coefficients, and a [`Stepper`](crate::Stepper) keeps their
+    /// factorised Jacobian from one step to the next rather than evaluating it at every step.
+    /// `false` by default;
     /// `#[dirac_system]` derives it from a Lagrangian written as an expression. A wrong claim
     /// never gives a wrong answer: a kept Jacobian that is not the equations' is evaluated
     /// again where it contracts too slowly, and a solve that still cannot converge fails as
@@ -152,8 +153,10 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// with a [`QUADRATIC`](Self::QUADRATIC) Lagrangian the step equations stay linear with
     /// constant coefficients. `false` by default; `#[dirac_system]` derives it from the forces'
     /// expressions (no product of the state with itself, the time or an input, and no
-    /// `abs` or `signum` of the state). As for `QUADRATIC`, a wrong claim costs iterations,
-    /// never the answer.
+    /// `abs` or `signum` of the state). As for `QUADRATIC`, a wrong claim never gives a wrong
+    /// answer: the kept Jacobian is evaluated again where it contracts too slowly, and a solve
+    /// that still cannot converge fails as any other (where Newton's method, which a cheap
+    /// Jacobian would otherwise get, might have converged).
     ///
     /// ```
     /// use dirac_runtime::{DiracSystem, Scalar};
