@@ -216,22 +216,37 @@ fn lc_run(quadrature: Quadrature, options: NewtonOptions) -> (SVector<f64, 4>, u
     (stepper.q(), jacobians)
 }
 
-#[test]
-fn a_linear_model_keeps_one_jacobian_and_steps_as_newtons_method_does() {
-    let newton = NewtonOptions {
+/// Newton's method: a Jacobian at every evaluation.
+fn newtons_method() -> NewtonOptions {
+    NewtonOptions {
         jacobian_reuse: Some(0.0),
         ..Default::default()
-    };
+    }
+}
+
+/// 1 000 steps with the kept Jacobian (`kept`: positions, Jacobians after the first step)
+/// against Newton's method (`fresh`): none evaluated by the first, one a step by the second, and
+/// the same positions to `tolerance`.
+fn assert_kept_as_newton<const N: usize>(
+    name: &str,
+    (kept, kept_jacobians): (SVector<f64, N>, usize),
+    (fresh, fresh_jacobians): (SVector<f64, N>, usize),
+    tolerance: f64,
+) {
+    assert_eq!(kept_jacobians, 0, "{name}");
+    assert!(fresh_jacobians >= 999, "{name}: {fresh_jacobians}");
+    let gap = (kept - fresh).amax();
+    assert!(gap <= tolerance, "{name}: the runs differ by {gap:e}");
+}
+
+#[test]
+fn a_linear_model_keeps_one_jacobian_and_steps_as_newtons_method_does() {
     for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
         let name = quadrature.name();
-        let (kept, kept_jacobians) = lc_run(quadrature.clone(), NewtonOptions::default());
-        let (fresh, fresh_jacobians) = lc_run(quadrature, newton);
-        assert_eq!(kept_jacobians, 0, "{name}");
-        assert!(fresh_jacobians >= 999, "{name}: {fresh_jacobians}");
-        let gap = (kept - fresh).amax();
-        assert!(gap <= 1e-13, "{name}: the runs differ by {gap:e}");
+        let kept = lc_run(quadrature.clone(), NewtonOptions::default());
+        assert_kept_as_newton(&name, kept, lc_run(quadrature, newtons_method()), 1e-13);
         // And both are the circuit: q_c2(10) against its closed form.
-        assert!((kept[2] - circuit::lc_q_c2(10.0)).abs() < 1e-3, "{name}");
+        assert!((kept.0[2] - circuit::lc_q_c2(10.0)).abs() < 1e-3, "{name}");
     }
 }
 
@@ -258,10 +273,6 @@ fn driven_run<S: DiracSystem<N>, const N: usize>(
 
 #[test]
 fn driven_linear_models_keep_one_jacobian_and_step_as_newtons_method_does() {
-    let newton = NewtonOptions {
-        jacobian_reuse: Some(0.0),
-        ..Default::default()
-    };
     let ladder = rlc_ladder::ladder(0.5, 0.3, 0.2);
     let with = |options: NewtonOptions| {
         Stepper::new(ladder, Quadrature::midpoint(), 0.01)
@@ -269,19 +280,12 @@ fn driven_linear_models_keep_one_jacobian_and_step_as_newtons_method_does() {
             .with_newton_options(options)
             .unwrap()
     };
-    let (kept, kept_jacobians) =
-        driven_run(with(NewtonOptions::default()), SVector::zeros(), "v.u");
-    let (fresh, fresh_jacobians) = driven_run(with(newton), SVector::zeros(), "v.u");
-    assert_eq!(kept_jacobians, 0);
-    assert!(fresh_jacobians >= 999, "{fresh_jacobians}");
-    let gap = (kept - fresh).amax();
-    assert!(
-        gap <= 1e-13 * fresh.amax(),
-        "the ladder's runs differ by {gap:e}"
-    );
+    let kept = driven_run(with(NewtonOptions::default()), SVector::zeros(), "v.u");
+    let fresh = driven_run(with(newtons_method()), SVector::zeros(), "v.u");
+    let scale = fresh.0.amax();
+    assert_kept_as_newton("ladder", kept, fresh, 1e-13 * scale);
     let oscillator = Driven { c: 0.3, k: 0.5 };
     for quadrature in [Quadrature::midpoint(), Quadrature::galerkin(2).unwrap()] {
-        let name = quadrature.name();
         let with = |options: NewtonOptions| {
             Stepper::new(oscillator, quadrature.clone(), 0.01)
                 .unwrap()
@@ -289,12 +293,9 @@ fn driven_linear_models_keep_one_jacobian_and_step_as_newtons_method_does() {
                 .unwrap()
         };
         let q0 = SVector::from([1.0]);
-        let (kept, kept_jacobians) = driven_run(with(NewtonOptions::default()), q0, "u");
-        let (fresh, fresh_jacobians) = driven_run(with(newton), q0, "u");
-        assert_eq!(kept_jacobians, 0, "{name}");
-        assert!(fresh_jacobians >= 999, "{name}: {fresh_jacobians}");
-        let gap = (kept - fresh).amax();
-        assert!(gap <= 1e-13, "{name}: the runs differ by {gap:e}");
+        let kept = driven_run(with(NewtonOptions::default()), q0, "u");
+        let fresh = driven_run(with(newtons_method()), q0, "u");
+        assert_kept_as_newton(&quadrature.name(), kept, fresh, 1e-13);
     }
 }
 
