@@ -48,69 +48,29 @@ fn ui() {
         .collect();
     cases.sort();
     assert!(!cases.is_empty(), "no cases in {CASES}");
-    let bless = std::env::var_os("DIRAC_BLESS").is_some_and(|v| v == "1");
-    let out = tempdir();
-
+    let checker = Checker {
+        workspace,
+        package: relative,
+        deps: &deps,
+        dirac: &dirac,
+        out: tempdir(),
+        bless: std::env::var_os("DIRAC_BLESS").is_some_and(|v| v == "1"),
+    };
     let next = AtomicUsize::new(0);
     let failures = Mutex::new(Vec::new());
     let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
     std::thread::scope(|scope| {
         for _ in 0..threads {
             scope.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(case) = cases.get(i) else { break };
-                    let name = case.file_stem().unwrap().to_string_lossy().into_owned();
-                    let source = relative.join(CASES).join(case.file_name().unwrap());
-                    let output = Command::new(rustc())
-                        .current_dir(workspace)
-                        .args(FLAGS)
-                        .arg("--crate-name")
-                        .arg(&name)
-                        .arg("-o")
-                        .arg(out.join(format!("lib{name}.rmeta")))
-                        .arg("-L")
-                        .arg(format!("dependency={}", deps.display()))
-                        .arg("--extern")
-                        .arg(format!("dirac={}", dirac.display()))
-                        .arg(&source)
-                        .output()
-                        .expect("rustc runs");
-                    let stderr = String::from_utf8_lossy(&output.stderr);
-                    let actual = normalise(&stderr, relative);
-                    let snapshot = case.with_extension("stderr");
-                    let setup = SETUP_ERRORS.iter().find(|code| stderr.contains(*code));
-                    let failure = if output.status.success() {
-                        Some(format!("{name}: compiled without an error\n{stderr}"))
-                    } else if let Some(code) = setup {
-                        Some(format!(
-                            "{name}: rustc could not load the workspace's crates ({code}): a \
-                             stale or foreign build in {}? `cargo clean -p dirac` rebuilds it\n\
-                             {stderr}",
-                            deps.display()
-                        ))
-                    } else if bless {
-                        std::fs::write(&snapshot, &actual).expect("the snapshot is writable");
-                        None
-                    } else {
-                        let expected = std::fs::read_to_string(&snapshot).unwrap_or_default();
-                        (expected.trim_end() != actual.trim_end()).then(|| {
-                            format!(
-                                "{name}: the diagnostics differ from {}\n--- expected\n{}\n--- actual\n{}",
-                                snapshot.display(),
-                                expected.trim_end(),
-                                actual.trim_end()
-                            )
-                        })
-                    };
-                    if let Some(failure) = failure {
+                while let Some(case) = cases.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    if let Some(failure) = checker.check(case) {
                         failures.lock().unwrap().push(failure);
                     }
                 }
             });
         }
     });
-    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&checker.out);
     let failures = failures.into_inner().unwrap();
     assert!(
         failures.is_empty(),
@@ -120,6 +80,72 @@ fn ui() {
         dirac.display(),
         failures.join("\n\n")
     );
+}
+
+/// What checking a case needs: where rustc runs and what it reads, where it writes.
+struct Checker<'a> {
+    workspace: &'a Path,
+    /// This package's path relative to the workspace.
+    package: &'a Path,
+    deps: &'a Path,
+    dirac: &'a Path,
+    out: PathBuf,
+    /// Whether to write the snapshots anew rather than compare with them.
+    bless: bool,
+}
+
+impl Checker<'_> {
+    /// Checks one case: `None` where its diagnostics are its snapshot's (or, blessing, were
+    /// written into it), else what failed.
+    fn check(&self, case: &Path) -> Option<String> {
+        let file = case.file_name().expect("a case is a file");
+        let name = case
+            .file_stem()
+            .expect("a case is a file")
+            .to_string_lossy()
+            .into_owned();
+        let source = self.package.join(CASES).join(file);
+        let output = Command::new(rustc())
+            .current_dir(self.workspace)
+            .args(FLAGS)
+            .arg("--crate-name")
+            .arg(&name)
+            .arg("-o")
+            .arg(self.out.join(format!("lib{name}.rmeta")))
+            .arg("-L")
+            .arg(format!("dependency={}", self.deps.display()))
+            .arg("--extern")
+            .arg(format!("dirac={}", self.dirac.display()))
+            .arg(&source)
+            .output()
+            .expect("rustc runs");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        if output.status.success() {
+            return Some(format!("{name}: compiled without an error\n{stderr}"));
+        }
+        if let Some(code) = SETUP_ERRORS.iter().find(|code| stderr.contains(*code)) {
+            return Some(format!(
+                "{name}: rustc could not load the workspace's crates ({code}): a stale or foreign \
+                 build in {}? `cargo clean -p dirac` rebuilds it\n{stderr}",
+                self.deps.display()
+            ));
+        }
+        let actual = normalise(&stderr, self.package);
+        let snapshot = case.with_extension("stderr");
+        if self.bless {
+            std::fs::write(&snapshot, &actual).expect("the snapshot is writable");
+            return None;
+        }
+        let expected = std::fs::read_to_string(&snapshot).unwrap_or_default();
+        (expected.trim_end() != actual.trim_end()).then(|| {
+            format!(
+                "{name}: the diagnostics differ from {}\n--- expected\n{}\n--- actual\n{}",
+                snapshot.display(),
+                expected.trim_end(),
+                actual.trim_end()
+            )
+        })
+    }
 }
 
 /// The rustc of the toolchain that built this test (rustup's proxy picks the same one).

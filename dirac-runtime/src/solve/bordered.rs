@@ -515,18 +515,24 @@ mod tests {
         (bordered, dense)
     }
 
+    /// Both matrices factorised and solved for `b_i = sin i`: their solutions.
+    fn solutions(a: &mut impl Jacobian, b: &mut impl Jacobian) -> (DVector<f64>, DVector<f64>) {
+        a.factorise(1e-13).unwrap();
+        b.factorise(1e-13).unwrap();
+        let rhs = DVector::from_fn(a.size(), |i, _| (i as f64).sin());
+        let (mut x, mut y) = (rhs.clone(), rhs);
+        a.solve(x.as_mut_slice());
+        b.solve(y.as_mut_slice());
+        (x, y)
+    }
+
     #[test]
     fn solves_and_measures_as_the_dense_matrix() {
         for (k, n) in [(2, 1), (5, 3), (12, 2)] {
             let (mut bordered, mut dense) = chain(k, n);
             assert_eq!(bordered.norm(), dense.norm());
             assert_eq!(bordered.band(), usize::from(k > 2));
-            bordered.factorise(1e-13).unwrap();
-            dense.factorise(1e-13).unwrap();
-            let b = DVector::from_fn(bordered.size(), |i, _| (i as f64).sin());
-            let (mut x, mut y) = (b.clone(), b.clone());
-            bordered.solve(x.as_mut_slice());
-            dense.solve(y.as_mut_slice());
+            let (x, y) = solutions(&mut bordered, &mut dense);
             assert!((&x - &y).amax() < 1e-13 * y.amax(), "k {k}, n {n}");
         }
     }
@@ -537,12 +543,7 @@ mod tests {
         let mut many = one.clone().parallel(1);
         assert_eq!(one.norm(), many.norm());
         assert!(many.is_finite());
-        one.factorise(1e-13).unwrap();
-        many.factorise(1e-13).unwrap();
-        let b = DVector::from_fn(one.size(), |i, _| (i as f64).cos());
-        let (mut x, mut y) = (b.clone(), b.clone());
-        one.solve(x.as_mut_slice());
-        many.solve(y.as_mut_slice());
+        let (x, y) = solutions(&mut one, &mut many);
         assert_eq!(x, y);
     }
 
