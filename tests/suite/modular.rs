@@ -568,12 +568,12 @@ fn both_ways(cells: usize, kappa: f64, steps: u64) -> [Modular; 2] {
     })
 }
 
-/// Stepped in parallel (rayon) or one component after another, the open chain of 200 cells
-/// steps bit for bit alike (each component's equations are its own; the Schur complement is
-/// summed in one order).
+/// Stepped in parallel (rayon) or one component after another, the open chain of 2 500 cells
+/// (long enough to be split into tasks) steps bit for bit alike (each component's equations are
+/// its own; the Schur complement is summed in one order).
 #[test]
 fn parallel_and_sequential_steps_agree_bit_for_bit() {
-    let mut runs = both_ways(200, 1.0, 50);
+    let mut runs = both_ways(2_500, 1.0, 20);
     assert_eq!(runs[0].q(), runs[1].q());
     assert_eq!(runs[0].p(), runs[1].p());
     assert!(runs[0].q().amax() > 0.0);

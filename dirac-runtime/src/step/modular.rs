@@ -77,8 +77,14 @@ use crate::step::ledger::{ComponentBalance, Ledger};
 use component::{Model, Part};
 use hidden::Hidden;
 
-/// Components per parallel task.
-const GRAIN: usize = 32;
+/// Components per parallel task, at least: a pass over this many takes tens of microseconds,
+/// above the cost of handing the task to another thread. Measured on 2 cores (the chain of
+/// `examples/modular_scaling.rs`), 1 000 components in two tasks still step slower than on one
+/// thread.
+const MIN_GRAIN: usize = 1024;
+
+/// Parallel tasks per thread in a pass, at most: enough that a thread done early finds more work.
+const TASKS_PER_THREAD: usize = 4;
 
 /// The relative consistency an initial state must have (as a [`Stepper`](crate::Stepper)'s).
 const START_TOLERANCE: f64 = 1e-9;
@@ -252,10 +258,9 @@ impl Modular {
     /// (rayon): each pass splits the components into runs of consecutive ones, each with its
     /// unknowns, and the junctions' rows and Newton's passes over its vectors likewise; the
     /// junctions' band (the Schur complement) is factorised and solved on one thread. By default
-    /// not. The steps are the same bit for bit. `examples/modular_scaling.rs` measures it on a
-    /// chain of tethered masses: on 16 cores 1.9× at 10⁴ masses, 5.5× at 10⁵ and 4.6× at 10⁶;
-    /// on 2 cores about 1.4–1.5× at 10⁴ and 10⁵; below a few thousand components it costs more
-    /// than it gains.
+    /// not. The steps are the same bit for bit. A pass is split into a few tasks per thread of at
+    /// least 1 024 components each, so a model of fewer components is stepped on one thread
+    /// all the same. `examples/modular_scaling.rs` measures it on a chain of tethered masses.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = Some(parallel);
         self.end_run();
@@ -927,6 +932,17 @@ impl Modular {
         self.parallel.unwrap_or(false)
     }
 
+    /// Components per parallel task of a pass (`usize::MAX`: one after another): about
+    /// [`TASKS_PER_THREAD`] tasks for each of rayon's threads, none below [`MIN_GRAIN`]
+    /// components, so that a model too small to gain from threads is stepped on one.
+    fn grain(&self) -> usize {
+        if !self.parallel() {
+            return usize::MAX;
+        }
+        let tasks = TASKS_PER_THREAD * rayon::current_num_threads();
+        self.components.len().div_ceil(tasks).max(MIN_GRAIN)
+    }
+
     /// Where the junctions' impulses are held: the constrained components' constraint point
     /// (they agree), or the midpoint; one share `σ` for every junction, as in the monolithic
     /// interconnection.
@@ -951,7 +967,7 @@ impl Modular {
         };
         let (rows, columns): (Vec<Vec<_>>, Vec<Vec<_>>) =
             self.components.iter().map(borders).unzip();
-        let grain = if self.parallel() { GRAIN } else { usize::MAX };
+        let grain = self.grain();
         Ok(Bordered::new(&sizes, &rows, &columns)?.parallel(grain))
     }
 
@@ -980,7 +996,7 @@ impl Modular {
     fn solve(&mut self, run: &mut Running, trial: bool) -> Result<(NewtonReport, f64), DiracError> {
         let first = run.unknowns.len() - self.junctions.len();
         let previous = run.predictor.predict();
-        let grain = if self.parallel() { GRAIN } else { usize::MAX };
+        let grain = self.grain();
         let (unknowns, multipliers) = run.unknowns.as_mut_slice().split_at_mut(first);
         let predict = |parts: Parts<'_>, run: &mut [f64]| {
             parts.each(run, |component, _, own| {
@@ -1076,7 +1092,7 @@ impl Modular {
         };
         // Each component's violation, or the first component's error.
         let advanced: Result<f64, (usize, DiracError)> = if grain < self.components.len() {
-            let components = self.components.par_iter_mut().with_min_len(GRAIN);
+            let components = self.components.par_iter_mut().with_min_len(grain);
             let each = components
                 .enumerate()
                 .map(|(c, component)| advance(component).map_err(|e| (c, e)));
@@ -1150,6 +1166,30 @@ impl Modular {
 
     /// Advances one step. On error nothing changes.
     pub fn step(&mut self) -> Result<(), DiracError> {
+        self.on_workers(|modular| modular.advance())
+    }
+
+    /// Advances `steps` steps; stops at the first error, with the state of the step before it.
+    pub fn run(&mut self, steps: u64) -> Result<(), DiracError> {
+        self.on_workers(|modular| (0..steps).try_for_each(|_| modular.advance()))
+    }
+
+    /// Runs `work` on one of rayon's threads where the step is parallel, so that the passes of a
+    /// step hand their halves to the other threads from inside the pool (from outside it, each
+    /// pass would wait for a thread to wake and to wake the caller back).
+    fn on_workers<F>(&mut self, work: F) -> Result<(), DiracError>
+    where
+        F: FnOnce(&mut Self) -> Result<(), DiracError> + Send,
+    {
+        if self.grain() < self.components.len() {
+            rayon::scope(|_| work(self))
+        } else {
+            work(self)
+        }
+    }
+
+    /// Advances one step (see [`Modular::step`]).
+    fn advance(&mut self) -> Result<(), DiracError> {
         let mut run = self.run.take().ok_or(DiracError::NotStarted)?;
         let solved = self.solve(&mut run, false);
         let (report, violation) = match solved {
@@ -1161,8 +1201,9 @@ impl Modular {
         };
         let t = (run.steps + 1) as f64 * self.h;
         let accept = |component: &mut Component| component.part.accept(t);
-        if self.parallel() && GRAIN < self.components.len() {
-            let components = self.components.par_iter_mut().with_min_len(GRAIN);
+        let grain = self.grain();
+        if grain < self.components.len() {
+            let components = self.components.par_iter_mut().with_min_len(grain);
             components.for_each(accept);
         } else {
             self.components.iter_mut().for_each(accept);
@@ -1177,11 +1218,6 @@ impl Modular {
         run.report = Some(report);
         self.run = Some(run);
         Ok(())
-    }
-
-    /// Advances `steps` steps; stops at the first error, with the state of the step before it.
-    pub fn run(&mut self, steps: u64) -> Result<(), DiracError> {
-        (0..steps).try_for_each(|_| self.step())
     }
 
     fn running(&self) -> Result<&Running, DiracError> {
