@@ -39,7 +39,7 @@ pub use model::{
 pub use solve::{jacobian, newton};
 pub use space::{configuration_space, manifold, product, rotation, sphere};
 pub use step::{
-    composition, dense_output, euler_lagrange, group_euler_lagrange, hamilton, modular,
+    composition, dense_output, euler_lagrange, field, group_euler_lagrange, hamilton, modular,
     step_derivatives, step_equations, verlet,
 };
 #[cfg(feature = "plot")]
@@ -58,6 +58,7 @@ pub use integrate::run::{Feedback, Progress, Run, Solution, Status};
 pub use integrate::stepper::{ManifoldStepper, Stepper};
 pub use integrate::trajectory::{EnergyBalance, Interrupted, Metadata, Trajectory};
 pub use model::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};
+pub use model::density::SeparableDensity;
 pub use model::hamiltonian_system::HamiltonianSystem;
 pub use model::interconnection::{Interconnected, Interconnection, Junction, Junctions, Ports};
 pub use model::repeated::Repeated;
@@ -71,6 +72,7 @@ pub use space::product::{Configuration, Product, Rates};
 pub use space::rotation::Retraction;
 pub use step::composition::Composition;
 pub use step::dense_output::Sample;
+pub use step::field::{Boundary, Field};
 pub use step::hamilton::Hamilton;
 pub use step::ledger::{ComponentBalance, Ledger};
 pub use step::modular::{Modular, ModularFeedback, PortWork};

@@ -9,6 +9,7 @@ pub mod circuit;
 pub mod components;
 pub mod double_pendulum;
 pub mod ensemble;
+pub mod field;
 pub mod figures;
 pub mod first_order;
 pub mod furuta;

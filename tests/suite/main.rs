@@ -16,6 +16,7 @@ mod ensemble;
 mod errors;
 mod explicit;
 mod extremes;
+mod field;
 mod first_order;
 mod golden;
 mod hamiltonian;

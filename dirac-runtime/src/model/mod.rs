@@ -1,5 +1,5 @@
 //! The continuous model: the traits a model implements (a Lagrangian or a Hamiltonian,
-//! one-forms, holonomic constraints, forces), its derivatives (closed forms from
+//! one-forms, holonomic constraints, forces) and the Lagrangian densities of fields, its derivatives (closed forms from
 //! `#[dirac_system]`, else dual numbers) and its Legendre transform, and models built from
 //! components joined by junctions (interconnection).
 //!
@@ -7,6 +7,7 @@
 //! [`quadrature`](crate::quadrature). A new kind of model term goes here.
 
 pub mod closed_form;
+pub mod density;
 pub(crate) mod derivatives;
 pub mod hamiltonian_system;
 pub mod interconnection;

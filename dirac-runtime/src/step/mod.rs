@@ -1,7 +1,7 @@
 //! One step: the [`StepEquations`](crate::StepEquations) seam and its implementations — the
 //! discrete Euler–Lagrange equations on vector spaces and on Lie groups, the discrete Hamiltonian
 //! route, the modular step of an interconnection, the explicit Störmer–Verlet step of a separable
-//! Lagrangian and its compositions — with the interpolant inside a step (dense
+//! Lagrangian and its compositions, the explicit multisymplectic step of a field — with the interpolant inside a step (dense
 //! output), the step map's derivatives and the work of the steps booked by component (ledger).
 //!
 //! Uses every layer below it, up to [`discrete`](crate::discrete). A new scheme goes here.
@@ -9,6 +9,7 @@
 pub mod composition;
 pub mod dense_output;
 pub mod euler_lagrange;
+pub mod field;
 pub mod group_euler_lagrange;
 pub mod hamilton;
 pub mod ledger;
