@@ -813,11 +813,49 @@ impl HandComposition {
     }
 }
 
+/// One step of the sine-Gordon field (Störmer–Verlet, Δx = 0.05, Δt = 0.02, periodic, started
+/// from `u = sin x`) by number of cells: `Field` one cell after another and in parallel, against
+/// a hand-written leapfrog of the same scheme (`scenes::field::leapfrog_sine_gordon`).
+fn field(c: &mut Criterion) {
+    use dirac::{Boundary, Field};
+    use scenes::field::{SineGordon, leapfrog_sine_gordon, sine_gordon_force};
+    let mut group = c.benchmark_group("field_step");
+    group.sample_size(20);
+    let (dx, dt) = (0.05, 0.02);
+    for cells in [1_000, 10_000, 100_000, 1_000_000] {
+        let length = cells as f64 * dx;
+        let u0: Vec<f64> = (0..cells).map(|j| (j as f64 * dx).sin()).collect();
+        for parallel in [false, true] {
+            let mut field = Field::new(SineGordon, (0.0, length), cells, Boundary::Periodic, dt)
+                .expect("valid field")
+                .with_parallel(parallel);
+            let u: Vec<SVector<f64, 1>> = u0.iter().map(|&u| SVector::from([u])).collect();
+            field
+                .start(&u, &vec![SVector::zeros(); cells])
+                .expect("finite start");
+            let name = if parallel { "parallel" } else { "sequential" };
+            group.bench_with_input(BenchmarkId::new(name, cells), &cells, |b, _| {
+                b.iter(|| black_box(field.step()).expect("step"))
+            });
+        }
+        let (mut u, mut p, mut force) = (u0.clone(), vec![0.0; cells], vec![0.0; cells]);
+        sine_gordon_force(&u, &mut force, dx);
+        group.bench_with_input(BenchmarkId::new("hand_written", cells), &cells, |b, _| {
+            b.iter(|| {
+                leapfrog_sine_gordon(&mut u, &mut p, &mut force, dx, dt);
+                black_box(&u);
+            })
+        });
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
     explicit,
     forced,
     modular,
+    field,
     interconnection,
     routes,
     lie_group,

@@ -74,6 +74,12 @@ const GROUPS: &[(&str, &str)] = &[
         "The modular step (components by parts, Schur complement on the junctions) against the \
          monolithic step, and its cost by number of components.",
     ),
+    (
+        "field_step",
+        "One step of the sine-Gordon field (Störmer–Verlet, Δx = 0.05, Δt = 0.02, periodic) by \
+         number of cells: `Field` one cell after another and in parallel, against a hand-written \
+         leapfrog of the same scheme.",
+    ),
 ];
 
 /// Paired path segments: a benchmark naming the first is divided by its twin naming the second.
@@ -85,6 +91,8 @@ const PAIRS: &[(&str, &str)] = &[
     ("run", "step_loop"),
     ("explicit", "implicit"),
     ("explicit", "hand_written"),
+    ("sequential", "hand_written"),
+    ("parallel", "sequential"),
 ];
 
 /// Groups whose every benchmark is divided by one of them.

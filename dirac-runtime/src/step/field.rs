@@ -42,16 +42,22 @@
 //! # Ok::<(), dirac_runtime::DiracError>(())
 //! ```
 
-use nalgebra::SVector;
+use nalgebra::{Const, SVector, U1};
+use num_dual::{Derivative, HyperDualSVec64};
 use rayon::prelude::*;
 
 use crate::base::error::DiracError;
 use crate::model::density::SeparableDensity;
-use crate::model::derivatives::{gradient, lift};
 use crate::step::composition::Composition;
 
-/// Nodes or cells per parallel task: a pass over this many takes tens of microseconds.
+/// Nodes per block of a pass, and per parallel task: a pass over this many takes tens of
+/// microseconds.
 const GRAIN: usize = 4096;
+
+/// Blocks a field needs for its passes to be split across threads: with fewer, handing blocks
+/// to threads costs more than it gains (measured on 2 cores: 10⁴ nodes in three blocks stepped
+/// slower in parallel than on one thread).
+const PARALLEL_BLOCKS: usize = 4;
 
 /// How the ends of a field's interval are held.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -93,15 +99,20 @@ struct Running<const C: usize> {
     /// `−∂Φ/∂u_j` at `u`.
     force: Vec<SVector<f64, C>>,
     /// The step being taken: field, momenta, force.
-    next: (
-        Vec<SVector<f64, C>>,
-        Vec<SVector<f64, C>>,
-        Vec<SVector<f64, C>>,
-    ),
-    /// Each cell's `∂(Δx ½[U_left + U_right])/∂u` at its left and right node.
-    cells: Vec<[SVector<f64, C>; 2]>,
+    next: Level<C>,
+    /// Per block of [`GRAIN`] nodes, the shares of `∂Φ/∂u` of the cells that touch them.
+    shares: Vec<Vec<Shares<C>>>,
     steps: u64,
 }
+
+/// A field, its momenta and its force at the nodes.
+type Level<const C: usize> = [Vec<SVector<f64, C>>; 3];
+
+/// Numbers that carry the derivatives along `u` and along `u_x` at once.
+type Pair<const C: usize> = HyperDualSVec64<C, C>;
+
+/// A cell's share of `∂Φ/∂u` at its left node and at its right node.
+type Shares<const C: usize> = [SVector<f64, C>; 2];
 
 impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     /// The field of `density` on `interval = (a, b)` cut into `cells` cells, its ends held by
@@ -157,11 +168,17 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     }
 
     /// Whether the passes of a step over the cells and nodes are split across rayon's threads
-    /// (by default not). The steps are the same bit for bit; a field of fewer than about 8 000
-    /// nodes is stepped on one thread all the same.
+    /// (by default not), in blocks of 4 096 nodes. The steps are the same bit for bit; a field
+    /// of fewer than 16 384 nodes is stepped on one thread all the same.
+    /// `cargo bench --bench step -- field_step` measures the gain.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = parallel;
         self
+    }
+
+    /// Whether this field's passes are split across threads.
+    fn in_parallel(&self) -> bool {
+        self.parallel && self.nodes() >= PARALLEL_BLOCKS * GRAIN
     }
 
     /// The node masses `w_j ρ(x_j)`, checked.
@@ -263,16 +280,20 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
         }
         let p = ut.iter().zip(&self.mass).map(|(v, m)| v.component_mul(m));
         let zeros = vec![SVector::zeros(); nodes];
+        let blocks = (0..nodes.div_ceil(GRAIN)).map(|k| {
+            let nodes_in_block = GRAIN.min(nodes - k * GRAIN);
+            vec![[SVector::zeros(); 2]; nodes_in_block + 1]
+        });
         let mut run = Running {
             u: u.to_vec(),
             p: p.collect(),
             force: zeros.clone(),
-            next: (zeros.clone(), zeros.clone(), zeros),
-            cells: vec![[SVector::zeros(); 2]; self.cells],
+            next: [zeros.clone(), zeros.clone(), zeros],
+            shares: blocks.collect(),
             steps: 0,
         };
-        let mut force = std::mem::take(&mut run.force);
-        self.force(&run.u, &mut run.cells, &mut force);
+        let (mut force, mut unmoved) = (std::mem::take(&mut run.force), run.p.clone());
+        self.force_and_kick(&run.u, &mut force, &mut unmoved, &mut run.shares, 0.0);
         if let Some((j, bad)) = first_not_finite(&force) {
             return Err(DiracError::NonFinite {
                 what: format!("the force on node {j} of the initial field"),
@@ -284,31 +305,81 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
         Ok(())
     }
 
-    /// `−∂Φ/∂u` at `u` into `force` (zero at a fixed end), through each cell's shares
-    /// (`cells`).
-    fn force(
+    /// `p += kick · f` (where `kick` is not zero) and `u += tau · p/m` at every node that moves:
+    /// a kick by the force `f` and the drift that follows it.
+    fn kick_and_drift(
+        &self,
+        u: &mut [SVector<f64, C>],
+        p: &mut [SVector<f64, C>],
+        f: &[SVector<f64, C>],
+        (kick, tau): (f64, f64),
+    ) {
+        let block = |((u, p), (f, m))| kick_and_drift(u, p, f, m, kick, tau);
+        if self.in_parallel() {
+            let nodes = u.par_chunks_mut(GRAIN).zip(p.par_chunks_mut(GRAIN));
+            let forces = f.par_chunks(GRAIN).zip(self.mass.par_chunks(GRAIN));
+            nodes.zip(forces).for_each(block);
+        } else {
+            block(((u, p), (f, &self.mass)));
+        }
+    }
+
+    /// `f = −∂Φ/∂u` at `u` (zero at a fixed end), then `p += kick · f`, a block of [`GRAIN`]
+    /// nodes at a time: each block takes the shares of the cells that touch its nodes into its
+    /// own `shares` (a cell at a block's edge is taken by both blocks, alike).
+    fn force_and_kick(
         &self,
         u: &[SVector<f64, C>],
-        cells: &mut [[SVector<f64, C>; 2]],
-        force: &mut [SVector<f64, C>],
+        f: &mut [SVector<f64, C>],
+        p: &mut [SVector<f64, C>],
+        shares: &mut [Vec<Shares<C>>],
+        kick: f64,
     ) {
-        let nodes = u.len();
-        self.for_each(cells, |i, shares| {
-            *shares = self.cell_gradient(i, &u[i], &u[(i + 1) % nodes]);
-        });
-        let cells = &*cells;
-        self.for_each(force, |j, f| {
-            let own = cells.get(j).map_or_else(SVector::zeros, |c| c[0]);
-            let left = match j {
-                0 if self.boundary == Boundary::Periodic => cells[nodes - 1][1],
-                0 => SVector::zeros(),
-                _ => cells[j - 1][1],
+        if self.in_parallel() {
+            let blocks = f.par_chunks_mut(GRAIN).zip(p.par_chunks_mut(GRAIN));
+            let blocks = blocks.zip(shares.par_iter_mut()).enumerate();
+            blocks.for_each(|(k, ((f, p), shares))| {
+                self.block_force_and_kick(k, u, f, p, shares, kick)
+            });
+        } else {
+            let blocks = f.chunks_mut(GRAIN).zip(p.chunks_mut(GRAIN));
+            let blocks = blocks.zip(shares.iter_mut()).enumerate();
+            blocks.for_each(|(k, ((f, p), shares))| {
+                self.block_force_and_kick(k, u, f, p, shares, kick)
+            });
+        }
+    }
+
+    /// [`Field::force_and_kick`] on block `k`, whose nodes' forces and momenta are `f` and `p`.
+    fn block_force_and_kick(
+        &self,
+        k: usize,
+        u: &[SVector<f64, C>],
+        f: &mut [SVector<f64, C>],
+        p: &mut [SVector<f64, C>],
+        shares: &mut [Shares<C>],
+        kick: f64,
+    ) {
+        let (nodes, first) = (u.len(), k * GRAIN);
+        let periodic = self.boundary == Boundary::Periodic;
+        // Share `s` is cell `first + s − 1`'s, where that cell exists.
+        for (s, share) in shares.iter_mut().enumerate() {
+            let cell = match (first + s).checked_sub(1) {
+                Some(cell) if cell < self.cells => Some(cell),
+                None if periodic => Some(self.cells - 1),
+                _ => None,
             };
-            *f = match is_zero(&self.mass[j]) {
+            *share = cell.map_or([SVector::zeros(); 2], |c| {
+                self.cell_gradient(c, &u[c], &u[(c + 1) % nodes])
+            });
+        }
+        for (i, (f, p)) in f.iter_mut().zip(p.iter_mut()).enumerate() {
+            *f = match is_zero(&self.mass[first + i]) {
                 true => SVector::zeros(),
-                false => -(own + left),
+                false => -(shares[i + 1][0] + shares[i][1]),
             };
-        });
+            *p += *f * kick;
+        }
     }
 
     /// Cell `i`'s share of `∂Φ/∂u` at its left node (field `left`) and its right node (`right`):
@@ -327,28 +398,32 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
         [u_left * half - flux, u_right * half + flux]
     }
 
-    /// `(∂U/∂u, ∂U/∂u_x)` at `(x, u, u_x)`, by dual numbers.
+    /// `(∂U/∂u, ∂U/∂u_x)` at `(x, u, u_x)`, in one pass of hyper-dual numbers: `u` moves along
+    /// the first infinitesimals, `u_x` along the second (their product, where it arises, is not
+    /// read).
     fn potential_gradient(
         &self,
         x: f64,
         u: &SVector<f64, C>,
         ux: &SVector<f64, C>,
     ) -> (SVector<f64, C>, SVector<f64, C>) {
-        let (lifted_u, lifted_ux) = (lift(u, 1.0), lift(ux, 1.0));
-        let (constant_u, constant_ux) = (lift(u, 0.0), lift(ux, 0.0));
-        let by_u = self.density.potential(x, &lifted_u, &constant_ux);
-        let by_ux = self.density.potential(x, &constant_u, &lifted_ux);
-        (gradient(&by_u), gradient(&by_ux))
-    }
-
-    /// `f(j, &mut values[j])` for every `j`, across threads where the field is parallel.
-    fn for_each<T: Send>(&self, values: &mut [T], f: impl Fn(usize, &mut T) + Sync + Send) {
-        if self.parallel && GRAIN < values.len() {
-            let each = values.par_iter_mut().enumerate().with_min_len(GRAIN);
-            each.for_each(|(j, v)| f(j, v));
-        } else {
-            values.iter_mut().enumerate().for_each(|(j, v)| f(j, v));
-        }
+        let unit = |i: usize| SVector::<f64, C>::from_fn(|j, _| if i == j { 1.0 } else { 0.0 });
+        let u = SVector::from_fn(|i, _| {
+            Pair::new(
+                u[i],
+                Derivative::some(unit(i)),
+                Derivative::none(),
+                Derivative::none(),
+            )
+        });
+        let ux = SVector::from_fn(|i, _| {
+            let along = Derivative::some(unit(i).transpose());
+            Pair::new(ux[i], Derivative::none(), along, Derivative::none())
+        });
+        let value = self.density.potential(x, &u, &ux);
+        let by_u = value.eps1.unwrap_generic(Const::<C>, U1);
+        let by_ux = value.eps2.unwrap_generic(U1, Const::<C>).transpose();
+        (by_u, by_ux)
     }
 
     /// Advances one step. On error nothing changes: `NotStarted` before a start, `NonFinite`
@@ -359,7 +434,7 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
 
     /// Advances `steps` steps; stops at the first error, with the state of the step before it.
     pub fn run(&mut self, steps: u64) -> Result<(), DiracError> {
-        if self.parallel && GRAIN < self.nodes() {
+        if self.in_parallel() {
             // Steps handed out from inside rayon's pool: one hand-off for the run, not one a pass.
             rayon::scope(|_| (0..steps).try_for_each(|_| self.advance()))
         } else {
@@ -370,28 +445,26 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     /// One step (see [`Field::step`]).
     fn advance(&mut self) -> Result<(), DiracError> {
         let mut run = self.run.take().ok_or(DiracError::NotStarted)?;
-        let (mut u, mut p, mut f) = std::mem::take(&mut run.next);
+        let [mut u, mut p, mut f] = std::mem::take(&mut run.next);
         u.copy_from_slice(&run.u);
         p.copy_from_slice(&run.p);
         f.copy_from_slice(&run.force);
-        let mass = &self.mass;
-        for &gamma in self.composition.coefficients() {
+        // Each stage a kick, a drift and a kick; a stage's closing kick and the next one's
+        // opening kick are one, by the sum of their halves.
+        let coefficients = self.composition.coefficients();
+        for (i, &gamma) in coefficients.iter().enumerate() {
             let tau = gamma * self.dt;
-            self.for_each(&mut p, |j, p| *p += f[j] * (0.5 * tau));
-            self.for_each(&mut u, |j, u| {
-                if !is_zero(&mass[j]) {
-                    *u += p[j].component_div(&mass[j]) * tau;
-                }
-            });
-            self.force(&u, &mut run.cells, &mut f);
-            self.for_each(&mut p, |j, p| *p += f[j] * (0.5 * tau));
+            let opening = if i == 0 { 0.5 * tau } else { 0.0 };
+            self.kick_and_drift(&mut u, &mut p, &f, (opening, tau));
+            let next = coefficients.get(i + 1).map_or(0.0, |g| g * self.dt);
+            self.force_and_kick(&u, &mut f, &mut p, &mut run.shares, 0.5 * (tau + next));
         }
         let bad = [("field", &u), ("momentum", &p), ("force", &f)]
             .into_iter()
             .find_map(|(what, values)| first_not_finite(values).map(|(j, v)| (what, j, v)));
         if let Some((what, j, value)) = bad {
             let step = run.steps;
-            run.next = (u, p, f);
+            run.next = [u, p, f];
             self.run = Some(run);
             return Err(DiracError::NonFinite {
                 what: format!("the {what} at node {j} after step {step} (try a smaller step)"),
@@ -401,7 +474,7 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
         std::mem::swap(&mut run.u, &mut u);
         std::mem::swap(&mut run.p, &mut p);
         std::mem::swap(&mut run.force, &mut f);
-        run.next = (u, p, f);
+        run.next = [u, p, f];
         run.steps += 1;
         self.run = Some(run);
         Ok(())
@@ -471,6 +544,25 @@ fn first_not_finite<const C: usize>(values: &[SVector<f64, C>]) -> Option<(usize
         .iter()
         .enumerate()
         .find_map(|(j, v)| v.iter().find(|x| !x.is_finite()).map(|&x| (j, x)))
+}
+
+/// `p += kick · f` (where `kick` is not zero) and `u += tau · p/m` at each node that moves.
+fn kick_and_drift<const C: usize>(
+    u: &mut [SVector<f64, C>],
+    p: &mut [SVector<f64, C>],
+    f: &[SVector<f64, C>],
+    mass: &[SVector<f64, C>],
+    kick: f64,
+    tau: f64,
+) {
+    for (((u, p), f), m) in u.iter_mut().zip(p.iter_mut()).zip(f).zip(mass) {
+        if kick != 0.0 {
+            *p += f * kick;
+        }
+        if !is_zero(m) {
+            *u += p.component_div(m) * tau;
+        }
+    }
 }
 
 /// Whether every entry of `v` is zero (a fixed end's mass).
