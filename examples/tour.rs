@@ -83,6 +83,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     reports.push(scenes::shafted_body::report()?);
     reports.push(scenes::satellite::report()?);
+    // A field: the sine-Gordon kink–antikink collision.
+    reports.push(scenes::field::report()?);
     scenes::print_table(&reports);
     scenes::save_table(&reports, "output/tour.csv")?;
     match circuit::lc_at_10(Quadrature::trapezoid(), 0.01) {

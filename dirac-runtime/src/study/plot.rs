@@ -1,5 +1,5 @@
-//! Charts drawn to PNG (feature `plot`): lines in the plane ([`line_chart`]) and curves in space
-//! ([`space_chart`]). Plotters' pure-Rust bitmap backend draws them with the bundled DejaVu Sans
+//! Charts drawn to PNG (feature `plot`): lines in the plane ([`line_chart`]), curves in space
+//! ([`space_chart`]) and a field over space and time ([`space_time_chart`]). Plotters' pure-Rust bitmap backend draws them with the bundled DejaVu Sans
 //! (Bitstream Vera licence) and `png` encodes them: no system library is needed. The tour's
 //! figures and the work–precision charts use them.
 //!
@@ -130,6 +130,42 @@ pub fn space_chart(
     save(path.as_ref(), || draw_in_space(title, series))
 }
 
+/// Draws a field over space and time as a map, 900×600, to the PNG file `path`: `x` along the
+/// horizontal axis, time up, the field's value `snapshots[k].1[j]` at `(x[j], snapshots[k].0)`
+/// in colour from blue (its least value) through white to red (its largest), the range in the
+/// title. At most 600 columns and 400 rows are drawn (evenly picked). An error where a snapshot
+/// does not have one value per position, where there are fewer than two positions or
+/// snapshots, and as [`line_chart`]'s.
+///
+/// ```
+/// use dirac_runtime::plot::space_time_chart;
+/// let x: Vec<f64> = (0..=50).map(|j| 0.02 * j as f64).collect();
+/// let wave = |t: f64| x.iter().map(|x| (6.0 * (x - t)).sin()).collect::<Vec<_>>();
+/// let snapshots: Vec<(f64, Vec<f64>)> = (0..=20).map(|k| (0.05 * k as f64, wave(0.05 * k as f64))).collect();
+/// let path = std::env::temp_dir().join("dirac_space_time_example.png");
+/// space_time_chart(&path, "a travelling wave", ("x", "t"), &x, &snapshots)?;
+/// assert!(std::fs::metadata(&path)?.len() > 1000);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn space_time_chart(
+    path: impl AsRef<Path>,
+    title: &str,
+    labels: (&str, &str),
+    x: &[f64],
+    snapshots: &[(f64, Vec<f64>)],
+) -> Result<(), DiracError> {
+    if let Some((t, values)) = snapshots.iter().find(|(_, v)| v.len() != x.len()) {
+        return Err(DiracError::Dimension(format!(
+            "the snapshot at t = {t} has {} values for {} positions",
+            values.len(),
+            x.len()
+        )));
+    }
+    save(path.as_ref(), || {
+        draw_space_time(title, labels, x, snapshots)
+    })
+}
+
 /// Checks that `path` names a PNG file, draws, and writes the pixels there.
 fn save(path: &Path, pixels: impl FnOnce() -> Result<Vec<u8>, Failure>) -> Result<(), DiracError> {
     let png = path
@@ -245,6 +281,94 @@ fn draw_in_space(title: &str, series: &[SpaceSeries]) -> Result<Vec<u8>, Failure
         }
         legend(&mut chart.configure_series_labels())
     })
+}
+
+/// The space–time map's pixels: a rectangle per picked position and snapshot.
+fn draw_space_time(
+    title: &str,
+    (x_label, t_label): (&str, &str),
+    x: &[f64],
+    snapshots: &[(f64, Vec<f64>)],
+) -> Result<Vec<u8>, Failure> {
+    if x.len() < 2 || snapshots.len() < 2 {
+        return Err("a space-time chart needs two positions and two snapshots".into());
+    }
+    let values = snapshots.iter().flat_map(|(_, v)| v.iter().map(|&u| [u]));
+    let [(low, high)] = bounds(values).unwrap_or([(-1.0, 1.0)]);
+    let picked = |count: usize, most: usize| -> Vec<usize> {
+        let step = count.div_ceil(most).max(1);
+        (0..count).step_by(step).collect()
+    };
+    let (columns, rows) = (picked(x.len(), 600), picked(snapshots.len(), 400));
+    // Each picked column spans to the next one's position (the last as wide as the one before).
+    let span = |picked: &[usize], at: &dyn Fn(usize) -> f64, i: usize| {
+        let start = at(picked[i]);
+        let end = match picked.get(i + 1) {
+            Some(&next) => at(next),
+            None => start + (start - at(picked[i - 1])),
+        };
+        (start, end)
+    };
+    let position = |j: usize| x[j];
+    let time = |k: usize| snapshots[k].0;
+    let (x0, x1) = (
+        span(&columns, &position, 0).0,
+        span(&columns, &position, columns.len() - 1).1,
+    );
+    let (t0, t1) = (
+        span(&rows, &time, 0).0,
+        span(&rows, &time, rows.len() - 1).1,
+    );
+    let caption = format!("{title} (blue {low:.3} to red {high:.3})");
+    canvas(|root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(caption, ("sans-serif", 22))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x0.min(x1)..x0.max(x1), t0.min(t1)..t0.max(t1))?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(x_label)
+            .y_desc(t_label)
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        let cells = rows.iter().enumerate().flat_map(|(r, &k)| {
+            let (t_start, t_end) = span(&rows, &time, r);
+            let columns = &columns;
+            columns.iter().enumerate().map(move |(c, &j)| {
+                let (x_start, x_end) = span(columns, &position, c);
+                let colour = diverging((snapshots[k].1[j] - low) / (high - low));
+                Rectangle::new([(x_start, t_start), (x_end, t_end)], colour.filled())
+            })
+        });
+        chart.draw_series(cells)?;
+        Ok(())
+    })
+}
+
+/// Blue at 0, white at ½, red at 1 (grey where `s` is not finite).
+fn diverging(s: f64) -> RGBColor {
+    if !s.is_finite() {
+        return RGBColor(128, 128, 128);
+    }
+    let s = s.clamp(0.0, 1.0);
+    let mix = |a: f64, b: f64, w: f64| (a + (b - a) * w).round() as u8;
+    let (blue, white, red) = (
+        (40.0, 70.0, 170.0),
+        (255.0, 255.0, 255.0),
+        (180.0, 30.0, 40.0),
+    );
+    let (from, to, w) = match s < 0.5 {
+        true => (blue, white, 2.0 * s),
+        false => (white, red, 2.0 * s - 1.0),
+    };
+    RGBColor(
+        mix(from.0, to.0, w),
+        mix(from.1, to.1, w),
+        mix(from.2, to.2, w),
+    )
 }
 
 /// Draws `points` as a line in the `k`-th colour of the palette, with its entry in the legend.
@@ -365,6 +489,49 @@ mod tests {
         let ((left, right), _) = spans(&across, 0);
         assert!(right - left > 100, "{left}..{right}");
         assert!(draw_in_space("a point", &[segment([0.0; 3])]).is_err());
+    }
+
+    /// A field low on the left half and high on the right, later in time on the right still:
+    /// the map is blue left of the middle, red right of it, the same at the bottom and the top;
+    /// a snapshot of the wrong length, or a single one, is refused.
+    #[test]
+    fn space_time_charts_put_x_across_and_colour_the_values() {
+        register_font().unwrap();
+        let x: Vec<f64> = (0..100).map(|j| j as f64).collect();
+        let step = |t: f64| {
+            (
+                t,
+                x.iter()
+                    .map(|&x| if x < 50.0 { -1.0 } else { 1.0 })
+                    .collect(),
+            )
+        };
+        let snapshots: Vec<(f64, Vec<f64>)> = (0..10).map(|k| step(k as f64)).collect();
+        let pixels = draw_space_time("a step", ("x", "t"), &x, &snapshots).unwrap();
+        let width = SIZE.0 as usize;
+        let pixel = |row: usize, column: usize| {
+            let at = 3 * (row * width + column);
+            [pixels[at], pixels[at + 1], pixels[at + 2]]
+        };
+        for row in [150, 300, 450] {
+            let (left, right) = (pixel(row, 250), pixel(row, 750));
+            assert!(left[2] > 150 && left[0] < 100, "row {row}: left {left:?}");
+            assert!(
+                right[0] > 150 && right[2] < 100,
+                "row {row}: right {right:?}"
+            );
+        }
+        let path =
+            std::env::temp_dir().join(format!("dirac_space_time_{}.png", std::process::id()));
+        let mut short = snapshots.clone();
+        short[3].1.pop();
+        let refused = space_time_chart(&path, "short", ("x", "t"), &x, &short);
+        assert!(
+            matches!(refused, Err(DiracError::Dimension(_))),
+            "{refused:?}"
+        );
+        assert!(space_time_chart(&path, "one", ("x", "t"), &x, &snapshots[..1]).is_err());
+        assert!(!path.exists());
     }
 
     /// Another format is refused before anything is drawn or written.
