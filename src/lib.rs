@@ -48,12 +48,12 @@ pub mod prelude {
     pub use dirac_macros::dirac_system;
     pub use dirac_runtime::nalgebra::{Matrix3, SMatrix, SVector, Vector3};
     pub use dirac_runtime::{
-        Composition, Configuration, ConfigurationSpace, ConstraintPoint, Crossing, DiracError,
-        DiracSystem, Direction, DiscreteLagrangian, DualNum, Euclidean, Event, Feedback,
-        FirstOrderScheme, HamiltonianSystem, HolonomicScheme, Input, Interconnected,
-        Interconnection, Junction, ManifoldStepper, Modular, NewtonOptions, Positive, Product,
-        Progress, Quadrature, Rates, Repeated, Retraction, Rule, Run, Sample, Scalar, Solution,
-        Status, Stepper, Trajectory,
+        Boundary, Composition, Configuration, ConfigurationSpace, ConstraintPoint, Crossing,
+        DiracError, DiracSystem, Direction, DiscreteLagrangian, DualNum, Euclidean, Event,
+        Feedback, Field, FirstOrderScheme, HamiltonianSystem, HolonomicScheme, Input,
+        Interconnected, Interconnection, Junction, ManifoldStepper, Modular, NewtonOptions,
+        Positive, Product, Progress, Quadrature, Rates, Repeated, Retraction, Rule, Run, Sample,
+        Scalar, SeparableDensity, Solution, Status, Stepper, Trajectory,
     };
 }
 

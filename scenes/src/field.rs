@@ -157,7 +157,7 @@ pub fn report() -> Result<super::Report, DiracError> {
         .map(|e| (e - e0).abs())
         .fold(0.0, f64::max);
     Ok(super::Report {
-        scene: "sine-Gordon collision (800 cells)",
+        scene: "sine-Gordon 800",
         quadrature: "Störmer–Verlet".into(),
         h: 16.0 / run.steps as f64,
         steps: run.steps,
