@@ -258,9 +258,10 @@ impl Modular {
     /// (rayon): each pass splits the components into runs of consecutive ones, each with its
     /// unknowns, and the junctions' rows and Newton's passes over its vectors likewise; the
     /// junctions' band (the Schur complement) is factorised and solved on one thread. By default
-    /// not. The steps are the same bit for bit. A pass is split into a few tasks per thread of at
-    /// least 1 024 components each, so a model of fewer components is stepped on one thread
-    /// all the same. `examples/modular_scaling.rs` measures it on a chain of tethered masses.
+    /// not. The steps are the same bit for bit. A pass is split into a few tasks per thread, none
+    /// of fewer than about 512 components, so a model of at most 1 024 components is stepped on
+    /// one thread all the same. `examples/modular_scaling.rs` measures it on a chain of tethered
+    /// masses.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = Some(parallel);
         self.end_run();

@@ -134,8 +134,9 @@ pub fn space_chart(
 /// horizontal axis, time up, the field's value `snapshots[k].1[j]` at `(x[j], snapshots[k].0)`
 /// in colour from blue (its least value) through white to red (its largest), the range in the
 /// title. At most 600 columns and 400 rows are drawn (evenly picked). An error where a snapshot
-/// does not have one value per position, where there are fewer than two positions or
-/// snapshots, and as [`line_chart`]'s.
+/// does not have one value per position, where the positions or the times are not finite or do
+/// not increase, where there are fewer than two positions or snapshots, and as
+/// [`line_chart`]'s.
 ///
 /// ```
 /// use dirac_runtime::plot::space_time_chart;
@@ -160,6 +161,22 @@ pub fn space_time_chart(
             values.len(),
             x.len()
         )));
+    }
+    let times: Vec<f64> = snapshots.iter().map(|(t, _)| *t).collect();
+    for (what, axis) in [("position", x), ("snapshot time", &times[..])] {
+        if let Some((k, &bad)) = axis.iter().enumerate().find(|(_, a)| !a.is_finite()) {
+            return Err(DiracError::NonFinite {
+                what: format!("{what} {k} of a space-time chart"),
+                value: bad,
+            });
+        }
+        if let Some(k) = axis.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(DiracError::Dimension(format!(
+                "the {what}s of a space-time chart must increase: {} then {}",
+                axis[k],
+                axis[k + 1]
+            )));
+        }
     }
     save(path.as_ref(), || {
         draw_space_time(title, labels, x, snapshots)
@@ -531,6 +548,20 @@ mod tests {
             "{refused:?}"
         );
         assert!(space_time_chart(&path, "one", ("x", "t"), &x, &snapshots[..1]).is_err());
+        let mut late = snapshots.clone();
+        late[4].0 = f64::NAN;
+        let refused = space_time_chart(&path, "NaN", ("x", "t"), &x, &late);
+        assert!(
+            matches!(refused, Err(DiracError::NonFinite { .. })),
+            "{refused:?}"
+        );
+        let mut back = x.clone();
+        back[7] = back[6];
+        let refused = space_time_chart(&path, "back", ("x", "t"), &back, &snapshots);
+        assert!(
+            matches!(refused, Err(DiracError::Dimension(_))),
+            "{refused:?}"
+        );
         assert!(!path.exists());
     }
 
