@@ -151,3 +151,29 @@ fn constrained_and_galerkin_steps_allocate_nothing() {
         assert_eq!(count, 0, "{name}: {count} allocations in 100 steps");
     }
 }
+
+/// The step of a field allocates nothing: its passes write into buffers the start made (a
+/// sine-Gordon field of 1 000 cells with free ends, by Kahan–Li 8).
+#[test]
+fn field_steps_allocate_nothing() {
+    use dirac::{Boundary, Field};
+    let mut kink = Field::new(
+        scenes::field::SineGordon,
+        (-20.0, 20.0),
+        1_000,
+        Boundary::Free,
+        0.01,
+    )
+    .unwrap()
+    .with_composition(Composition::kahan_li_8());
+    let x = kink.positions();
+    let at = |pick: fn((f64, f64)) -> f64| -> Vec<SVector<f64, 1>> {
+        let value = |x: f64| pick(scenes::field::kink(0.5, 0.0, x));
+        x.iter().map(|&x| SVector::from([value(x)])).collect()
+    };
+    kink.start(&at(|k| k.0), &at(|k| k.1)).unwrap();
+    kink.step().unwrap();
+    let count = allocations(|| kink.run(100).unwrap());
+    assert_eq!(count, 0, "{count} allocations in 100 steps of a field");
+    assert!(kink.u().unwrap().iter().any(|u| u[0] > 3.0));
+}
