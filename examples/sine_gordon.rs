@@ -15,12 +15,7 @@ use scenes::field::collision_run;
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let cells: usize = std::env::args().nth(1).map_or(Ok(4_000), |a| a.parse())?;
     let run = collision_run(cells, 10.0, 400)?;
-    let e0 = run.energy[0];
-    let energy_error = run
-        .energy
-        .iter()
-        .map(|e| (e - e0).abs())
-        .fold(0.0, f64::max);
+    let (e0, energy_error) = (run.energy[0], run.energy_error());
     println!(
         "{cells} cells, {} steps in {:.2?} ({:.2?} a step)",
         run.steps,

@@ -90,6 +90,17 @@ pub struct CollisionRun {
     pub wall: std::time::Duration,
 }
 
+impl CollisionRun {
+    /// The largest `|E − E_0|` over the snapshots.
+    pub fn energy_error(&self) -> f64 {
+        let e0 = self.energy[0];
+        self.energy
+            .iter()
+            .map(|e| (e - e0).abs())
+            .fold(0.0, f64::max)
+    }
+}
+
 /// The kink–antikink collision ([`collision`]) stepped by [`Field`] with `cells` cells.
 pub fn collision_run(
     cells: usize,
@@ -150,12 +161,7 @@ pub fn collision_run(
 /// with the energy's largest error.
 pub fn report() -> Result<super::Report, DiracError> {
     let run = collision_run(800, 8.0, 200)?;
-    let e0 = run.energy[0];
-    let drift = run
-        .energy
-        .iter()
-        .map(|e| (e - e0).abs())
-        .fold(0.0, f64::max);
+    let drift = run.energy_error();
     Ok(super::Report {
         scene: "sine-Gordon 800",
         quadrature: "Störmer–Verlet".into(),
