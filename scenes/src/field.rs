@@ -101,7 +101,8 @@ impl CollisionRun {
     }
 }
 
-/// The kink–antikink collision ([`collision`]) stepped by [`Field`] with `cells` cells.
+/// The kink–antikink collision ([`collision`]) stepped by [`Field`] with `cells` cells, with a
+/// progress bar on a terminal.
 pub fn collision_run(
     cells: usize,
     t_end: f64,
@@ -133,13 +134,17 @@ pub fn collision_run(
     let mut taken = vec![level(&field)?];
     let mut energy = vec![field.energy()?];
     let mut wall = std::time::Duration::ZERO;
+    let bar = super::progress::bar(0.0, 2.0 * t_end, dt);
     while field.steps() < steps {
         let clock = std::time::Instant::now();
         field.run(every.min(steps - field.steps()))?;
         wall += clock.elapsed();
         taken.push(level(&field)?);
         energy.push(field.energy()?);
+        bar.set_position(field.steps());
+        bar.set_message(format!("t = {:.1}", field.t() - t_end));
     }
+    bar.finish_and_clear();
     let exact = at(collision, t_end, |p| p.0);
     let u = field.u()?;
     let error = u
