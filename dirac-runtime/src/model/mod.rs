@@ -1,7 +1,7 @@
 //! The continuous model: the traits a model implements (a Lagrangian or a Hamiltonian,
-//! one-forms, holonomic constraints, forces) and the Lagrangian densities of fields, its derivatives (closed forms from
-//! `#[dirac_system]`, else dual numbers) and its Legendre transform, and models built from
-//! components joined by junctions (interconnection).
+//! one-forms, holonomic constraints, forces) and the Lagrangian densities of fields, its
+//! derivatives (closed forms from `#[dirac_system]`, else dual numbers) and its Legendre
+//! transform, and models built from components joined by junctions (interconnection).
 //!
 //! Uses [`base`](crate::base), [`space`](crate::space), [`solve`](crate::solve) and
 //! [`quadrature`](crate::quadrature). A new kind of model term goes here.

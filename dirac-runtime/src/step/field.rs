@@ -93,13 +93,9 @@ pub struct Field<D, const C: usize> {
 /// The state of a run, and the buffers a step writes into before it is accepted.
 #[derive(Debug, Clone)]
 struct Running<const C: usize> {
-    /// The field at the nodes.
-    u: Vec<SVector<f64, C>>,
-    /// The momenta `m_j u̇_j` of the nodes.
-    p: Vec<SVector<f64, C>>,
-    /// `−∂Φ/∂u_j` at `u`.
-    force: Vec<SVector<f64, C>>,
-    /// The step being taken: field, momenta, force.
+    /// The state.
+    now: Level<C>,
+    /// The step being taken.
     next: Level<C>,
     /// Per block of [`GRAIN`] nodes, the shares of `∂Φ/∂u` of the cells that touch them.
     shares: Vec<Vec<Shares<C>>>,
@@ -107,7 +103,24 @@ struct Running<const C: usize> {
 }
 
 /// A field, its momenta and its force at the nodes.
-type Level<const C: usize> = [Vec<SVector<f64, C>>; 3];
+#[derive(Debug, Clone, Default)]
+struct Level<const C: usize> {
+    /// The field at the nodes.
+    u: Vec<SVector<f64, C>>,
+    /// The momenta `m_j u̇_j` of the nodes.
+    p: Vec<SVector<f64, C>>,
+    /// `−∂Φ/∂u_j` at `u`.
+    force: Vec<SVector<f64, C>>,
+}
+
+impl<const C: usize> Level<C> {
+    /// Copies `other` into these buffers of the same lengths (no allocation).
+    fn copy_from(&mut self, other: &Self) {
+        self.u.copy_from_slice(&other.u);
+        self.p.copy_from_slice(&other.p);
+        self.force.copy_from_slice(&other.force);
+    }
+}
 
 /// Numbers that carry the derivatives along `u` and along `u_x` at once.
 type Pair<const C: usize> = HyperDualSVec64<C, C>;
@@ -298,28 +311,30 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
             }
         }
         let p = ut.iter().zip(&self.mass).map(|(v, m)| v.component_mul(m));
-        let zeros = vec![SVector::zeros(); nodes];
         let blocks = (0..nodes.div_ceil(GRAIN)).map(|k| {
             let nodes_in_block = GRAIN.min(nodes - k * GRAIN);
             vec![[SVector::zeros(); 2]; nodes_in_block + 1]
         });
-        let mut run = Running {
+        let mut now = Level {
             u: u.to_vec(),
             p: p.collect(),
-            force: zeros.clone(),
-            next: [zeros.clone(), zeros.clone(), zeros],
-            shares: blocks.collect(),
-            steps: 0,
+            force: vec![SVector::zeros(); nodes],
         };
-        let (mut force, mut unmoved) = (std::mem::take(&mut run.force), run.p.clone());
-        self.force_and_kick(&run.u, &mut force, &mut unmoved, &mut run.shares, 0.0);
-        if let Some((j, bad)) = first_not_finite(&force) {
+        let mut shares: Vec<_> = blocks.collect();
+        // The force alone: a kick by nothing (a failed start drops this run).
+        self.force_and_kick(&now.u, &mut now.force, &mut now.p, &mut shares, 0.0);
+        if let Some((j, bad)) = first_not_finite(&now.force) {
             return Err(DiracError::NonFinite {
                 what: format!("the force on node {j} of the initial field"),
                 value: bad,
             });
         }
-        run.force = force;
+        let run = Running {
+            next: now.clone(),
+            now,
+            shares,
+            steps: 0,
+        };
         self.run = Some(run);
         Ok(())
     }
@@ -464,36 +479,32 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     /// One step (see [`Field::step`]).
     fn advance(&mut self) -> Result<(), DiracError> {
         let mut run = self.run.take().ok_or(DiracError::NotStarted)?;
-        let [mut u, mut p, mut f] = std::mem::take(&mut run.next);
-        u.copy_from_slice(&run.u);
-        p.copy_from_slice(&run.p);
-        f.copy_from_slice(&run.force);
+        let mut next = std::mem::take(&mut run.next);
+        next.copy_from(&run.now);
+        let Level { u, p, force: f } = &mut next;
         // Each stage a kick, a drift and a kick; a stage's closing kick and the next one's
         // opening kick are one, by the sum of their halves.
         let coefficients = self.composition.coefficients();
         for (i, &gamma) in coefficients.iter().enumerate() {
             let tau = gamma * self.dt;
             let opening = if i == 0 { 0.5 * tau } else { 0.0 };
-            self.kick_and_drift(&mut u, &mut p, &f, (opening, tau));
-            let next = coefficients.get(i + 1).map_or(0.0, |g| g * self.dt);
-            self.force_and_kick(&u, &mut f, &mut p, &mut run.shares, 0.5 * (tau + next));
+            self.kick_and_drift(u, p, f, (opening, tau));
+            let later = coefficients.get(i + 1).map_or(0.0, |g| g * self.dt);
+            self.force_and_kick(u, f, p, &mut run.shares, 0.5 * (tau + later));
         }
-        let bad = [("field", &u), ("momentum", &p), ("force", &f)]
+        let bad = [("field", &*u), ("momentum", &*p), ("force", &*f)]
             .into_iter()
             .find_map(|(what, values)| first_not_finite(values).map(|(j, v)| (what, j, v)));
         if let Some((what, j, value)) = bad {
             let step = run.steps;
-            run.next = [u, p, f];
+            run.next = next;
             self.run = Some(run);
             return Err(DiracError::NonFinite {
                 what: format!("the {what} at node {j} at step {step} (try a smaller step)"),
                 value,
             });
         }
-        std::mem::swap(&mut run.u, &mut u);
-        std::mem::swap(&mut run.p, &mut p);
-        std::mem::swap(&mut run.force, &mut f);
-        run.next = [u, p, f];
+        run.next = std::mem::replace(&mut run.now, next);
         run.steps += 1;
         self.run = Some(run);
         Ok(())
@@ -505,12 +516,12 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
 
     /// The field at the nodes.
     pub fn u(&self) -> Result<&[SVector<f64, C>], DiracError> {
-        Ok(&self.running()?.u)
+        Ok(&self.running()?.now.u)
     }
 
     /// The momenta `m_j u̇_j` of the nodes (`m_j = w_j ρ(x_j)`, zero at a fixed end).
     pub fn momenta(&self) -> Result<&[SVector<f64, C>], DiracError> {
-        Ok(&self.running()?.p)
+        Ok(&self.running()?.now.p)
     }
 
     /// The rates `u̇_j = p_j / m_j` at the nodes (zero at a fixed end).
@@ -520,7 +531,7 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
             true => SVector::zeros(),
             false => p.component_div(m),
         };
-        Ok(run.p.iter().zip(&self.mass).map(rate).collect())
+        Ok(run.now.p.iter().zip(&self.mass).map(rate).collect())
     }
 
     /// The time `n Δt` of the current state (0 before a start).
@@ -538,14 +549,14 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     /// order of `Δt^order`) over long runs.
     pub fn energy(&self) -> Result<f64, DiracError> {
         let run = self.running()?;
-        let kinetic: f64 = (run.p.iter().zip(&self.mass))
+        let kinetic: f64 = (run.now.p.iter().zip(&self.mass))
             .filter(|(_, m)| !is_zero(m))
             .map(|(p, m)| 0.5 * p.component_mul(&p.component_div(m)).sum())
             .sum();
-        let nodes = run.u.len();
+        let nodes = run.now.u.len();
         let potential: f64 = (0..self.cells)
             .map(|i| {
-                let (left, right) = (&run.u[i], &run.u[(i + 1) % nodes]);
+                let (left, right) = (&run.now.u[i], &run.now.u[(i + 1) % nodes]);
                 let slope = (right - left) / self.dx;
                 let density = &self.density;
                 let ends = density.potential(self.position(i), left, &slope)

@@ -343,7 +343,7 @@ fn draw_space_time(
             .margin(15)
             .x_label_area_size(45)
             .y_label_area_size(70)
-            .build_cartesian_2d(x0.min(x1)..x0.max(x1), t0.min(t1)..t0.max(t1))?;
+            .build_cartesian_2d(x0..x1, t0..t1)?;
         chart
             .configure_mesh()
             .disable_mesh()
