@@ -813,6 +813,95 @@ impl HandComposition {
     }
 }
 
+/// One time-transformed step (`dt/ds = |q|`, the logarithmic Hamiltonian) on Kepler's orbit of
+/// eccentricity 0.9, 32 fictive steps a revolution: `TimeTransformed` against the same
+/// drift–kick–drift composition written by hand (no compensated sums, no checks).
+fn time_transformed(c: &mut Criterion) {
+    let mut group = c.benchmark_group("time_transformed_step");
+    let (e, ds) = (0.9, std::f64::consts::TAU / 32.0);
+    let q0 = vector![1.0 - e, 0.0];
+    let v0 = vector![0.0, ((1.0 + e) / (1.0 - e)).sqrt()];
+    for (order, composition) in [
+        ("order_2", Composition::verlet()),
+        ("order_8", Composition::kahan_li_8()),
+    ] {
+        let mut hand = HandLogH::start(composition.coefficients(), ds, q0, v0);
+        let mut stepper =
+            TimeTransformed::new(scenes::kepler::SCENE, composition, ds).expect("separable scene");
+        stepper.start_from_velocity(q0, v0).expect("finite start");
+        group.bench_function(format!("kepler_e0.9_{order}/time_transformed"), |b| {
+            b.iter(|| {
+                if stepper.steps() >= 10_000 {
+                    stepper.start_from_velocity(q0, v0).expect("finite start");
+                }
+                black_box(stepper.step()).expect("step")
+            })
+        });
+        group.bench_function(format!("kepler_e0.9_{order}/hand_written"), |b| {
+            b.iter(|| {
+                if hand.steps >= 10_000 {
+                    hand = HandLogH::start(&hand.gammas, ds, q0, v0);
+                }
+                hand.step();
+                black_box(&hand.q);
+            })
+        });
+    }
+    group.finish();
+}
+
+/// The logarithmic-Hamiltonian composition on Kepler's problem (μ = 1), by hand: per stage
+/// `q += (γ δs/2) p/W, t += (γ δs/2)/W` with `W = |p|²/2 − E`, `p += γ δs ∇(1/|q|)·|q|`, and the
+/// same drift again (adjacent drifts merged).
+struct HandLogH {
+    gammas: Vec<f64>,
+    ds: f64,
+    energy: f64,
+    t: f64,
+    q: [f64; 2],
+    p: [f64; 2],
+    steps: u64,
+}
+
+impl HandLogH {
+    fn start(gammas: &[f64], ds: f64, q: SVector<f64, 2>, v: SVector<f64, 2>) -> Self {
+        let energy = 0.5 * v.norm_squared() - 1.0 / q.norm();
+        Self {
+            gammas: gammas.to_vec(),
+            ds,
+            energy,
+            t: 0.0,
+            q: [q[0], q[1]],
+            p: [v[0], v[1]],
+            steps: 0,
+        }
+    }
+
+    fn drift(&mut self, by: f64) {
+        let w = 0.5 * (self.p[0] * self.p[0] + self.p[1] * self.p[1]) - self.energy;
+        let rate = by / w;
+        self.t += rate;
+        self.q[0] += rate * self.p[0];
+        self.q[1] += rate * self.p[1];
+    }
+
+    fn step(&mut self) {
+        let ds = self.ds;
+        let mut drift = 0.5 * self.gammas[0] * ds;
+        for i in 0..self.gammas.len() {
+            let gamma = self.gammas[i];
+            self.drift(drift);
+            // p += γ δs F/U with F = −q/|q|³, U = 1/|q|: F/U = −q/|q|².
+            let k = -gamma * ds / (self.q[0] * self.q[0] + self.q[1] * self.q[1]);
+            self.p[0] += k * self.q[0];
+            self.p[1] += k * self.q[1];
+            drift = 0.5 * gamma * ds + self.gammas.get(i + 1).map_or(0.0, |&g| 0.5 * g * ds);
+        }
+        self.drift(drift);
+        self.steps += 1;
+    }
+}
+
 /// One step of the sine-Gordon field (Störmer–Verlet, Δx = 0.05, Δt = 0.02, periodic, started
 /// from `u = sin x`) by number of cells: `Field` one cell after another and in parallel, against
 /// a hand-written leapfrog of the same scheme (`scenes::field::leapfrog_sine_gordon`).
@@ -853,6 +942,7 @@ fn field(c: &mut Criterion) {
 criterion_group!(
     benches,
     explicit,
+    time_transformed,
     forced,
     modular,
     field,

@@ -41,6 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for scene in constrained {
         reports.push(scene(Quadrature::midpoint())?);
     }
+    reports.extend(scenes::kepler::eccentric_reports()?);
     reports.push(circuit::driven_report()?);
     reports.push(circuit::subcircuits_report()?);
     reports.push(circuit::by_parts_report()?);

@@ -40,7 +40,7 @@ pub use solve::{jacobian, newton};
 pub use space::{configuration_space, manifold, product, rotation, sphere};
 pub use step::{
     composition, dense_output, euler_lagrange, field, group_euler_lagrange, hamilton, modular,
-    step_derivatives, step_equations, verlet,
+    step_derivatives, step_equations, time_transformation, verlet,
 };
 #[cfg(feature = "plot")]
 pub use study::plot;
@@ -78,6 +78,7 @@ pub use step::ledger::{ComponentBalance, Ledger};
 pub use step::modular::{Modular, ModularFeedback, PortWork};
 pub use step::step_derivatives::{StepDerivatives, StepHessians};
 pub use step::step_equations::{State, StepEquations, StepWork};
+pub use step::time_transformation::TimeTransformed;
 pub use step::verlet::Verlet;
 pub use study::work_precision::{Measurement, Study, WorkPrecision};
 

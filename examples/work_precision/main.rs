@@ -2,9 +2,12 @@
 //! pick, on seven scenes, to T = 10 and T = 10⁴, measured in one run.
 //!
 //! Per scene and horizon: a reference, the closed form where the scene has one, else Dop853 at
-//! `rtol = atol = 1e-13` (its error estimated by the run at 1e-12); dirac's `midpoint`, `galerkin(2)` and `galerkin(3)` at the scene's
-//! steps, measured by `Study`; Dop853 and Dopri5 (ode_solvers) at tolerances 1e-4 … 1e-12 on the
-//! hand-derived first-order form; and BDF (diffsol) on the index-1 DAE of the circuit and of the
+//! `rtol = atol = 1e-13` (its error estimated by the run at 1e-12); dirac's `midpoint`,
+//! `galerkin(2)` and `galerkin(3)` at the scene's steps, for a separable model the explicit
+//! compositions of orders 2 to 8 as well, and on Kepler's orbits those compositions
+//! time-transformed (`dt/ds = |q|`) at the scene's fictive steps, measured by `Study`; Dop853
+//! and Dopri5 (ode_solvers) at tolerances 1e-4 … 1e-12 on the hand-derived first-order form;
+//! and BDF (diffsol) on the index-1 DAE of the circuit and of the
 //! knife edge, in a build with `--features scenes/bdf` (as `scripts/performance.sh` runs
 //! it). Every run's error at the horizon, largest energy error over every step and wall
 //! time per unit of simulated time go to `output/work_precision/study.csv`, with two PNGs per
@@ -14,7 +17,7 @@
 //! `A(q_c)(q_{k+1} − q_k)`, the peers' forms the velocity constraint at each state.
 //!
 //! `cargo run --release --example work_precision --features scenes/bdf` (16 minutes here; `-- 10`
-//! runs T = 10 only)
+//! runs T = 10 only, `-- 10000 Kepler` the scenes whose name contains `Kepler` at T = 10⁴)
 
 use std::fmt::Write as _;
 
@@ -32,6 +35,8 @@ struct Target {
 /// Runs every scene at each horizon and collects the rows.
 struct Runner {
     horizons: Vec<f64>,
+    /// Runs only the scenes whose name contains this (all: empty).
+    only: String,
     rows: Vec<Row>,
     /// Per scene and horizon: the reference's own error estimate.
     references: Vec<(&'static str, f64, f64)>,
@@ -47,6 +52,9 @@ impl Visitor for Runner {
         F: FirstOrder<Y, N>,
         G: FirstOrder<Z, N>,
     {
+        if !scene.name.contains(self.only.as_str()) {
+            return Ok(());
+        }
         for horizon in self.horizons.clone() {
             println!("{} to T = {horizon}", scene.name);
             let (rows, estimate, failures) = study::measure(&scene, horizon)?;
@@ -250,8 +258,10 @@ fn main() -> Result<(), String> {
     if !scenes::peers::Peer::Bdf.is_built() {
         println!("BDF is left out: it is built with `--features scenes/bdf`");
     }
+    let only = std::env::args().nth(2).unwrap_or_default();
     let mut runner = Runner {
         horizons,
+        only,
         rows: Vec::new(),
         references: Vec::new(),
     };

@@ -29,6 +29,9 @@ pub struct Scene<S, F, G, const Y: usize, const Z: usize, const N: usize> {
     pub steps: Vec<f64>,
     /// The quadratures and steps at a long horizon (T = 10⁴), where a step costs 10³ times more.
     pub long: (Vec<Quadrature>, Vec<f64>),
+    /// The fictive steps of the time-transformed compositions (`dt/ds = −1/V(q)`), for a
+    /// potential negative along the motion; none for the other scenes.
+    pub fictive_steps: Vec<f64>,
 }
 
 /// Something done with every scene (the study, a test).
@@ -64,6 +67,7 @@ pub fn pendulum() -> Scene<pendulum::Pendulum, PendulumOde, PendulumOde, 2, 2, 1
         dae: None,
         steps: vec![0.2, 0.1, 0.05, 0.025],
         long: (every_quadrature(), vec![0.2, 0.1, 0.05, 0.025]),
+        fictive_steps: Vec::new(),
     }
 }
 
@@ -81,6 +85,7 @@ pub fn visit_all(visitor: &mut impl Visitor) -> Result<(), String> {
         dae: None,
         steps: vec![0.02, 0.01, 0.005],
         long: (every_quadrature(), vec![0.02, 0.01, 0.005]),
+        fictive_steps: Vec::new(),
     })?;
     for (name, e, steps) in [
         ("Kepler e = 0.5", 0.5, vec![0.04, 0.02, 0.01, 0.005]),
@@ -96,6 +101,8 @@ pub fn visit_all(visitor: &mut impl Visitor) -> Result<(), String> {
             dae: None,
             long: (every_quadrature(), steps.clone()),
             steps,
+            // A revolution is 2π of the fictive time: 16 to 128 steps a revolution.
+            fictive_steps: vec![0.4, 0.2, 0.1, 0.05],
         })?;
     }
     visitor.visit(Scene::<_, _, ChainOde<8>, 16, 16, 8> {
@@ -115,6 +122,7 @@ pub fn visit_all(visitor: &mut impl Visitor) -> Result<(), String> {
             ],
             vec![0.02],
         ),
+        fictive_steps: Vec::new(),
     })?;
     let lc = LcOde {
         circuit: circuit::LC,
@@ -127,6 +135,7 @@ pub fn visit_all(visitor: &mut impl Visitor) -> Result<(), String> {
         dae: Some(LcDae(lc)),
         steps: vec![0.1, 0.05, 0.025, 0.0125],
         long: (every_quadrature(), vec![0.1, 0.05, 0.025, 0.0125]),
+        fictive_steps: Vec::new(),
     })?;
     let knife = KnifeEdgeOde {
         knife: knife_edge::SCENE,
@@ -139,6 +148,7 @@ pub fn visit_all(visitor: &mut impl Visitor) -> Result<(), String> {
         dae: Some(KnifeEdgeDae(knife)),
         steps: vec![0.1, 0.05, 0.025, 0.0125],
         long: (every_quadrature(), vec![0.1, 0.05, 0.025, 0.0125]),
+        fictive_steps: Vec::new(),
     })
 }
 
@@ -195,15 +205,17 @@ where
     } else {
         (every_quadrature(), scene.steps.clone())
     };
-    let dirac = Study::new(scene.system.clone(), horizon, |s| {
+    let mut study = Study::new(scene.system.clone(), horizon, |s| {
         s.start_from_velocity(start.q, start.v)
     })
     .quadratures(quadratures)
     .steps(steps)
     .repetitions(repetitions)
-    .reference_with_error(reference, estimate)
-    .run()
-    .map_err(|e| e.to_string())?;
+    .reference_with_error(reference, estimate);
+    if !scene.fictive_steps.is_empty() {
+        study = study.time_transformed(0.0, scene.fictive_steps.clone());
+    }
+    let dirac = study.run().map_err(|e| e.to_string())?;
     let mut failures: Vec<String> = dirac
         .failures
         .iter()

@@ -32,5 +32,6 @@ mod roundoff;
 mod run;
 mod step_derivatives;
 mod step_equations;
+mod time_transformation;
 mod vector_algebra;
 mod work_precision;

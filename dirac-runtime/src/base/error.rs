@@ -111,6 +111,15 @@ pub enum DiracError {
         /// What could not be held.
         why: String,
     },
+    /// A step left the region where its method is defined (for a time-transformed step, where
+    /// `c − V(q) > 0` and time runs forward); the message says where.
+    #[error("step {step}: {why}; nothing was changed (try a smaller step)")]
+    OutsideDomain {
+        /// Index of the step that failed.
+        step: u64,
+        /// Where the step went and why the method is not defined there.
+        why: String,
+    },
     /// A run's time span, save times or events do not fit the stepper (the message says how).
     #[error("invalid run: {0}")]
     InvalidRun(String),

@@ -1,7 +1,7 @@
-//! Error measures that a NaN cannot make look small, and the matrix norm the solver and the
-//! Jacobian shapes judge by.
+//! Error measures that a NaN cannot make look small, the matrix norm the solver and the
+//! Jacobian shapes judge by, and sums that keep their rounding errors (TwoSum).
 
-use nalgebra::{Dim, IsContiguous, Matrix, Storage};
+use nalgebra::{Dim, IsContiguous, Matrix, SVector, Storage};
 
 /// Whether the error measure `x` exceeds `bound`, or either is NaN: a test that a NaN (a
 /// constraint or balance that is not finite) cannot pass.
@@ -27,6 +27,32 @@ pub(crate) fn rounded_sum(first: f64, terms: impl Iterator<Item = f64>) -> (f64,
         (sum, error) = (next, error + rounding);
     }
     two_sum(sum, error)
+}
+
+/// `x += increment` with the rounding error of each component's addition added to `lo`
+/// (`x_new + e = x + increment` exactly).
+#[inline(always)]
+pub(crate) fn two_sum_add<const N: usize>(
+    x: &mut SVector<f64, N>,
+    lo: &mut SVector<f64, N>,
+    increment: &SVector<f64, N>,
+) {
+    for i in 0..N {
+        let (sum, error) = two_sum(x[i], increment[i]);
+        lo[i] += error;
+        x[i] = sum;
+    }
+}
+
+/// `x + lo` as a rounded sum and the carry of a compensated sum (the sum's excess over
+/// `x + lo`, which the next addition takes back, as a Kahan sum does).
+pub(crate) fn folded<const N: usize>(
+    x: &SVector<f64, N>,
+    lo: &SVector<f64, N>,
+) -> (SVector<f64, N>, SVector<f64, N>) {
+    let (mut sum, mut error) = (*x, SVector::zeros());
+    two_sum_add(&mut sum, &mut error, lo);
+    (sum, -error)
 }
 
 /// The largest magnitude among `values`, or NaN where one is NaN (which `f64::max` and

@@ -566,6 +566,20 @@ pub(crate) fn gradients<F: PhaseFunction<N>, const N: usize>(
     (gradient(&lq), gradient(&lv))
 }
 
+/// `L(q, v)` and `∂L/∂q` at `(q, v)`: the closed form where the model has one, else one pass of
+/// first-order duals.
+pub(crate) fn value_and_position_gradient<F: PhaseFunction<N>, const N: usize>(
+    lagrangian: &F,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+) -> (f64, SVector<f64, N>) {
+    if let Some(g) = lagrangian.closed_gradient(q, v) {
+        return (g.value, g.q);
+    }
+    let l = lagrangian.value(&lift(q, 1.0), &v.map(Dual::<N>::from));
+    (l.re, gradient(&l))
+}
+
 /// The gradient of `L` along `seed` at `(q, v)`: `∂L/∂x_i` where moving `x_i` moves `q_i` by
 /// `seed.position` and `v_i` by `seed.velocity` (one pass of first-order duals).
 pub(crate) fn directional_gradient<F: PhaseFunction<N>, const N: usize>(

@@ -30,7 +30,7 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::base::error::DiracError;
-use crate::base::float::two_sum;
+use crate::base::float::{folded, two_sum_add};
 use crate::discrete::discrete_lagrangian::DiscreteLagrangian;
 use crate::discrete::state::State;
 use crate::model::derivatives::{self, Seed};
@@ -104,7 +104,7 @@ impl<const N: usize> Taken<N> {
 
 /// The constant kinetic terms: `v = M⁻¹ (p − b)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Kinetic<const N: usize> {
+pub(crate) struct Kinetic<const N: usize> {
     mass: SMatrix<f64, N, N>,
     inverse_mass: SMatrix<f64, N, N>,
     offset: SVector<f64, N>,
@@ -113,9 +113,89 @@ struct Kinetic<const N: usize> {
 }
 
 impl<const N: usize> Kinetic<N> {
+    /// `M⁻¹` and `b` at `(q, v)`, checked against a second state: `∂²L/∂q∂v = 0` at both, the
+    /// same `∂²L/∂v² = M` and `∂L/∂v − M v = b` at both, `M` invertible.
+    pub(crate) fn of<S: DiracSystem<N>>(
+        system: &S,
+        q: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> Result<Self, DiracError> {
+        let at = |q: &SVector<f64, N>, v: &SVector<f64, N>| {
+            let h = derivatives::hessian(system, q, v);
+            (h.vv, h.gradient.v - h.vv * v, h.qv)
+        };
+        let (mass, offset, mixed) = at(q, v);
+        if !(mass.iter().chain(offset.iter()).all(|x| x.is_finite())) {
+            return Err(DiracError::NonFinite {
+                what: "∂²L/∂v² or ∂L/∂v at the start".into(),
+                value: mass
+                    .iter()
+                    .chain(offset.iter())
+                    .copied()
+                    .find(|x| !x.is_finite())
+                    .unwrap_or(f64::NAN),
+            });
+        }
+        // A second state, moved by uneven amounts (a term may vanish at one state).
+        let q2 = derivatives::moved(q, derivatives::POSITION_SHIFT);
+        let v2 = derivatives::moved(v, derivatives::VELOCITY_SHIFT);
+        let (mass2, offset2, mixed2) = at(&q2, &v2);
+        let scale = 1.0 + mass.amax() + offset.amax();
+        let differs = |a: f64, b: f64| (a - b).abs() > PROBE_TOLERANCE * scale;
+        let probe_finite = mass2.iter().chain(offset2.iter()).all(|x| x.is_finite());
+        let inconsistent = mixed.iter().any(|&x| differs(x, 0.0))
+            || (probe_finite
+                && (mixed2.iter().any(|&x| differs(x, 0.0))
+                    || mass.iter().zip(mass2.iter()).any(|(&a, &b)| differs(a, b))
+                    || offset
+                        .iter()
+                        .zip(offset2.iter())
+                        .any(|(&a, &b)| differs(a, b))));
+        if inconsistent {
+            return Err(DiracError::InconsistentDerivatives(format!(
+                "the model declares SEPARABLE, but its ∂²L/∂q∂v is not zero or its ∂²L/∂v² or \
+                 ∂L/∂v − (∂²L/∂v²) v changes between (q, v) = ({q:?}, {v:?}) and ({q2:?}, \
+                 {v2:?})"
+            )));
+        }
+        let inverse_mass = mass
+            .try_inverse()
+            .filter(|inverse| inverse.iter().all(|x| x.is_finite()))
+            .ok_or_else(|| {
+                DiracError::Unsupported(format!(
+                    "the explicit step of a model whose mass matrix ∂²L/∂v² is singular ({} \
+                     carries no kinetic energy of its own); Stepper::new steps it with a \
+                     quadrature",
+                    (0..N)
+                        .find(|&i| mass.row(i).iter().all(|&x| x == 0.0))
+                        .map_or_else(
+                            || "some combination of the velocities".to_string(),
+                            |i| system.coordinate_name(i)
+                        )
+                ))
+            })?;
+        Ok(Kinetic {
+            unit: mass == SMatrix::<f64, N, N>::identity() && offset == SVector::<f64, N>::zeros(),
+            mass,
+            inverse_mass,
+            offset,
+        })
+    }
+
+    /// `v = M⁻¹ (p − b)` and the kinetic energy `T(p) = ½ vᵀ M v = ½ v · (p − b)`.
+    #[inline]
+    pub(crate) fn velocity_and_energy(&self, p: &SVector<f64, N>) -> (SVector<f64, N>, f64) {
+        let v = self.velocity(p);
+        let energy = match self.unit {
+            true => 0.5 * v.dot(&v),
+            false => 0.5 * v.dot(&(p - self.offset)),
+        };
+        (v, energy)
+    }
+
     /// `v = M⁻¹ (p − b)`.
     #[inline]
-    fn velocity(&self, p: &SVector<f64, N>) -> SVector<f64, N> {
+    pub(crate) fn velocity(&self, p: &SVector<f64, N>) -> SVector<f64, N> {
         match self.unit {
             true => *p,
             false => self.inverse_mass * (p - self.offset),
@@ -230,72 +310,6 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
         Ok(())
     }
 
-    /// `M⁻¹` and `b` at `(q, v)`, checked against a second state: `∂²L/∂q∂v = 0` at both, the
-    /// same `∂²L/∂v² = M` and `∂L/∂v − M v = b` at both, `M` invertible.
-    fn kinetic(&self, q: &SVector<f64, N>, v: &SVector<f64, N>) -> Result<Kinetic<N>, DiracError> {
-        let system = self.discrete.system();
-        let at = |q: &SVector<f64, N>, v: &SVector<f64, N>| {
-            let h = derivatives::hessian(system, q, v);
-            (h.vv, h.gradient.v - h.vv * v, h.qv)
-        };
-        let (mass, offset, mixed) = at(q, v);
-        if !(mass.iter().chain(offset.iter()).all(|x| x.is_finite())) {
-            return Err(DiracError::NonFinite {
-                what: "∂²L/∂v² or ∂L/∂v at the start".into(),
-                value: mass
-                    .iter()
-                    .chain(offset.iter())
-                    .copied()
-                    .find(|x| !x.is_finite())
-                    .unwrap_or(f64::NAN),
-            });
-        }
-        // A second state, moved by uneven amounts (a term may vanish at one state).
-        let q2 = derivatives::moved(q, derivatives::POSITION_SHIFT);
-        let v2 = derivatives::moved(v, derivatives::VELOCITY_SHIFT);
-        let (mass2, offset2, mixed2) = at(&q2, &v2);
-        let scale = 1.0 + mass.amax() + offset.amax();
-        let differs = |a: f64, b: f64| (a - b).abs() > PROBE_TOLERANCE * scale;
-        let probe_finite = mass2.iter().chain(offset2.iter()).all(|x| x.is_finite());
-        let inconsistent = mixed.iter().any(|&x| differs(x, 0.0))
-            || (probe_finite
-                && (mixed2.iter().any(|&x| differs(x, 0.0))
-                    || mass.iter().zip(mass2.iter()).any(|(&a, &b)| differs(a, b))
-                    || offset
-                        .iter()
-                        .zip(offset2.iter())
-                        .any(|(&a, &b)| differs(a, b))));
-        if inconsistent {
-            return Err(DiracError::InconsistentDerivatives(format!(
-                "the model declares SEPARABLE, but its ∂²L/∂q∂v is not zero or its ∂²L/∂v² or \
-                 ∂L/∂v − (∂²L/∂v²) v changes between (q, v) = ({q:?}, {v:?}) and ({q2:?}, \
-                 {v2:?})"
-            )));
-        }
-        let inverse_mass = mass
-            .try_inverse()
-            .filter(|inverse| inverse.iter().all(|x| x.is_finite()))
-            .ok_or_else(|| {
-                DiracError::Unsupported(format!(
-                    "the explicit step of a model whose mass matrix ∂²L/∂v² is singular ({} \
-                     carries no kinetic energy of its own); Stepper::new steps it with a \
-                     quadrature",
-                    (0..N)
-                        .find(|&i| mass.row(i).iter().all(|&x| x == 0.0))
-                        .map_or_else(
-                            || "some combination of the velocities".to_string(),
-                            |i| system.coordinate_name(i)
-                        )
-                ))
-            })?;
-        Ok(Kinetic {
-            unit: mass == SMatrix::<f64, N, N>::identity() && offset == SVector::<f64, N>::zeros(),
-            mass,
-            inverse_mass,
-            offset,
-        })
-    }
-
     /// The step from `state` with the run's kinetic terms, starting from the gradient `first`
     /// at `state.q` where it is known. The last half kick of a stage and the first of the next
     /// act at the same point: they are one kick `(γ_i + γ_{i+1}) h/2`.
@@ -389,35 +403,9 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
     fn kinetic_at(&self, state: &State<N>) -> Result<Kinetic<N>, DiracError> {
         match self.kinetic {
             Some(kinetic) => Ok(kinetic),
-            None => self.kinetic(&state.q, &state.velocity),
+            None => Kinetic::of(self.discrete.system(), &state.q, &state.velocity),
         }
     }
-}
-
-/// `x += increment` with the rounding error of each component's addition added to `lo`
-/// (`x_new + e = x + increment` exactly).
-#[inline(always)]
-fn two_sum_add<const N: usize>(
-    x: &mut SVector<f64, N>,
-    lo: &mut SVector<f64, N>,
-    increment: &SVector<f64, N>,
-) {
-    for i in 0..N {
-        let (sum, error) = two_sum(x[i], increment[i]);
-        lo[i] += error;
-        x[i] = sum;
-    }
-}
-
-/// `x + lo` as a rounded sum and the carry of a compensated sum (the sum's excess over
-/// `x + lo`, which the next addition takes back, as a Kahan sum does).
-fn folded<const N: usize>(
-    x: &SVector<f64, N>,
-    lo: &SVector<f64, N>,
-) -> (SVector<f64, N>, SVector<f64, N>) {
-    let (mut sum, mut error) = (*x, SVector::zeros());
-    two_sum_add(&mut sum, &mut error, lo);
-    (sum, -error)
 }
 
 impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
@@ -467,11 +455,11 @@ impl<S: DiracSystem<N>, const N: usize> StepEquations<N> for Verlet<S, N> {
             });
         }
         self.check_forces(state.t, &state.q, &state.velocity)?;
-        self.kinetic(&state.q, &state.velocity).map(|_| ())
+        Kinetic::of(self.discrete.system(), &state.q, &state.velocity).map(|_| ())
     }
 
     fn begin(&mut self, state: &State<N>) {
-        self.kinetic = self.kinetic(&state.q, &state.velocity).ok();
+        self.kinetic = Kinetic::of(self.discrete.system(), &state.q, &state.velocity).ok();
         self.memo = None;
         self.proposal = None;
     }

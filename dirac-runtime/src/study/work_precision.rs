@@ -1,6 +1,6 @@
 //! The trade between speed and accuracy, measured for the user's own model: a grid of
-//! methods (quadratures, and for a separable model the explicit compositions) × steps run to a
-//! horizon, each run's error against a reference, its energy error,
+//! methods (quadratures, and for a separable model the explicit compositions, at a fixed step or
+//! time-transformed) × steps run to a horizon, each run's error against a reference, its energy error,
 //! constraint violation, Newton iterations and wall time per unit of simulated time; and the
 //! cheapest run meeting a target.
 //!
@@ -31,6 +31,7 @@ use crate::space::manifold::Vectors;
 use crate::step::composition::Composition;
 use crate::step::dense_output::Sample;
 use crate::step::step_equations::StepEquations;
+use crate::step::time_transformation::TimeTransformed;
 use crate::step::verlet::Verlet;
 
 /// How a study starts each of its steppers (e.g. `|s| s.start_from_velocity(q0, v0)`).
@@ -67,6 +68,8 @@ pub struct Study<'a, S: DiracSystem<N>, const N: usize> {
     /// Whether the compositions are the default ones (not asked for).
     compositions_by_default: bool,
     steps: Vec<f64>,
+    /// The offset `c` and the fictive steps of the time-transformed compositions, where asked.
+    time_transformed: Option<(f64, Vec<f64>)>,
     repetitions: usize,
     /// The given reference and its error estimate.
     reference: Option<(Sample<N>, f64)>,
@@ -79,6 +82,7 @@ impl<S: DiracSystem<N>, const N: usize> std::fmt::Debug for Study<'_, S, N> {
             .field("quadratures", &self.quadratures)
             .field("compositions", &self.compositions)
             .field("steps", &self.steps)
+            .field("time_transformed", &self.time_transformed)
             .field("repetitions", &self.repetitions)
             .field("reference", &self.reference)
             .finish_non_exhaustive()
@@ -89,9 +93,10 @@ impl<S: DiracSystem<N>, const N: usize> std::fmt::Debug for Study<'_, S, N> {
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Measurement {
-    /// The method's name: the quadrature's, or the composition's for an explicit step.
+    /// The method's name: the quadrature's, or the composition's for an explicit step (followed
+    /// by `, time-transformed` for a [`TimeTransformed`] one).
     pub quadrature: String,
-    /// The step size.
+    /// The step size (the fictive step `δs` of a time-transformed run).
     pub h: f64,
     /// Steps taken to the horizon.
     pub steps: u64,
@@ -171,6 +176,7 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
             compositions,
             compositions_by_default: true,
             steps: [16.0, 32.0, 64.0, 128.0].map(|n| horizon / n).to_vec(),
+            time_transformed: None,
             repetitions: 3,
             reference: None,
         }
@@ -220,6 +226,49 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
     pub fn steps(self, steps: impl IntoIterator<Item = f64>) -> Self {
         Self {
             steps: steps.into_iter().collect(),
+            ..self
+        }
+    }
+
+    /// Adds the grid's compositions time-transformed ([`TimeTransformed`]: `dt/ds = 1/(c − V(q))`
+    /// with `c = offset`) at the fictive steps `fictive_steps`. Each run lands on the horizon;
+    /// its energy error is measured at every step.
+    ///
+    /// ```
+    /// use dirac_runtime::{Composition, DiracSystem, Sample, Scalar, work_precision::Study};
+    /// use nalgebra::{SVector, vector};
+    /// /// Kepler's problem, V = −1/|q|.
+    /// #[derive(Clone)]
+    /// struct Kepler;
+    /// impl DiracSystem<2> for Kepler {
+    ///     const SEPARABLE: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1]) * 0.5 + (q[0] * q[0] + q[1] * q[1]).sqrt().recip()
+    ///     }
+    /// }
+    /// // One revolution of an orbit of eccentricity 0.9 from its pericentre.
+    /// let (q0, v0) = (vector![0.1, 0.0], vector![0.0, 19f64.sqrt()]);
+    /// let period = 2.0 * std::f64::consts::PI;
+    /// let exact = Sample { t: period, q: q0, v: v0, p: v0 };
+    /// let study = Study::new(Kepler, period, |s| s.start_from_velocity(q0, v0))
+    ///     .quadratures([])
+    ///     .compositions([Composition::kahan_li_8()])
+    ///     .steps([period / 1000.0])
+    ///     .time_transformed(0.0, [period / 25.0])
+    ///     .reference(exact)
+    ///     .run()?;
+    /// let adaptive = study.cheapest(1e-8)?;
+    /// assert_eq!(adaptive.quadrature, "Kahan–Li 8 (17 stages), time-transformed");
+    /// assert!(adaptive.steps < 30);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn time_transformed(
+        self,
+        offset: f64,
+        fictive_steps: impl IntoIterator<Item = f64>,
+    ) -> Self {
+        Self {
+            time_transformed: Some((offset, fictive_steps.into_iter().collect())),
             ..self
         }
     }
@@ -314,6 +363,16 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
                 record(name, h, self.measure(&stepper, h, &reference));
             }
         }
+        if let Some((offset, fictive_steps)) = &self.time_transformed {
+            for composition in compositions {
+                for &ds in fictive_steps {
+                    let name = format!("{}, time-transformed", composition.name());
+                    let measured =
+                        self.measure_time_transformed(composition, *offset, ds, &reference);
+                    record(name, ds, measured);
+                }
+            }
+        }
         Ok(WorkPrecision {
             reference,
             reference_method,
@@ -334,7 +393,13 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
         if self.quadratures.is_empty() && self.compositions.is_empty() || self.steps.is_empty() {
             return invalid("the grid needs at least one method and one step".into());
         }
-        if let Some(h) = self.steps.iter().find(|h| !(h.is_finite() && **h > 0.0)) {
+        let fictive = self.time_transformed.iter().flat_map(|(_, steps)| steps);
+        if let Some(h) = self
+            .steps
+            .iter()
+            .chain(fictive)
+            .find(|h| !(h.is_finite() && **h > 0.0))
+        {
             return invalid(format!("steps must be positive and finite, got {h}"));
         }
         if let Some((reference, error)) = &self.reference {
@@ -456,6 +521,55 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
             energy_error: trajectory.max_energy_error(),
             constraint_violation: trajectory.max_constraint_violation(),
             newton_iterations: iterations as f64 / steps.max(1) as f64,
+            seconds_per_unit_time: fastest / self.horizon,
+        })
+    }
+}
+
+impl<S: DiracSystem<N> + Clone, const N: usize> Study<'_, S, N> {
+    /// A started time-transformed stepper, from the state `start` gives a midpoint stepper.
+    fn time_transformed_stepper(
+        &self,
+        composition: &Composition,
+        offset: f64,
+        ds: f64,
+    ) -> Result<TimeTransformed<S, N>, DiracError> {
+        let start = self.stepper(&Quadrature::midpoint(), self.steps[0])?;
+        let state = start.state().ok_or(DiracError::NotStarted)?;
+        let mut stepper = TimeTransformed::new(self.system.clone(), composition.clone(), ds)?
+            .with_offset(offset)?
+            .with_start_time(state.t);
+        stepper.start_from_momentum(state.q, state.p)?;
+        Ok(stepper)
+    }
+
+    /// One time-transformed run of the grid: recorded at every step, then timed.
+    fn measure_time_transformed(
+        &self,
+        composition: &Composition,
+        offset: f64,
+        ds: f64,
+        reference: &Sample<N>,
+    ) -> Result<Measurement, DiracError> {
+        let mut stepper = self.time_transformed_stepper(composition, offset, ds)?;
+        let t_end = stepper.t() + self.horizon;
+        let trajectory = stepper.trajectory_until(t_end)?;
+        let end = stepper.sample().ok_or(DiracError::NotStarted)?;
+        let mut fastest = f64::INFINITY;
+        for _ in 0..self.repetitions {
+            let mut timed = self.time_transformed_stepper(composition, offset, ds)?;
+            let clock = Instant::now();
+            timed.run_until(t_end)?;
+            fastest = fastest.min(clock.elapsed().as_secs_f64());
+        }
+        Ok(Measurement {
+            quadrature: format!("{}, time-transformed", composition.name()),
+            h: ds,
+            steps: stepper.steps(),
+            error: distance(&end, reference),
+            energy_error: trajectory.max_energy_error(),
+            constraint_violation: 0.0,
+            newton_iterations: 0.0,
             seconds_per_unit_time: fastest / self.horizon,
         })
     }
