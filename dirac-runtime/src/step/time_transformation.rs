@@ -317,6 +317,7 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
     }
 
     /// The step of fictive size `ds` from `from`: drifts and kicks of the composition.
+    #[inline]
     fn advance(
         &self,
         motion: &Motion<N>,
@@ -383,6 +384,7 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
 
     /// Moves `q` and `t` by `ds` of the fictive time with the momenta fixed:
     /// `q += ds M⁻¹(p − b)/W`, `t += ds/W`, `W = T(p) + p_t`.
+    #[inline(always)]
     fn drift(
         &self,
         kinetic: &Kinetic<N>,
@@ -411,14 +413,14 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
         Ok(())
     }
 
-    fn motion(&self) -> Result<Motion<N>, DiracError> {
-        self.motion.ok_or(DiracError::NotStarted)
+    fn motion(&self) -> Result<&Motion<N>, DiracError> {
+        self.motion.as_ref().ok_or(DiracError::NotStarted)
     }
 
     /// One step of the fictive time. A failed step changes nothing.
     pub fn step(&mut self) -> Result<(), DiracError> {
         let motion = self.motion()?;
-        let next = self.advance(&motion, &motion.at, self.ds)?;
+        let next = self.advance(motion, &motion.at, self.ds)?;
         self.set(next);
         Ok(())
     }
@@ -486,7 +488,7 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
         t_end: f64,
         mut each: impl FnMut(&Self) -> Result<(), DiracError>,
     ) -> Result<(), DiracError> {
-        let motion = self.motion()?;
+        let motion = *self.motion()?;
         if !t_end.is_finite() {
             return Err(DiracError::InvalidRun(format!(
                 "the end time {t_end} is not finite"
