@@ -32,7 +32,7 @@ pub mod study;
 
 pub use base::{error, scalar};
 pub use discrete::{constraint, discrete_lagrangian};
-pub use integrate::{event, run, stepper, trajectory};
+pub use integrate::{event, run, stepper, time_transformation, trajectory};
 pub use model::{
     closed_form, hamiltonian_system, interconnection, legendre, repeated, slot, system,
 };
@@ -40,7 +40,7 @@ pub use solve::{jacobian, newton};
 pub use space::{configuration_space, manifold, product, rotation, sphere};
 pub use step::{
     composition, dense_output, euler_lagrange, field, group_euler_lagrange, hamilton, modular,
-    step_derivatives, step_equations, time_transformation, verlet,
+    step_derivatives, step_equations, verlet,
 };
 #[cfg(feature = "plot")]
 pub use study::plot;
@@ -56,6 +56,7 @@ pub use discrete::discrete_lagrangian::DiscreteLagrangian;
 pub use integrate::event::{Crossing, Direction, Event};
 pub use integrate::run::{Feedback, Progress, Run, Solution, Status};
 pub use integrate::stepper::{ManifoldStepper, Stepper};
+pub use integrate::time_transformation::TimeTransformed;
 pub use integrate::trajectory::{EnergyBalance, Interrupted, Metadata, Trajectory};
 pub use model::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};
 pub use model::density::SeparableDensity;
@@ -78,7 +79,6 @@ pub use step::ledger::{ComponentBalance, Ledger};
 pub use step::modular::{Modular, ModularFeedback, PortWork};
 pub use step::step_derivatives::{StepDerivatives, StepHessians};
 pub use step::step_equations::{State, StepEquations, StepWork};
-pub use step::time_transformation::TimeTransformed;
 pub use step::verlet::Verlet;
 pub use study::work_precision::{Measurement, Study, WorkPrecision};
 

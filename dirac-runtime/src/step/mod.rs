@@ -1,7 +1,7 @@
 //! One step: the [`StepEquations`](crate::StepEquations) seam and its implementations — the
 //! discrete Euler–Lagrange equations on vector spaces and on Lie groups, the discrete Hamiltonian
 //! route, the modular step of an interconnection, the explicit Störmer–Verlet step of a separable
-//! Lagrangian and its compositions (at a fixed step, or adaptive through a time transformation), the explicit multisymplectic step of a field — with the interpolant inside a step (dense
+//! Lagrangian and its compositions, the explicit multisymplectic step of a field — with the interpolant inside a step (dense
 //! output), the step map's derivatives and the work of the steps booked by component (ledger).
 //!
 //! Uses every layer below it, up to [`discrete`](crate::discrete). A new scheme goes here.
@@ -16,5 +16,4 @@ pub mod ledger;
 pub mod modular;
 pub mod step_derivatives;
 pub mod step_equations;
-pub mod time_transformation;
 pub mod verlet;

@@ -24,6 +24,7 @@ use crate::base::error::DiracError;
 use crate::base::float::largest;
 use crate::integrate::run::Run;
 use crate::integrate::stepper::Stepper;
+use crate::integrate::time_transformation::TimeTransformed;
 use crate::integrate::trajectory;
 use crate::model::system::DiracSystem;
 use crate::quadrature::Quadrature;
@@ -31,7 +32,6 @@ use crate::space::manifold::Vectors;
 use crate::step::composition::Composition;
 use crate::step::dense_output::Sample;
 use crate::step::step_equations::StepEquations;
-use crate::step::time_transformation::TimeTransformed;
 use crate::step::verlet::Verlet;
 
 /// How a study starts each of its steppers (e.g. `|s| s.start_from_velocity(q0, v0)`).
@@ -392,6 +392,15 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
         }
         if self.quadratures.is_empty() && self.compositions.is_empty() || self.steps.is_empty() {
             return invalid("the grid needs at least one method and one step".into());
+        }
+        if let Some((offset, _)) = self
+            .time_transformed
+            .as_ref()
+            .filter(|(c, _)| !c.is_finite())
+        {
+            return invalid(format!(
+                "the offset of the time transformation must be finite, got {offset}"
+            ));
         }
         let fictive = self.time_transformed.iter().flat_map(|(_, steps)| steps);
         if let Some(h) = self
