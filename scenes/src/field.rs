@@ -62,6 +62,23 @@ pub fn kink_energy(v: f64) -> f64 {
     8.0 / (1.0 - v * v).sqrt()
 }
 
+/// The sine-Gordon breather of frequency `ω` (0 < ω < 1), a kink and an antikink bound to each
+/// other, at rest and centred at `x = 0`:
+/// `u = 4 arctan(√(1 − ω²) sin(ωt) / (ω cosh(√(1 − ω²) x)))`; returns `(u, u_t)`.
+pub fn breather(omega: f64, t: f64, x: f64) -> (f64, f64) {
+    let k = (1.0 - omega * omega).sqrt();
+    let (sin, cos) = (omega * t).sin_cos();
+    let width = (k * x).cosh();
+    let ratio = k * sin / (omega * width);
+    let rate = 4.0 * k * cos / (width * (1.0 + ratio * ratio));
+    (4.0 * ratio.atan(), rate)
+}
+
+/// The breather's energy `16 √(1 − ω²)`.
+pub fn breather_energy(omega: f64) -> f64 {
+    16.0 * (1.0 - omega * omega).sqrt()
+}
+
 /// The kink–antikink collision of Perring and Skyrme: `u = 4 arctan(sinh(γvt) / (v cosh γx))`,
 /// an antikink and a kink approaching at speeds `±v` for `t < 0`, passing through each other at
 /// `t = 0` and parting; returns `(u, u_t)`.
