@@ -50,8 +50,8 @@ pub mod prelude {
     pub use dirac_runtime::{
         Boundary, Composition, Configuration, ConfigurationSpace, ConstraintPoint, Crossing,
         DiracError, DiracSystem, Direction, DiscreteLagrangian, DualNum, Euclidean, Event,
-        Feedback, Field, FirstOrderScheme, HamiltonianSystem, HolonomicScheme, Input,
-        Interconnected, Interconnection, Junction, ManifoldStepper, Modular, NewtonOptions,
+        ExplicitSystem, Feedback, Field, FirstOrderScheme, HamiltonianSystem, HolonomicScheme,
+        Input, Interconnected, Interconnection, Junction, ManifoldStepper, Modular, NewtonOptions,
         Positive, Product, Progress, Quadrature, Rates, Repeated, Retraction, Rule, Run, Sample,
         Scalar, SeparableDensity, Solution, Status, Stepper, TimeTransformed, Trajectory,
     };

@@ -79,7 +79,7 @@ pub use step::ledger::{ComponentBalance, Ledger};
 pub use step::modular::{Modular, ModularFeedback, PortWork};
 pub use step::step_derivatives::{StepDerivatives, StepHessians};
 pub use step::step_equations::{State, StepEquations, StepWork};
-pub use step::verlet::Verlet;
+pub use step::verlet::{ExplicitSystem, Verlet};
 pub use study::work_precision::{Measurement, Study, WorkPrecision};
 
 pub use nalgebra;

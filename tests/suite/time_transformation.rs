@@ -237,6 +237,41 @@ fn a_run_lands_on_its_end_and_adapts_its_steps() {
     assert!((comet.time_rate().unwrap() - 1.9).abs() < 1e-3);
 }
 
+/// Saving at given times does not change the run: it ends where `run_until` ends, bit for
+/// bit, after as many steps; each saved state is on Kepler's orbit at its time, to the run's
+/// accuracy; and bad save times are refused, changing nothing.
+#[test]
+fn saved_times_do_not_change_the_run() {
+    let times: Vec<f64> = (1..=40).map(|i| 0.25 * i as f64).collect();
+    let mut saved = comet(0.9, Composition::kahan_li_8(), 32);
+    let trajectory = saved.trajectory_at(&times).unwrap();
+    let mut plain = comet(0.9, Composition::kahan_li_8(), 32);
+    plain.run_until(10.0).unwrap();
+    assert_eq!(saved.sample(), plain.sample());
+    assert_eq!(saved.steps(), plain.steps());
+    assert_eq!(trajectory.t(), &times[..]);
+    let mut worst = 0.0_f64;
+    for (t, q) in trajectory.t().iter().zip(trajectory.q()) {
+        let exact = orbit(0.9).exact(*t).unwrap();
+        worst = worst.max((q - vector![exact[0], exact[1]]).amax());
+    }
+    println!("40 saved states, Kahan–Li 8 at 32 steps a revolution: {worst:.1e} from the orbit");
+    assert!(worst < 1e-10, "{worst}");
+    assert!(trajectory.max_energy_error() < 1e-13);
+    let before = saved.sample();
+    for bad in [vec![11.0, 10.5], vec![11.0, f64::NAN], vec![9.0, 12.0]] {
+        assert!(matches!(
+            saved.trajectory_at(&bad),
+            Err(DiracError::InvalidRun(_))
+        ));
+    }
+    assert_eq!(saved.sample(), before);
+    assert!(saved.trajectory_at(&[]).unwrap().is_empty());
+    // A time equal to now is saved without a step.
+    assert_eq!(saved.trajectory_at(&[10.0]).unwrap().t(), &[10.0]);
+    assert_eq!(saved.sample(), before);
+}
+
 /// Refusals, each leaving the state as it was.
 #[test]
 fn refusals() {

@@ -16,6 +16,8 @@ pub struct Model {
     /// Whether the model is given by a Hamiltonian (`impl HamiltonianSystem`).
     pub hamiltonian: bool,
     pub quadrature: TokenStream,
+    /// The composition `quadrature = explicit(...)` names (`impl ExplicitSystem`).
+    pub explicit: Option<TokenStream>,
     pub parameters: Vec<Parameter>,
     /// Constraint one-forms, each a list of terms.
     pub one_forms: Vec<Vec<Term>>,

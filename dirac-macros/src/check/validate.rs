@@ -10,7 +10,7 @@ use syn::spanned::Spanned;
 use syn::{Expr, Fields, GenericParam, Ident, Meta, Token, Type};
 
 use crate::check::model::Model;
-use crate::internals::ast::{Arguments, Coordinate, Lagrangian, Length, Parameter, Shape};
+use crate::internals::ast::{Arguments, Coordinate, Lagrangian, Length, Parameter, Shape, Term};
 use crate::internals::errors::Errors;
 use crate::lower::expression::{
     Context, Hoisted, Rewriter, Scope, bounds, is_reserved, reserved_message,
@@ -252,8 +252,20 @@ fn composite(
     for span in spans.into_iter().flatten() {
         errors.push(span, OWN);
     }
+    if let Some(expr) = e
+        .quadrature
+        .as_ref()
+        .filter(|e| quadrature::explicit(e).is_some())
+    {
+        errors.push(
+            expr.span(),
+            "explicit steps are not offered for a model made of subsystems (its junctions are \
+             constraints): name a quadrature",
+        );
+    }
     let quadrature = e
         .quadrature
+        .filter(|expr| quadrature::explicit(expr).is_none())
         .and_then(|expr| match quadrature::parse(&expr) {
             Ok(tokens) => Some(tokens),
             Err(err) => {
@@ -395,16 +407,34 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         }
         (Some(_), None) => None,
     };
+    // `explicit(...)`: the composition, and where it was named; `Stepper::from_system` is then
+    // refused with the constructor to call.
+    let mut explicit = None;
     let quadrature = match e.quadrature {
         None => Some(quote!(::core::result::Result::Ok(
             __dirac::Quadrature::midpoint()
         ))),
-        Some(expr) => match quadrature::parse(&expr) {
-            Ok(tokens) => Some(tokens),
-            Err(err) => {
+        Some(expr) => match quadrature::explicit(&expr) {
+            Some(Ok(composition)) => {
+                explicit = Some((composition, expr.span()));
+                Some(quote!(::core::result::Result::Err(
+                    __dirac::DiracError::InvalidQuadrature(::std::string::String::from(
+                        "the model names an explicit step (quadrature = explicit(...)): step it \
+                         with Stepper::explicit_from_system(model, h)"
+                    ))
+                )))
+            }
+            Some(Err(err)) => {
                 errors.add(err);
                 None
             }
+            None => match quadrature::parse(&expr) {
+                Ok(tokens) => Some(tokens),
+                Err(err) => {
+                    errors.add(err);
+                    None
+                }
+            },
         },
     };
     let constraint_point = e.constraint_at.and_then(|expr| match &expr {
@@ -491,7 +521,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                     .map(|form| names_no_coordinate(form, coordinates))
                     .collect(),
             };
-            let one_forms = e
+            let one_forms: Vec<Vec<Term>> = e
                 .constraints
                 .unwrap_or_default()
                 .iter()
@@ -544,6 +574,31 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         }
         None => Default::default(),
     };
+    if let (Some((_, span)), Some(coordinates)) = (&explicit, &coordinates) {
+        let refusal = if hamiltonian {
+            Some("explicit steps take a Lagrangian: name a quadrature for a Hamiltonian")
+        } else if is_product(coordinates) {
+            Some("explicit steps are not offered on rotations and unit vectors: name a quadrature")
+        } else if !one_forms.is_empty() || !holonomic.is_empty() {
+            Some("explicit steps are not offered with constraints: name a quadrature")
+        } else if !forces_free_of_velocity {
+            Some(
+                "explicit steps need forces of the positions, time and inputs alone: a force \
+                 reading dot(x) makes the step implicit; name a quadrature",
+            )
+        } else if !closed_form.as_ref().is_some_and(|c| c.separable) {
+            Some(
+                "explicit steps need a separable Lagrangian ½ vᵀ M v + bᵀ v − V(q) with constant \
+                 M and b; this one's ∂²L/∂v² or ∂²L/∂q∂v is not constant (or its derivatives \
+                 could not be derived): name a quadrature",
+            )
+        } else {
+            None
+        };
+        if let Some(refusal) = refusal {
+            errors.push(*span, refusal);
+        }
+    }
     match (coordinates, lagrangian, quadrature) {
         (Some(coordinates), Some(lagrangian), Some(quadrature)) if errors.is_empty() => {
             Outcome::Valid(Box::new(Model {
@@ -552,6 +607,7 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 lagrangian,
                 hamiltonian,
                 quadrature,
+                explicit: explicit.map(|(composition, _)| composition),
                 parameters,
                 one_forms,
                 constant_one_forms,

@@ -211,6 +211,17 @@ fn expand(model: &Model) -> TokenStream {
     let quadrature = &model.quadrature;
     let (point, tangent) = (&space.point, &space.tangent);
     let component = component(model, &n);
+    let explicit = model.explicit.as_ref().map(|composition| {
+        let name = &item.ident;
+        quote! {
+            #[automatically_derived]
+            impl __dirac::ExplicitSystem<#n> for #name {
+                fn composition(&self) -> __dirac::Composition {
+                    #composition
+                }
+            }
+        }
+    });
     let implementation = quote! {
         #parts
 
@@ -247,6 +258,7 @@ fn expand(model: &Model) -> TokenStream {
         }
 
         #component
+        #explicit
     };
     let implementation = in_scope(&model.krate, implementation);
     let index_checks = &model.index_checks;

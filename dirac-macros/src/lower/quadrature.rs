@@ -1,5 +1,6 @@
 //! `quadrature = midpoint | trapezoid | galerkin(s) | galerkin(s, gauss_legendre(r)) |
-//! galerkin(s, gauss_lobatto(r))`, checked at compile time with the runtime's rules.
+//! galerkin(s, gauss_lobatto(r))`, checked at compile time with the runtime's rules; and
+//! `quadrature = explicit(name | order)`, the explicit step of a separable Lagrangian.
 
 use proc_macro2::TokenStream;
 use quote::{quote, quote_spanned};
@@ -11,7 +12,7 @@ const MAX_DEGREE: usize = 8;
 const MAX_NODES: usize = 16;
 
 const EXPECTED: &str = "expected `midpoint`, `trapezoid`, `galerkin(s)`, \
-     `galerkin(s, gauss_legendre(r))` or `galerkin(s, gauss_lobatto(r))`";
+     `galerkin(s, gauss_legendre(r))`, `galerkin(s, gauss_lobatto(r))` or `explicit(8)`";
 
 /// The tokens building the runtime `Quadrature` named by `expr`.
 pub fn parse(expr: &Expr) -> syn::Result<TokenStream> {
@@ -29,6 +30,61 @@ pub fn parse(expr: &Expr) -> syn::Result<TokenStream> {
             format!("unknown quadrature; {EXPECTED}"),
         )),
     }
+}
+
+/// The compositions `explicit(...)` may name, with the runtime's constructor of each.
+const COMPOSITIONS: &[&str] = &[
+    "verlet",
+    "triple_jump",
+    "suzuki",
+    "kahan_li_6",
+    "mclachlan_8",
+    "kahan_li_8",
+    "sofroniou_spaletta_10",
+];
+
+/// For `explicit(name)` or `explicit(order)`: the tokens building the runtime `Composition`
+/// (`None` for any other expression).
+pub fn explicit(expr: &Expr) -> Option<syn::Result<TokenStream>> {
+    let Expr::Call(call) = expr else {
+        return None;
+    };
+    if callee(call).as_deref() != Some("explicit") {
+        return None;
+    }
+    let expected = format!(
+        "explicit takes a composition, one of `{}`, or its order: 2, 4, 6, 8 or 10",
+        COMPOSITIONS.join("`, `")
+    );
+    let args: Vec<&Expr> = call.args.iter().collect();
+    let [arg] = args[..] else {
+        return Some(Err(syn::Error::new(call.span(), expected)));
+    };
+    let name = match arg {
+        Expr::Path(p) => p
+            .path
+            .get_ident()
+            .map(|i| i.to_string())
+            .filter(|n| COMPOSITIONS.contains(&n.as_str())),
+        Expr::Lit(ExprLit {
+            lit: Lit::Int(lit), ..
+        }) => match lit.base10_parse::<usize>() {
+            Ok(2) => Some("verlet".to_string()),
+            Ok(4) => Some("suzuki".to_string()),
+            Ok(6) => Some("kahan_li_6".to_string()),
+            Ok(8) => Some("kahan_li_8".to_string()),
+            Ok(10) => Some("sofroniou_spaletta_10".to_string()),
+            _ => None,
+        },
+        _ => None,
+    };
+    Some(match name {
+        Some(name) => {
+            let constructor = syn::Ident::new(&name, arg.span());
+            Ok(quote_spanned!(arg.span()=> __dirac::Composition::#constructor()))
+        }
+        None => Err(syn::Error::new(arg.span(), expected)),
+    })
 }
 
 /// The name of a call's function when it is a bare identifier.

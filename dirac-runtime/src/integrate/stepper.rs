@@ -38,7 +38,7 @@ use crate::step::group_euler_lagrange::GroupEulerLagrange;
 use crate::step::hamilton::Hamilton;
 use crate::step::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step::step_equations::{Point, State, StepEquations, StepWork, Tangent};
-use crate::step::verlet::Verlet;
+use crate::step::verlet::{ExplicitSystem, Verlet};
 
 /// The relative consistency an initial state must have with the model's constraints, at the
 /// default solver tolerance.
@@ -147,7 +147,9 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N> {
         Self::on_space(system, Euclidean, quadrature, h)
     }
 
-    /// A stepper with the system's own quadrature (the one named in `#[dirac_system]`).
+    /// A stepper with the system's own quadrature (the one named in `#[dirac_system]`). A model
+    /// whose attribute names an explicit step (`quadrature = explicit(...)`) is refused with
+    /// `InvalidQuadrature`, naming [`explicit_from_system`](Stepper::explicit_from_system).
     ///
     /// ```
     /// # use dirac_runtime::{DiracError, DiracSystem, Quadrature, Scalar, Stepper};
@@ -235,6 +237,40 @@ impl<S: DiracSystem<N>, const N: usize> Stepper<S, N, Verlet<S, N>> {
     /// ```
     pub fn explicit(system: S, composition: Composition, h: f64) -> Result<Self, DiracError> {
         Self::with_equations(Verlet::new(system, composition, h)?)
+    }
+
+    /// The explicit stepper of the composition the model's attribute names
+    /// (`quadrature = explicit(...)`, [`ExplicitSystem`]), with step `h`; refused as
+    /// [`explicit`](Self::explicit) is. [`Stepper::from_system`] refuses such a model, naming
+    /// this constructor.
+    ///
+    /// ```
+    /// use dirac_runtime::{Composition, DiracSystem, ExplicitSystem, Scalar, Stepper};
+    /// use nalgebra::{SVector, vector};
+    /// struct Oscillator;
+    /// impl DiracSystem<1> for Oscillator {
+    ///     const SEPARABLE: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (v[0] * v[0] - q[0] * q[0]) * 0.5
+    ///     }
+    /// }
+    /// impl ExplicitSystem<1> for Oscillator {
+    ///     fn composition(&self) -> Composition {
+    ///         Composition::kahan_li_8()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::explicit_from_system(Oscillator, 0.1)?;
+    /// stepper.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// stepper.run(10)?;
+    /// assert!((stepper.q()[0] - 1f64.cos()).abs() < 1e-11);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn explicit_from_system(system: S, h: f64) -> Result<Self, DiracError>
+    where
+        S: ExplicitSystem<N>,
+    {
+        let composition = system.composition();
+        Self::explicit(system, composition, h)
     }
 
     /// The composition the stepper takes.

@@ -505,19 +505,7 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
             if at.t == t_end {
                 return Ok(());
             }
-            let next = self.advance(&motion, &at, self.ds)?;
-            // A composition with negative coefficients could, at a large step, turn time back
-            // over a whole step: that run would never end.
-            if (next.t - at.t) - (next.t_carry - at.t_carry) <= 0.0 {
-                return Err(DiracError::OutsideDomain {
-                    step: at.steps,
-                    why: format!(
-                        "time did not advance over the step (from t = {}): the fictive step is \
-                         too large for this composition",
-                        at.t
-                    ),
-                });
-            }
+            let next = self.whole_step(&motion, &at)?;
             if next.t >= t_end {
                 let landed = self.land(&motion, &at, next, t_end)?;
                 self.set(landed);
@@ -526,6 +514,102 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
             self.set(next);
             each(self)?;
         }
+    }
+
+    /// The whole step from `at`, refused where it does not advance time (a composition with
+    /// negative coefficients could turn time back over a large step: a run would never end).
+    fn whole_step(&self, motion: &Motion<N>, at: &Phase<N>) -> Result<Phase<N>, DiracError> {
+        let next = self.advance(motion, at, self.ds)?;
+        if (next.t - at.t) - (next.t_carry - at.t_carry) <= 0.0 {
+            return Err(DiracError::OutsideDomain {
+                step: at.steps,
+                why: format!(
+                    "time did not advance over the step (from t = {}): the fictive step is too \
+                     large for this composition",
+                    at.t
+                ),
+            });
+        }
+        Ok(next)
+    }
+
+    /// Runs to the last of `times` (increasing, none before the current time), landing on it as
+    /// [`run_until`](Self::run_until) does, and records the state at each of `times`. A time
+    /// inside a step is reached by a step of the fictive size that lands on it from the step's
+    /// start, taken aside: the run goes on from the whole step, so what is saved does not change
+    /// the run. `InvalidRun` for times that are not finite, not increasing or before now; on a
+    /// failed step the state is the last step's before it.
+    ///
+    /// ```
+    /// use dirac_runtime::{Composition, DiracSystem, Scalar, TimeTransformed};
+    /// use nalgebra::{SVector, vector};
+    ///
+    /// struct Kepler;
+    /// impl DiracSystem<2> for Kepler {
+    ///     const SEPARABLE: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1]) * 0.5 + (q[0] * q[0] + q[1] * q[1]).sqrt().recip()
+    ///     }
+    /// }
+    /// let mut comet = TimeTransformed::new(Kepler, Composition::kahan_li_8(), 0.2)?;
+    /// comet.start_from_velocity(vector![0.1, 0.0], vector![0.0, 19f64.sqrt()])?;
+    /// let times: Vec<f64> = (0..=10).map(|i| i as f64).collect();
+    /// let saved = comet.trajectory_at(&times)?;
+    /// assert_eq!(saved.t(), &times[..]);
+    /// assert_eq!(comet.t(), 10.0);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn trajectory_at(&mut self, times: &[f64]) -> Result<Trajectory<N>, DiracError> {
+        let motion = *self.motion()?;
+        let names = (0..N).map(|i| self.system.coordinate_name(i)).collect();
+        let mut trajectory = Trajectory::new(names)?;
+        if let Some(t) = times.iter().find(|t| !t.is_finite()) {
+            return Err(DiracError::InvalidRun(format!(
+                "a save time {t} is not finite"
+            )));
+        }
+        if let Some(pair) = times.windows(2).find(|w| w[1] <= w[0]) {
+            return Err(DiracError::InvalidRun(format!(
+                "save times must increase, got {} then {}",
+                pair[0], pair[1]
+            )));
+        }
+        let Some(&last) = times.last() else {
+            return Ok(trajectory);
+        };
+        if times[0] < motion.at.t {
+            return Err(DiracError::InvalidRun(format!(
+                "the save time {} is before the current time {}",
+                times[0], motion.at.t
+            )));
+        }
+        let mut record = |this: &Self, phase: &Phase<N>| {
+            let sample = Sample {
+                t: phase.t,
+                q: phase.q,
+                v: motion.kinetic.velocity(&phase.p),
+                p: phase.p,
+            };
+            trajectory.push(&sample, this.energy_at(&motion.kinetic, phase))
+        };
+        let mut pending = times.iter().copied().peekable();
+        while pending.next_if(|&t| t == motion.at.t).is_some() {
+            record(self, &motion.at)?;
+        }
+        while pending.peek().is_some() {
+            let at = self.motion()?.at;
+            let next = self.whole_step(&motion, &at)?;
+            while let Some(t) = pending.next_if(|&t| t <= next.t) {
+                let landed = self.land(&motion, &at, next, t)?;
+                record(self, &landed)?;
+                if t == last {
+                    self.set(landed);
+                    return Ok(trajectory);
+                }
+            }
+            self.set(next);
+        }
+        Ok(trajectory)
     }
 
     /// The step from `at` of the fictive size that ends at `t_end`, given the whole step

@@ -44,6 +44,41 @@ use crate::step::dense_output::Sample;
 use crate::step::euler_lagrange::check_finite;
 use crate::step::step_equations::{StepEquations, StepWork};
 
+/// A model whose attribute names its explicit step, `quadrature = explicit(kahan_li_8)` or
+/// `explicit(8)` in `#[dirac_system]` (the attribute refuses it, at compile time, for a
+/// Lagrangian that is not separable, for constraints and for forces that read a velocity):
+/// [`Stepper::explicit_from_system`](crate::Stepper::explicit_from_system) takes that step.
+///
+/// ```
+/// use dirac_runtime::{Composition, DiracSystem, ExplicitSystem, Scalar, Stepper};
+/// use nalgebra::{SVector, vector};
+/// struct Pendulum;
+/// impl DiracSystem<1> for Pendulum {
+///     const SEPARABLE: bool = true;
+///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+///         v[0] * v[0] * 0.5 + q[0].cos()
+///     }
+/// }
+/// impl ExplicitSystem<1> for Pendulum {
+///     fn composition(&self) -> Composition {
+///         Composition::suzuki()
+///     }
+/// }
+/// let stepper = Stepper::explicit_from_system(Pendulum, 0.1)?;
+/// assert_eq!(stepper.composition().order(), 4);
+/// # Ok::<(), dirac_runtime::DiracError>(())
+/// ```
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` names no explicit step",
+    label = "the attribute names no explicit step for this model",
+    note = "name one in the attribute, `quadrature = explicit(kahan_li_8)` or `explicit(8)`, or \
+            pass one: `Stepper::explicit(model, Composition::kahan_li_8(), h)`"
+)]
+pub trait ExplicitSystem<const N: usize>: DiracSystem<N> {
+    /// The composition the attribute names.
+    fn composition(&self) -> Composition;
+}
+
 /// Relative size of a disagreement between the two probes of the kinetic energy that refuses a
 /// model's claim to be separable.
 const PROBE_TOLERANCE: f64 = 1e-8;

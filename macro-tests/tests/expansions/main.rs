@@ -4,6 +4,7 @@
 mod arrays_and_constants;
 mod atoms_of_like_names;
 mod dirac_features;
+mod explicit_step;
 mod generic_chain;
 mod hamiltonian_models;
 mod hamiltonian_with_holonomic;
