@@ -46,7 +46,7 @@ use crate::model::system::DiracSystem;
 use crate::step::composition::Composition;
 use crate::step::dense_output::Sample;
 use crate::step::euler_lagrange::check_finite;
-use crate::step::verlet::Kinetic;
+use crate::step::verlet::{Kinetic, not_explicit};
 
 /// Iterations of the Illinois method that lands a run on its end time: it gains about a digit
 /// and a half per iteration, and stops where the bracket is a few ulps wide.
@@ -141,27 +141,12 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
         if !(ds.is_finite() && ds > 0.0) {
             return Err(DiracError::InvalidStep { h: ds });
         }
-        let refuse = |why: &str| {
-            Err(DiracError::Unsupported(format!(
-                "the time-transformed step ({}) of a model {why}",
+        if let Some(why) = not_explicit::<S, N>(S::FORCES) {
+            return Err(DiracError::Unsupported(format!(
+                "the time-transformed step ({}) of a model {why}; Stepper::new steps it at a \
+                 fixed step",
                 composition.name()
-            )))
-        };
-        if !S::SEPARABLE {
-            return refuse(
-                "not known to be separable: it needs L = ½ vᵀ M v + bᵀ v − V(q) with constant \
-                 M and b (DiracSystem::SEPARABLE, which #[dirac_system] derives from the \
-                 Lagrangian); Stepper::new steps it at a fixed step",
-            );
-        }
-        if S::ONE_FORMS + S::HOLONOMIC > 0 {
-            return refuse("with constraints; Stepper::new steps it at a fixed step");
-        }
-        if S::FORCES {
-            return refuse(
-                "with forces or inputs (the extended Hamiltonian holds neither); \
-                 Stepper::explicit steps it at a fixed step",
-            );
+            )));
         }
         for (name, value) in system.parameters() {
             if !value.is_finite() {

@@ -79,6 +79,29 @@ pub trait ExplicitSystem<const N: usize>: DiracSystem<N> {
     fn composition(&self) -> Composition;
 }
 
+/// Why `S` has no explicit step, where it has none: not declared separable, constraints, or
+/// `forces` it cannot take (those of velocity for the fixed step, any for the time-transformed
+/// one).
+pub(crate) fn not_explicit<S: DiracSystem<N>, const N: usize>(
+    forces: bool,
+) -> Option<&'static str> {
+    if !S::SEPARABLE {
+        Some(
+            "not known to be separable: it needs L = ½ vᵀ M v + bᵀ v − V(q) with constant M and b \
+             (DiracSystem::SEPARABLE, which #[dirac_system] derives from the Lagrangian)",
+        )
+    } else if S::ONE_FORMS + S::HOLONOMIC > 0 {
+        Some("with constraints")
+    } else if forces {
+        Some(
+            "with forces it cannot hold (a force reading dot(x) makes a step implicit; the \
+             time-transformed step takes no forces or inputs at all)",
+        )
+    } else {
+        None
+    }
+}
+
 /// Relative size of a disagreement between the two probes of the kinetic energy that refuses a
 /// model's claim to be separable.
 const PROBE_TOLERANCE: f64 = 1e-8;
@@ -261,27 +284,11 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
     pub fn new(system: S, composition: Composition, h: f64) -> Result<Self, DiracError> {
         let discrete = DiscreteLagrangian::new(system, Quadrature::trapezoid(), h);
         discrete.check()?;
-        let refuse = |why: &str| {
-            Err(DiracError::Unsupported(format!(
+        if let Some(why) = not_explicit::<S, N>(S::FORCES && !S::FORCES_FREE_OF_VELOCITY) {
+            return Err(DiracError::Unsupported(format!(
                 "the explicit step ({}) of a model {why}; Stepper::new steps it with a quadrature",
                 composition.name()
-            )))
-        };
-        if !S::SEPARABLE {
-            return refuse(
-                "not known to be separable: it needs L = ½ vᵀ M v + bᵀ v − V(q) with constant \
-                 M and b (DiracSystem::SEPARABLE, which #[dirac_system] derives from the \
-                 Lagrangian)",
-            );
-        }
-        if S::ONE_FORMS + S::HOLONOMIC > 0 {
-            return refuse("with constraints");
-        }
-        if S::FORCES && !S::FORCES_FREE_OF_VELOCITY {
-            return refuse(
-                "with forces that may depend on the velocity (DiracSystem::FORCES_FREE_OF_VELOCITY \
-                 is not declared: a force reading dot(x) makes the step implicit)",
-            );
+            )));
         }
         Ok(Self {
             discrete,
