@@ -32,7 +32,7 @@ pub mod study;
 
 pub use base::{error, scalar};
 pub use discrete::{constraint, discrete_lagrangian};
-pub use integrate::{event, run, stepper, time_transformation, trajectory};
+pub use integrate::{event, run, snapshots, stepper, time_transformation, trajectory};
 pub use model::{
     closed_form, hamiltonian_system, interconnection, legendre, repeated, slot, system,
 };

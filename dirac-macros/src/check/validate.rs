@@ -420,7 +420,8 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
                 Some(quote!(::core::result::Result::Err(
                     __dirac::DiracError::InvalidQuadrature(::std::string::String::from(
                         "the model names an explicit step (quadrature = explicit(...)): step it \
-                         with Stepper::explicit_from_system(model, h)"
+                         with Stepper::explicit_from_system(model, h), or pass a quadrature to \
+                         Stepper::new (a model made of it names its own with quadrature = ...)"
                     ))
                 )))
             }

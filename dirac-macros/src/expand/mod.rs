@@ -213,9 +213,10 @@ fn expand(model: &Model) -> TokenStream {
     let component = component(model, &n);
     let explicit = model.explicit.as_ref().map(|composition| {
         let name = &item.ident;
+        let (impl_generics, ty_generics, where_clause) = item.generics.split_for_impl();
         quote! {
             #[automatically_derived]
-            impl __dirac::ExplicitSystem<#n> for #name {
+            impl #impl_generics __dirac::ExplicitSystem<#n> for #name #ty_generics #where_clause {
                 fn composition(&self) -> __dirac::Composition {
                     #composition
                 }

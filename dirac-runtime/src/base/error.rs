@@ -131,7 +131,7 @@ pub enum DiracError {
     /// (the message names the junctions or instances involved and why).
     #[error("invalid interconnection: {0}")]
     InvalidInterconnection(String),
-    /// Writing a trajectory failed.
-    #[error("could not write the trajectory: {0}")]
+    /// Writing a trajectory or snapshots failed, or a snapshot file could not be read.
+    #[error("input or output failed: {0}")]
     Io(String),
 }

@@ -1,5 +1,6 @@
 //! Many steps in time: the [`Stepper`](crate::Stepper), runs over a time span with saved times,
-//! events and observers, the trajectories they record, and the time-transformed runs of a
+//! events and observers, the trajectories they record, a field's snapshots in a compact binary
+//! file, and the time-transformed runs of a
 //! separable model ([`TimeTransformed`](crate::TimeTransformed): adaptive steps from a fixed
 //! step of a fictive time).
 //!
@@ -7,6 +8,7 @@
 
 pub mod event;
 pub mod run;
+pub mod snapshots;
 pub mod stepper;
 pub mod time_transformation;
 pub mod trajectory;

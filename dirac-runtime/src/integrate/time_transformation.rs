@@ -141,10 +141,13 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
         if !(ds.is_finite() && ds > 0.0) {
             return Err(DiracError::InvalidStep { h: ds });
         }
-        if let Some(why) = not_explicit::<S, N>(S::FORCES) {
+        let forces = S::FORCES.then_some(
+            "with forces or inputs (the extended Hamiltonian holds neither; Stepper::explicit \
+             takes forces of the position, time and inputs at a fixed step)",
+        );
+        if let Some(why) = not_explicit::<S, N>(forces) {
             return Err(DiracError::Unsupported(format!(
-                "the time-transformed step ({}) of a model {why}; Stepper::new steps it at a \
-                 fixed step",
+                "the time-transformed step ({}) of a model {why}",
                 composition.name()
             )));
         }
@@ -522,8 +525,9 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
     /// [`run_until`](Self::run_until) does, and records the state at each of `times`. A time
     /// inside a step is reached by a step of the fictive size that lands on it from the step's
     /// start, taken aside: the run goes on from the whole step, so what is saved does not change
-    /// the run. `InvalidRun` for times that are not finite, not increasing or before now; on a
-    /// failed step the state is the last step's before it.
+    /// the run; a time equal to the current one is saved without a step. `InvalidRun` for times
+    /// that are not finite, not increasing or before now; on a failed step the state is the
+    /// last step's before it and the states saved are dropped with the error.
     ///
     /// ```
     /// use dirac_runtime::{Composition, DiracSystem, Scalar, TimeTransformed};

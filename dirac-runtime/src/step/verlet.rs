@@ -80,10 +80,10 @@ pub trait ExplicitSystem<const N: usize>: DiracSystem<N> {
 }
 
 /// Why `S` has no explicit step, where it has none: not declared separable, constraints, or
-/// `forces` it cannot take (those of velocity for the fixed step, any for the time-transformed
-/// one).
+/// the caller's `forces` refusal (those of velocity for the fixed step, any for the
+/// time-transformed one).
 pub(crate) fn not_explicit<S: DiracSystem<N>, const N: usize>(
-    forces: bool,
+    forces: Option<&'static str>,
 ) -> Option<&'static str> {
     if !S::SEPARABLE {
         Some(
@@ -92,13 +92,8 @@ pub(crate) fn not_explicit<S: DiracSystem<N>, const N: usize>(
         )
     } else if S::ONE_FORMS + S::HOLONOMIC > 0 {
         Some("with constraints")
-    } else if forces {
-        Some(
-            "with forces it cannot hold (a force reading dot(x) makes a step implicit; the \
-             time-transformed step takes no forces or inputs at all)",
-        )
     } else {
-        None
+        forces
     }
 }
 
@@ -284,7 +279,11 @@ impl<S: DiracSystem<N>, const N: usize> Verlet<S, N> {
     pub fn new(system: S, composition: Composition, h: f64) -> Result<Self, DiracError> {
         let discrete = DiscreteLagrangian::new(system, Quadrature::trapezoid(), h);
         discrete.check()?;
-        if let Some(why) = not_explicit::<S, N>(S::FORCES && !S::FORCES_FREE_OF_VELOCITY) {
+        let forces = (S::FORCES && !S::FORCES_FREE_OF_VELOCITY).then_some(
+            "with forces that may depend on the velocity (DiracSystem::FORCES_FREE_OF_VELOCITY \
+             is not declared: a force reading dot(x) makes the step implicit)",
+        );
+        if let Some(why) = not_explicit::<S, N>(forces) {
             return Err(DiracError::Unsupported(format!(
                 "the explicit step ({}) of a model {why}; Stepper::new steps it with a quadrature",
                 composition.name()
