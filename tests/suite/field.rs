@@ -528,7 +528,8 @@ fn the_multisymplectic_law_holds_cell_by_cell() {
     }
     println!("multisymplectic law: largest defect {worst:.2e} against terms of {scale:.2e}");
     assert!(
-        scale > 1.0 && worst < 1e-13 * scale,
+        // Measured 3.4e-13 against 6.2e2.
+        scale > 1.0 && worst < 1e-14 * scale,
         "{worst:e} of {scale:e}"
     );
 }
