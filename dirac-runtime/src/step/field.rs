@@ -201,6 +201,59 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
         self
     }
 
+    /// Point masses `left` and `right` (each component's inertia) joined to the free ends: a
+    /// rigid body at each end of a string or bar, added to the end nodes' half cells. The ends'
+    /// condition becomes `M u_tt = ±∂U/∂u_x` (measured order 2 against the modes of a string
+    /// with end masses, `tests/suite/field.rs`). `Unsupported` unless the ends are
+    /// [`Boundary::Free`]; `NonFinite` for a mass that is negative or not finite. Ends a run.
+    ///
+    /// ```
+    /// use dirac_runtime::{Boundary, Field, Scalar, SeparableDensity};
+    /// use nalgebra::SVector;
+    ///
+    /// /// A string: `ℒ = ½ u_t² − ½ u_x²`.
+    /// struct String;
+    /// impl SeparableDensity<1> for String {
+    ///     fn inertia(&self, _x: f64) -> SVector<f64, 1> {
+    ///         SVector::from([1.0])
+    ///     }
+    ///     fn potential<S: Scalar>(&self, _x: f64, _u: &SVector<S, 1>, ux: &SVector<S, 1>) -> S {
+    ///         ux[0] * ux[0] * 0.5
+    ///     }
+    /// }
+    /// let mut beads = Field::new(String, (0.0, 1.0), 100, Boundary::Free, 0.005)?
+    ///     .with_end_masses(2.0, 0.0)?;
+    /// // A uniform motion: the whole string and its bead, mass 1 + 2.
+    /// beads.start(&vec![SVector::zeros(); 101], &vec![SVector::from([1.0]); 101])?;
+    /// assert!((beads.energy()? - 1.5).abs() < 1e-12);
+    /// assert!(Field::new(String, (0.0, 1.0), 100, Boundary::Fixed, 0.005)?.with_end_masses(1.0, 1.0).is_err());
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn with_end_masses(mut self, left: f64, right: f64) -> Result<Self, DiracError> {
+        if self.boundary != Boundary::Free {
+            return Err(DiracError::Unsupported(format!(
+                "masses at the ends of a field with {:?} ends: they join free ends",
+                self.boundary
+            )));
+        }
+        if let Some(bad) = [left, right]
+            .into_iter()
+            .find(|m| !(*m >= 0.0 && m.is_finite()))
+        {
+            return Err(DiracError::NonFinite {
+                what: "a mass at an end (it must be finite and not negative)".into(),
+                value: bad,
+            });
+        }
+        // From the cells' masses: a second call replaces the first's end masses.
+        self.mass = self.masses()?;
+        let last = self.mass.len() - 1;
+        self.mass[0].add_scalar_mut(left);
+        self.mass[last].add_scalar_mut(right);
+        self.run = None;
+        Ok(self)
+    }
+
     /// Whether this field's passes are split across threads.
     fn in_parallel(&self) -> bool {
         self.parallel && self.nodes() >= PARALLEL_BLOCKS * GRAIN
