@@ -22,6 +22,24 @@ fn at(x: &[f64], f: impl Fn(f64) -> f64) -> Vec<SVector<f64, 1>> {
     x.iter().map(|&x| SVector::from([f(x)])).collect()
 }
 
+/// `string` started from `shape` at rest and run `steps` steps, with its largest distance from
+/// the standing wave `shape(x) cos(ωt)`.
+fn standing_wave<D: SeparableDensity<1>>(
+    mut string: Field<D, 1>,
+    shape: impl Fn(f64) -> f64,
+    omega: f64,
+    steps: u64,
+) -> (Field<D, 1>, f64) {
+    let x = string.positions();
+    string
+        .start(&at(&x, &shape), &vec![SVector::zeros(); x.len()])
+        .unwrap();
+    string.run(steps).unwrap();
+    let t = string.t();
+    let off = error(&string, |x| SVector::from([shape(x) * (omega * t).cos()]));
+    (string, off)
+}
+
 /// The largest `|u_j − exact(x_j)|`.
 fn error<const C: usize>(
     field: &Field<impl SeparableDensity<C>, C>,
@@ -418,18 +436,11 @@ fn fixed_and_free_ends_converge_at_order_two() {
         for cells in [20, 40, 80] {
             let dx = 1.0 / cells as f64;
             let steps = (t / (0.5 * dx)).round() as u64;
-            let mut string =
-                Field::new(WAVE, (0.0, 1.0), cells, boundary, t / steps as f64).unwrap();
-            let x = string.positions();
-            string
-                .start(&at(&x, shape), &vec![SVector::zeros(); x.len()])
-                .unwrap();
-            string.run(steps).unwrap();
-            errors.push(error(&string, |x| {
-                SVector::from([shape(x) * (PI * t).cos()])
-            }));
+            let string = Field::new(WAVE, (0.0, 1.0), cells, boundary, t / steps as f64).unwrap();
+            let (string, off) = standing_wave(string, shape, PI, steps);
+            errors.push(off);
             hs.push(dx);
-            let u = string.u().unwrap();
+            let (u, x) = (string.u().unwrap(), string.positions());
             if boundary == Boundary::Fixed {
                 assert_eq!((u[0][0], u[cells][0]), (shape(x[0]), shape(x[cells])));
             }
@@ -490,28 +501,17 @@ fn a_string_with_masses_at_its_ends_keeps_its_mode() {
     for cells in [50, 100, 200] {
         let dx = 1.0 / cells as f64;
         let steps = (t / (0.5 * dx)).round() as u64;
-        let mut string = Field::new(WAVE, (0.0, 1.0), cells, Boundary::Free, t / steps as f64)
+        let string = Field::new(WAVE, (0.0, 1.0), cells, Boundary::Free, t / steps as f64)
             .unwrap()
             .with_end_masses(m, m)
             .unwrap();
-        let x = string.positions();
-        string
-            .start(&at(&x, shape), &vec![SVector::zeros(); x.len()])
-            .unwrap();
-        string.run(steps).unwrap();
-        errors.push(error(&string, |x| {
-            SVector::from([shape(x) * (k * t).cos()])
-        }));
+        errors.push(standing_wave(string, shape, k, steps).1);
         hs.push(dx);
     }
     assert_order("string with end masses", &hs, &errors, 2.0);
     // Without the masses the same shape is no mode: the run leaves it by far more.
-    let mut bare = Field::new(WAVE, (0.0, 1.0), 200, Boundary::Free, 0.0025).unwrap();
-    let x = bare.positions();
-    bare.start(&at(&x, shape), &vec![SVector::zeros(); x.len()])
-        .unwrap();
-    bare.run(1200).unwrap();
-    let off = error(&bare, |x| SVector::from([shape(x) * (k * t).cos()]));
+    let bare = Field::new(WAVE, (0.0, 1.0), 200, Boundary::Free, 0.0025).unwrap();
+    let off = standing_wave(bare, shape, k, 1200).1;
     assert!(off > 1e3 * errors[2], "{off} {errors:?}");
     for boundary in [Boundary::Fixed, Boundary::Periodic] {
         let refused = Field::new(WAVE, (0.0, 1.0), 10, boundary, 0.01)
