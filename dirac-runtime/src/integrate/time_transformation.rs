@@ -283,9 +283,7 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
 
     /// `c − V(q) > 0`, or the error that says it is not.
     fn check_potential(&self, q: &SVector<f64, N>, offset: f64) -> Result<(), DiracError> {
-        let (minus_v, _) =
-            derivatives::value_and_position_gradient(&self.system, q, &SVector::zeros());
-        let u = offset + minus_v;
+        let u = offset + self.system.lagrangian(q, &SVector::zeros());
         match u > 0.0 {
             true => Ok(()),
             false => Err(DiracError::Unsupported(format!(
@@ -299,9 +297,7 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
     /// `T(p) + V(q)`.
     fn energy_at(&self, kinetic: &Kinetic<N>, at: &Phase<N>) -> f64 {
         let (_, kinetic_energy) = kinetic.velocity_and_energy(&at.p);
-        let (minus_v, _) =
-            derivatives::value_and_position_gradient(&self.system, &at.q, &SVector::zeros());
-        kinetic_energy - minus_v
+        kinetic_energy - self.system.lagrangian(&at.q, &SVector::zeros())
     }
 
     /// The step of fictive size `ds` from `from`: drifts and kicks of the composition.
@@ -432,7 +428,7 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
     /// fictive size that lands on it (`t` is then `t_end`). `InvalidRun` for an end before the
     /// current time; on a failed step the state is the last step's before it.
     pub fn run_until(&mut self, t_end: f64) -> Result<(), DiracError> {
-        self.until(t_end, |_| Ok(()))
+        self.drive(&[t_end], |_, _, _| Ok(()))
     }
 
     /// [`run_until`](Self::run_until), recording the start and every step's end.
@@ -459,49 +455,87 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn trajectory_until(&mut self, t_end: f64) -> Result<Trajectory<N>, DiracError> {
-        let names = (0..N).map(|i| self.system.coordinate_name(i)).collect();
-        let mut trajectory = Trajectory::new(names)?;
-        let record = |this: &Self, trajectory: &mut Trajectory<N>| match this.sample() {
-            Some(sample) => trajectory.push(&sample, this.energy()?),
-            None => Err(DiracError::NotStarted),
-        };
-        record(self, &mut trajectory)?;
-        self.until(t_end, |this| record(this, &mut trajectory))?;
+        let start = self.motion()?.at;
+        let mut trajectory = self.trajectory()?;
+        self.record(&mut trajectory, &start)?;
+        // Every step's end; an end at the start time is the start, recorded already.
+        self.drive(&[t_end], |this, phase, _| match phase.steps > start.steps {
+            true => this.record(&mut trajectory, phase),
+            false => Ok(()),
+        })?;
         Ok(trajectory)
     }
 
-    /// Steps to `t_end` (see [`run_until`](Self::run_until)), calling `each` after every step.
-    fn until(
+    /// An empty trajectory with the model's coordinate names.
+    fn trajectory(&self) -> Result<Trajectory<N>, DiracError> {
+        Trajectory::new((0..N).map(|i| self.system.coordinate_name(i)).collect())
+    }
+
+    /// Appends `phase` (of the current run) to `trajectory`, with its energy.
+    fn record(&self, trajectory: &mut Trajectory<N>, phase: &Phase<N>) -> Result<(), DiracError> {
+        let motion = self.motion()?;
+        let sample = Sample {
+            t: phase.t,
+            q: phase.q,
+            v: motion.kinetic.velocity(&phase.p),
+            p: phase.p,
+        };
+        trajectory.push(&sample, self.energy_at(&motion.kinetic, phase))
+    }
+
+    /// Steps to the last of `times` (finite, increasing, none before now), landing on it, and
+    /// calls `each(self, phase, saved)`: after every whole step (`saved` false, `phase` the
+    /// state), and at each of `times` (`saved` true): a time equal to the current one with the
+    /// state, a time inside a step with the step of fictive size that lands on it from the step's
+    /// start, taken aside (the run goes on from the whole step), the last with the state it
+    /// lands on.
+    fn drive(
         &mut self,
-        t_end: f64,
-        mut each: impl FnMut(&Self) -> Result<(), DiracError>,
+        times: &[f64],
+        mut each: impl FnMut(&Self, &Phase<N>, bool) -> Result<(), DiracError>,
     ) -> Result<(), DiracError> {
         let motion = *self.motion()?;
-        if !t_end.is_finite() {
+        if let Some(t) = times.iter().find(|t| !t.is_finite()) {
             return Err(DiracError::InvalidRun(format!(
-                "the end time {t_end} is not finite"
+                "the time {t} is not finite"
             )));
         }
-        if t_end < motion.at.t {
+        if let Some(pair) = times.windows(2).find(|w| w[1] <= w[0]) {
             return Err(DiracError::InvalidRun(format!(
-                "the end time {t_end} is before the current time {}",
-                motion.at.t
+                "times must increase, got {} then {}",
+                pair[0], pair[1]
             )));
         }
-        loop {
+        let Some(&last) = times.last() else {
+            return Ok(());
+        };
+        if times[0] < motion.at.t {
+            return Err(DiracError::InvalidRun(format!(
+                "the time {} is before the current time {}",
+                times[0], motion.at.t
+            )));
+        }
+        let mut pending = times.iter().copied().peekable();
+        while pending.next_if(|&t| t == motion.at.t).is_some() {
+            each(self, &motion.at, true)?;
+        }
+        while pending.peek().is_some() {
             let at = self.motion()?.at;
-            if at.t == t_end {
+            let next = self.whole_step(&motion, &at)?;
+            while let Some(t) = pending.next_if(|&t| t <= next.t) {
+                let landed = self.land(&motion, &at, next, t)?;
+                if t == last {
+                    self.set(landed);
+                }
+                each(self, &landed, true)?;
+            }
+            if next.t >= last {
                 return Ok(());
             }
-            let next = self.whole_step(&motion, &at)?;
-            if next.t >= t_end {
-                let landed = self.land(&motion, &at, next, t_end)?;
-                self.set(landed);
-                return each(self);
-            }
             self.set(next);
-            each(self)?;
+            each(self, &next, false)?;
         }
+        Ok(())
     }
 
     /// The whole step from `at`, refused where it does not advance time (a composition with
@@ -549,55 +583,11 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn trajectory_at(&mut self, times: &[f64]) -> Result<Trajectory<N>, DiracError> {
-        let motion = *self.motion()?;
-        let names = (0..N).map(|i| self.system.coordinate_name(i)).collect();
-        let mut trajectory = Trajectory::new(names)?;
-        if let Some(t) = times.iter().find(|t| !t.is_finite()) {
-            return Err(DiracError::InvalidRun(format!(
-                "a save time {t} is not finite"
-            )));
-        }
-        if let Some(pair) = times.windows(2).find(|w| w[1] <= w[0]) {
-            return Err(DiracError::InvalidRun(format!(
-                "save times must increase, got {} then {}",
-                pair[0], pair[1]
-            )));
-        }
-        let Some(&last) = times.last() else {
-            return Ok(trajectory);
-        };
-        if times[0] < motion.at.t {
-            return Err(DiracError::InvalidRun(format!(
-                "the save time {} is before the current time {}",
-                times[0], motion.at.t
-            )));
-        }
-        let mut record = |this: &Self, phase: &Phase<N>| {
-            let sample = Sample {
-                t: phase.t,
-                q: phase.q,
-                v: motion.kinetic.velocity(&phase.p),
-                p: phase.p,
-            };
-            trajectory.push(&sample, this.energy_at(&motion.kinetic, phase))
-        };
-        let mut pending = times.iter().copied().peekable();
-        while pending.next_if(|&t| t == motion.at.t).is_some() {
-            record(self, &motion.at)?;
-        }
-        while pending.peek().is_some() {
-            let at = self.motion()?.at;
-            let next = self.whole_step(&motion, &at)?;
-            while let Some(t) = pending.next_if(|&t| t <= next.t) {
-                let landed = self.land(&motion, &at, next, t)?;
-                record(self, &landed)?;
-                if t == last {
-                    self.set(landed);
-                    return Ok(trajectory);
-                }
-            }
-            self.set(next);
-        }
+        let mut trajectory = self.trajectory()?;
+        self.drive(times, |this, phase, saved| match saved {
+            true => this.record(&mut trajectory, phase),
+            false => Ok(()),
+        })?;
         Ok(trajectory)
     }
 

@@ -515,13 +515,10 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
         let error = distance(&end, reference);
         let trajectory = &solution.trajectory;
         let steps = stepper.steps();
-        let mut fastest = f64::INFINITY;
-        for _ in 0..self.repetitions {
-            let mut timed = make()?;
-            let clock = Instant::now();
+        let fastest = self.fastest(make, |timed| {
             timed.solve(Run::until(t_end).every(usize::MAX))?;
-            fastest = fastest.min(clock.elapsed().as_secs_f64());
-        }
+            Ok(())
+        })?;
         Ok(Measurement {
             quadrature: stepper.equations().method(),
             h,
@@ -536,6 +533,23 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
 }
 
 impl<S: DiracSystem<N> + Clone, const N: usize> Study<'_, S, N> {
+    /// The least wall time, in seconds, of [`Study::repetitions`] runs `run` of steppers `make`
+    /// makes (the making not timed).
+    fn fastest<T>(
+        &self,
+        make: impl Fn() -> Result<T, DiracError>,
+        run: impl Fn(&mut T) -> Result<(), DiracError>,
+    ) -> Result<f64, DiracError> {
+        let mut fastest = f64::INFINITY;
+        for _ in 0..self.repetitions {
+            let mut timed = make()?;
+            let clock = Instant::now();
+            run(&mut timed)?;
+            fastest = fastest.min(clock.elapsed().as_secs_f64());
+        }
+        Ok(fastest)
+    }
+
     /// A started time-transformed stepper, from the state `start` gives a midpoint stepper.
     fn time_transformed_stepper(
         &self,
@@ -564,13 +578,10 @@ impl<S: DiracSystem<N> + Clone, const N: usize> Study<'_, S, N> {
         let t_end = stepper.t() + self.horizon;
         let trajectory = stepper.trajectory_until(t_end)?;
         let end = stepper.sample().ok_or(DiracError::NotStarted)?;
-        let mut fastest = f64::INFINITY;
-        for _ in 0..self.repetitions {
-            let mut timed = self.time_transformed_stepper(composition, offset, ds)?;
-            let clock = Instant::now();
-            timed.run_until(t_end)?;
-            fastest = fastest.min(clock.elapsed().as_secs_f64());
-        }
+        let fastest = self.fastest(
+            || self.time_transformed_stepper(composition, offset, ds),
+            |timed| timed.run_until(t_end),
+        )?;
         Ok(Measurement {
             quadrature: format!("{}, time-transformed", composition.name()),
             h: ds,
