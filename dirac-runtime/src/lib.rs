@@ -34,7 +34,7 @@ pub use base::{error, scalar};
 pub use discrete::{constraint, discrete_lagrangian};
 pub use integrate::{event, run, snapshots, stepper, time_transformation, trajectory};
 pub use model::{
-    closed_form, hamiltonian_system, interconnection, legendre, repeated, slot, system,
+    body_frame, closed_form, hamiltonian_system, interconnection, legendre, repeated, slot, system,
 };
 pub use solve::{jacobian, newton};
 pub use space::{configuration_space, manifold, product, rotation, sphere};

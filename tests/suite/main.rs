@@ -5,6 +5,7 @@
 
 mod support;
 
+mod body_frame;
 mod closed_form;
 mod configuration_space;
 mod constrained;

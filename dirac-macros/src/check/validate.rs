@@ -389,7 +389,23 @@ pub fn model(arguments: Arguments, mut item: syn::ItemStruct) -> Outcome {
         (Some(expr), Some(coordinates)) => {
             let n =
                 literal_dimension(coordinates).filter(|_| !is_product(coordinates) && !hamiltonian);
-            let closed = n.and_then(|n| symbolic::closed_form(&expr, coordinates, n));
+            let closed = match n {
+                Some(n) => symbolic::closed_form(&expr, coordinates, n),
+                // On rotations: the expression lowered to the matrices' entries (its errors
+                // are reported by `lagrangian_of` below, not twice).
+                None if is_product(coordinates) && !hamiltonian => {
+                    let algebra = Algebra {
+                        coordinates,
+                        parameters: &parameters,
+                        no_velocities: None,
+                        differentials: false,
+                    };
+                    vector_algebra::lower(&expr, &algebra, &mut Errors::default()).and_then(
+                        |lowered| symbolic::closed_form_in_body_frame(&lowered, coordinates),
+                    )
+                }
+                None => None,
+            };
             let lagrangian = lagrangian_of(
                 expr,
                 coordinates,

@@ -353,6 +353,17 @@ fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
     });
     let parameters = quote!(#(#parameters)*);
     let vector = quote!(&__dirac::nalgebra::SVector<f64, #n>);
+    // On rotations the closed forms are read at the `Product`'s points and rates.
+    let (point, rates) = match validate::is_product(&model.coordinates) {
+        false => (vector.clone(), vector.clone()),
+        true => {
+            let (k, a, b) = crate::internals::ast::product_sizes(&model.coordinates);
+            (
+                quote!(&__dirac::Configuration<f64, #k, #a, #b>),
+                quote!(&__dirac::Rates<f64, #k, #a, #b>),
+            )
+        }
+    };
     let one_forms = model.one_form_derivatives.as_ref().map(|derivatives| {
         let arms = derivatives
             .iter()
@@ -387,8 +398,8 @@ fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
             #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
             fn lagrangian_hessian(
                 &self,
-                __q: #vector,
-                __v: #vector,
+                __q: #point,
+                __v: #rates,
             ) -> ::core::option::Option<__dirac::LagrangianHessian<#n>> {
                 #parameters
                 #hessian
@@ -432,8 +443,8 @@ fn closed_form(model: &Model, n: &TokenStream) -> TokenStream {
         #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
         fn lagrangian_gradient(
             &self,
-            __q: #vector,
-            __v: #vector,
+            __q: #point,
+            __v: #rates,
         ) -> ::core::option::Option<__dirac::LagrangianGradient<#n>> {
             #parameters
             #gradient

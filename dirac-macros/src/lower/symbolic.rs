@@ -22,6 +22,9 @@ use crate::lower::expression::{Family, spine};
 
 /// Most nodes of the Lagrangian's own graph that get a closed form.
 const MAX_SOURCE: usize = 1_000;
+/// Most variables (entries, angular velocities, coordinates and velocities) of a Lagrangian on
+/// rotations that gets a closed form: eight rotations, or fewer with vectors.
+const MAX_BODY_VARIABLES: usize = 96;
 /// Most nodes the graph may hold with every derivative (beyond it: no closed form).
 const MAX_GRAPH: usize = 8_000;
 
@@ -594,6 +597,25 @@ impl Reader<'_> {
         self.forces.as_ref()?.iter().position(|v| *v == name)
     }
 
+    /// An entry `m[i][j]` of a parameter's array of arrays (literal indices): a constant. `None`
+    /// where a coordinate is indexed.
+    fn entry(&mut self, ix: &syn::ExprIndex) -> Option<Id> {
+        let mut base = &*ix.expr;
+        literal_index(&ix.index)?;
+        while let Expr::Index(inner) = base {
+            literal_index(&inner.index)?;
+            base = &inner.expr;
+        }
+        let Expr::Path(p) = base else {
+            return None;
+        };
+        let ident = p.path.get_ident()?;
+        if self.coordinate(ident).is_some() || self.differential(ident).is_some() {
+            return None;
+        }
+        Some(self.graph.constant(ix.to_token_stream()))
+    }
+
     /// The flat index of `x` or `theta[i]` (literal `i`).
     fn flat_index(&self, expr: &Expr) -> Option<usize> {
         match expr {
@@ -648,7 +670,7 @@ impl Reader<'_> {
             },
             Expr::Index(ix) => {
                 let Expr::Path(p) = &*ix.expr else {
-                    return None;
+                    return self.entry(ix);
                 };
                 let ident = p.path.get_ident();
                 if ident.and_then(|i| self.differential(i)).is_some() {
@@ -1107,6 +1129,155 @@ pub fn closed_form(expr: &Expr, coordinates: &[Coordinate], n: usize) -> Option<
         zeros,
         separable,
         quadratic,
+    })
+}
+
+/// The closed forms of `L` on `Rᴷ × SO(3)ᴬ` in the body frame, from `expr` lowered to the
+/// atoms (the rotations' entries `R_rc` and angular velocities `Ω_c`): the graph's variables
+/// are the vectors' coordinates and the entries (`K + 9A` positions, numbered as the runtime's
+/// `BodyFrame` numbers them) and the rates (`K + 3A`, the chart's order); the emitted code
+/// hands every derivative that is not identically zero to a `BodyFrame`, which turns them into
+/// body-frame ones. `None` with unit vectors, a length that is not a literal, more than
+/// [`MAX_BODY_VARIABLES`] variables, or where the expression leaves the graph's language.
+pub fn closed_form_in_body_frame(expr: &Expr, coordinates: &[Coordinate]) -> Option<ClosedForm> {
+    use crate::internals::ast::Kind;
+    use crate::lower::atom::atom;
+    let (mut reals, mut rotations) = (0usize, 0usize);
+    let mut layout = Vec::new();
+    for c in coordinates {
+        let length = match &c.length {
+            None => None,
+            Some(Length::Literal(k, _)) => Some(*k),
+            Some(Length::Named(_)) => return None,
+        };
+        let count = length.unwrap_or(1);
+        match c.kind {
+            Kind::Real => {
+                layout.push((c.name.clone(), reals, length));
+                reals += count;
+            }
+            Kind::Rotation => rotations += count,
+            Kind::Direction => return None,
+        }
+    }
+    let positions = reals + 9 * rotations;
+    let n = reals + 3 * rotations;
+    // Every pair of the variables gets a second derivative: past this many, compile time grows
+    // with their square for a Hessian the runtime can take by dual numbers.
+    if positions + n > MAX_BODY_VARIABLES {
+        return None;
+    }
+    // Each atom is a coordinate of its own: an entry a position, an angular velocity a rate
+    // (variables from `positions` on are rates).
+    let span = proc_macro2::Span::call_site();
+    for a in 0..rotations {
+        for r in 0..3 {
+            for c in 0..3 {
+                let entry = atom("R", a, &[r, c], span);
+                layout.push((entry, reals + 9 * a + 3 * r + c, None));
+            }
+        }
+        for c in 0..3 {
+            layout.push((
+                atom("W", a, &[c], span),
+                positions + reals + 3 * a + c,
+                None,
+            ));
+        }
+    }
+    let mut graph = Graph::new(positions);
+    let lagrangian = Reader {
+        graph: &mut graph,
+        coordinates: layout,
+        n: positions,
+        differentials: false,
+        forces: None,
+    }
+    .read(expr)?;
+    let variables: Vec<usize> = (0..positions).chain(positions..positions + n).collect();
+    let first: Vec<Id> = variables
+        .iter()
+        .map(|&x| graph.derivative(lagrangian, x))
+        .collect();
+    let mut second = Vec::new();
+    for (i, &derivative) in first.iter().enumerate() {
+        for (j, &y) in variables.iter().enumerate().skip(i) {
+            second.push((i, j, graph.derivative(derivative, y)));
+            if graph.nodes.len() > MAX_GRAPH {
+                return None;
+            }
+        }
+    }
+    let hands = |i: usize| match i < positions {
+        true => (quote!(position), i),
+        false => (quote!(velocity), i - positions),
+    };
+    let bindings = {
+        let point = (0..reals)
+            .map(|k| quote!(__point.vector[#k]))
+            .chain((0..rotations).flat_map(|a| {
+                (0..9usize).map(move |e| {
+                    let (r, c) = (e / 3, e % 3);
+                    quote!(__point.rotation[#a][(#r, #c)])
+                })
+            }));
+        let rates = (0..reals).map(|k| quote!(__rates.vector[#k])).chain(
+            (0..rotations).flat_map(|a| (0..3usize).map(move |c| quote!(__rates.rotation[#a][#c]))),
+        );
+        quote! {
+            let (__point, __rates) = (__q, __v);
+            let __q: [f64; #positions] = [#(#point),*];
+            let __v: [f64; #n] = [#(#rates),*];
+        }
+    };
+    let body = |with_hessian: bool| {
+        let mut outputs = vec![lagrangian];
+        outputs.extend(&first);
+        if with_hessian {
+            outputs.extend(second.iter().map(|&(.., id)| id));
+        }
+        let code = graph.emit(&outputs);
+        let statements = &code.statements;
+        let value = &code.outputs[0];
+        let gradient = first
+            .iter()
+            .zip(&code.outputs[1..=first.len()])
+            .enumerate()
+            .filter(|(_, (id, _))| !graph.is(**id, 0.0))
+            .map(|(i, (_, x))| {
+                let (hand, i) = hands(i);
+                quote!(__forms.#hand(#i, #x);)
+            });
+        let hessian = second
+            .iter()
+            .zip(code.outputs.iter().skip(1 + first.len()))
+            .filter(|((.., id), _)| !graph.is(*id, 0.0))
+            .map(|(&(i, j, _), x)| {
+                let ((a, i), (b, j)) = (hands(i), hands(j));
+                let method = quote::format_ident!("{}_{}", a.to_string(), b.to_string());
+                quote!(__forms.#method(#i, #j, #x);)
+            });
+        let finish = match with_hessian {
+            true => quote!(hessian),
+            false => quote!(gradient),
+        };
+        quote! {
+            #bindings
+            #statements
+            let mut __forms =
+                __dirac::body_frame::BodyFrame::<#n, #reals, #rotations>::new(__point, #value);
+            #(#gradient)*
+            #(#hessian)*
+            ::core::option::Option::Some(__forms.#finish())
+        }
+    };
+    Some(ClosedForm {
+        gradient: body(false),
+        entire: false,
+        hessian: Some(body(true)),
+        zeros: Default::default(),
+        separable: false,
+        quadratic: false,
     })
 }
 

@@ -17,6 +17,7 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::base::error::DiracError;
 use crate::base::float::rounded_sum;
+use crate::discrete::group_slots;
 use crate::discrete::state::State;
 use crate::model::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};
 use crate::model::derivatives::{
@@ -690,6 +691,32 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         let (quad, h) = (&self.quadrature, self.h);
         let s = quad.degree();
         residual.as_mut_slice().fill(0.0);
+        if s == 1
+            && let Some(chart) = self.space.group_chart()
+        {
+            let slot = group_slots::first_slot(
+                &self.system,
+                &self.space,
+                chart,
+                base,
+                quad,
+                h,
+                &increments[0],
+                jacobian.is_some(),
+            );
+            residual
+                .fixed_rows_mut::<N>(0)
+                .copy_from(&(momentum + slot.row));
+            if let (Some(jacobian), Some(block)) = (jacobian, slot.jacobian) {
+                let mut target = jacobian.fixed_view_mut::<N, N>(0, 0);
+                target += block;
+            }
+            let covectors = StepCovectors {
+                impulse: SVector::zeros(),
+                end: slot.end,
+            };
+            return (Some(covectors), (momentum.abs() + slot.magnitude).amax());
+        }
         let moving = moving_row(
             &self.system,
             &self.space,

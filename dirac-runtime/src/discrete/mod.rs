@@ -10,6 +10,7 @@ pub mod constraint;
 pub mod discrete_lagrangian;
 pub(crate) mod first_order;
 pub(crate) mod force;
+pub(crate) mod group_slots;
 pub(crate) mod hidden_constraint;
 pub(crate) mod initial_state;
 pub(crate) mod layout;

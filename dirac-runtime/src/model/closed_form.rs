@@ -12,7 +12,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::base::error::DiracError;
 use crate::base::float::exceeds;
-use crate::model::derivatives::{Seed, seeded_by_duals};
+use crate::model::derivatives::{PhaseFunction, Seed, seeded_by_duals};
 use crate::model::system::DiracSystem;
 
 /// `L` and its first derivatives at one `(q, v)`.
@@ -179,49 +179,13 @@ pub fn check<S: DiracSystem<N>, const N: usize>(
     v: &SVector<f64, N>,
 ) -> Result<(), DiracError> {
     check_one_forms(system, q)?;
+    let zeros = S::LAGRANGIAN_HESSIAN_ZEROS;
     let gradient = system.lagrangian_gradient(q, v);
     let hessian = system.lagrangian_hessian(q, v);
-    let zeros = S::LAGRANGIAN_HESSIAN_ZEROS;
     if gradient.is_none() && hessian.is_none() && zeros == HessianZeros::NONE {
         return Ok(());
     }
-    let qv = seeded_by_duals(system, q, v, Seed::POSITION, Seed::VELOCITY);
-    let qq = seeded_by_duals(system, q, v, Seed::POSITION, Seed::POSITION).mixed;
-    let vv = seeded_by_duals(system, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed;
-    let reference = LagrangianHessian {
-        gradient: LagrangianGradient {
-            value: qv.value,
-            q: qv.first,
-            v: qv.second,
-        },
-        qq,
-        qv: qv.mixed,
-        vv,
-    };
-    let first = |g: &LagrangianGradient<N>| {
-        let mut all = vec![g.value];
-        all.extend(g.q.iter().chain(g.v.iter()));
-        all
-    };
-    let second = |h: &LagrangianHessian<N>| {
-        h.qq.iter()
-            .chain(h.qv.iter())
-            .chain(h.vv.iter())
-            .copied()
-            .collect::<Vec<_>>()
-    };
-    let compare =
-        |what: &str, closed: Vec<f64>, duals: Vec<f64>| match disagreement(&closed, &duals) {
-            None => Ok(()),
-            Some(k) => Err(DiracError::InconsistentDerivatives(format!(
-                "the closed-form {what} of the Lagrangian differs from dual numbers at \
-             q = {:?}, v = {:?}: entry {k} is {} against {}",
-                q.as_slice(),
-                v.as_slice(),
-                closed[k],
-                duals[k]
-            ))),
-        };
+    let reference = by_duals(system, q, v);
     for (claimed, block, name) in [
         (&zeros.qq, &reference.qq, ["q", "q"]),
         (&zeros.qv, &reference.qv, ["q", "v"]),
@@ -242,17 +206,83 @@ pub fn check<S: DiracSystem<N>, const N: usize>(
             }
         }
     }
+    let at = format!("q = {:?}, v = {:?}", q.as_slice(), v.as_slice());
+    compare(gradient, hessian, &reference, &at)
+}
+
+/// `L`, its gradient and its Hessian blocks at `(q, v)` by dual numbers alone.
+fn by_duals<F: PhaseFunction<N>, const N: usize>(
+    lagrangian: &F,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+) -> LagrangianHessian<N> {
+    let qv = seeded_by_duals(lagrangian, q, v, Seed::POSITION, Seed::VELOCITY);
+    LagrangianHessian {
+        gradient: LagrangianGradient {
+            value: qv.value,
+            q: qv.first,
+            v: qv.second,
+        },
+        qq: seeded_by_duals(lagrangian, q, v, Seed::POSITION, Seed::POSITION).mixed,
+        qv: qv.mixed,
+        vv: seeded_by_duals(lagrangian, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed,
+    }
+}
+
+/// The closed forms of `lagrangian` at `(q, v)`, where it has them, against its dual numbers
+/// (see [`check`]); `at` names the point in the error.
+pub(crate) fn check_function<F: PhaseFunction<N>, const N: usize>(
+    lagrangian: &F,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+    at: &str,
+) -> Result<(), DiracError> {
+    let gradient = lagrangian.closed_gradient(q, v);
+    let hessian = lagrangian.closed_hessian(q, v);
+    if gradient.is_none() && hessian.is_none() {
+        return Ok(());
+    }
+    compare(gradient, hessian, &by_duals(lagrangian, q, v), at)
+}
+
+/// Closed forms against `reference`, the first entry beyond the tolerance named.
+fn compare<const N: usize>(
+    gradient: Option<LagrangianGradient<N>>,
+    hessian: Option<LagrangianHessian<N>>,
+    reference: &LagrangianHessian<N>,
+    at: &str,
+) -> Result<(), DiracError> {
+    let first = |g: &LagrangianGradient<N>| {
+        let mut all = vec![g.value];
+        all.extend(g.q.iter().chain(g.v.iter()));
+        all
+    };
+    let second = |h: &LagrangianHessian<N>| {
+        h.qq.iter()
+            .chain(h.qv.iter())
+            .chain(h.vv.iter())
+            .copied()
+            .collect::<Vec<_>>()
+    };
+    let compare =
+        |what: &str, closed: Vec<f64>, duals: Vec<f64>| match disagreement(&closed, &duals) {
+            None => Ok(()),
+            Some(k) => Err(DiracError::InconsistentDerivatives(format!(
+                "the closed-form {what} of the Lagrangian differs from dual numbers at {at}: \
+                 entry {k} is {} against {}",
+                closed[k], duals[k]
+            ))),
+        };
     if let Some(g) = gradient {
         compare("gradient", first(&g), first(&reference.gradient))?;
     }
     if let Some(h) = hessian {
         compare("gradient", first(&h.gradient), first(&reference.gradient))?;
-        compare("Hessian", second(&h), second(&reference))?;
+        compare("Hessian", second(&h), second(reference))?;
     }
     Ok(())
 }
 
-/// The one-forms' closed-form derivatives against dual numbers at `q` (see [`check`]).
 fn check_one_forms<S: DiracSystem<N>, const N: usize>(
     system: &S,
     q: &SVector<f64, N>,

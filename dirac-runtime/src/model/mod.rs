@@ -6,6 +6,7 @@
 //! Uses [`base`](crate::base), [`space`](crate::space), [`solve`](crate::solve) and
 //! [`quadrature`](crate::quadrature). A new kind of model term goes here.
 
+pub mod body_frame;
 pub mod closed_form;
 pub mod density;
 pub(crate) mod derivatives;

@@ -192,11 +192,16 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// The continuous Lagrangian `L(q, v)` at position `q` and velocity `v`.
     fn lagrangian<D: Scalar>(&self, q: &M::Point<D>, v: &M::Tangent<D>) -> D;
 
-    /// `L` and its gradient at `(q, v)` in closed form, where a model on `Rᴺ` has them:
+    /// `L` and its gradient at `(q, v)` in closed form, where the model has them:
     /// `#[dirac_system]` derives them at compile time from a Lagrangian written as an
-    /// expression. `None` (the default) lets the runtime take them by dual numbers. They must
-    /// be the derivatives of [`lagrangian`](Self::lagrangian): a stepper compares the two at the
-    /// start of every run ([`closed_form::check`](crate::model::closed_form::check)).
+    /// expression, on `Rᴺ` and on vectors and rotations (`Rᴷ × SO(3)ᴬ`). `None` (the default)
+    /// lets the runtime take them by dual numbers. They must be the derivatives of
+    /// [`lagrangian`](Self::lagrangian): a stepper compares the two at the start of every run
+    /// ([`closed_form::check`](crate::model::closed_form::check)).
+    ///
+    /// On rotations the position derivatives are read in the body frame, along `R exp(ŵ)`, and
+    /// the velocity derivatives along `Ω` ([`body_frame`](crate::model::body_frame)); with unit
+    /// vectors the runtime reads no closed forms.
     fn lagrangian_gradient(
         &self,
         q: &M::Point<f64>,

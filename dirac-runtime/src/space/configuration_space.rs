@@ -27,6 +27,7 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::base::scalar::Scalar;
 use crate::space::manifold::{Manifold, Vectors};
+use crate::space::rotation::Retraction;
 
 /// The covectors a solved step hands to the configuration space to advance the momentum.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,6 +65,19 @@ pub type Point<C, const N: usize, D> =
 /// A tangent vector (or covector) of a configuration space `C` over the scalar `D`.
 pub type Tangent<C, const N: usize, D> =
     <<C as ConfigurationSpace<N>>::Manifold as Manifold<N>>::Tangent<D>;
+
+/// The shape of a configuration space that is `Rᴷ × SO(3)ᴬ` with the chart `q τ(ξ)` on each
+/// rotation: the vectors' chart coordinates first, then each rotation's three
+/// ([`ConfigurationSpace::group_chart`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GroupChart {
+    /// `K`, the number of ordinary coordinates.
+    pub reals: usize,
+    /// `A`, the number of rotations.
+    pub rotations: usize,
+    /// The retraction `τ`.
+    pub retraction: Retraction,
+}
 
 /// A configuration space of dimension `N` on a [`Manifold`], with a retraction `R_q(ξ)` whose
 /// charts a step works in.
@@ -137,6 +151,13 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
     /// they do. By default always: the charts move with their centre continuously.
     fn charts_continue(&self, _from: &Point<Self, N, f64>, _to: &Point<Self, N, f64>) -> bool {
         true
+    }
+
+    /// Where the space is `Rᴷ × SO(3)ᴬ` (vectors and rotations, no unit vectors): its shape. A
+    /// degree-1 step then takes its slot derivatives by the chain rule through the retraction
+    /// rather than by dual numbers through the moving chart. `None` by default.
+    fn group_chart(&self) -> Option<GroupChart> {
+        None
     }
 
     /// `(T_ξ R_q)ᵀ α`: the covector `α` at `R_q(ξ)` read in the chart.

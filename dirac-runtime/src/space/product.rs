@@ -21,7 +21,7 @@ use std::ops::{Index, IndexMut};
 use nalgebra::{Matrix3, SVector, Vector2, Vector3};
 
 use crate::base::scalar::Scalar;
-use crate::space::configuration_space::{ConfigurationSpace, sealed};
+use crate::space::configuration_space::{ConfigurationSpace, GroupChart, sealed};
 use crate::space::manifold::Manifold;
 use crate::space::rotation::{self, Retraction};
 use crate::space::sphere;
@@ -552,6 +552,14 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
 
     const AFFINE: bool = A + B == 0;
 
+    fn group_chart(&self) -> Option<GroupChart> {
+        (B == 0).then_some(GroupChart {
+            reals: K,
+            rotations: A,
+            retraction: self.retraction,
+        })
+    }
+
     fn contains(&self, q: &Configuration<f64, K, A, B>) -> bool {
         <Self as Manifold<N>>::violation(q, 1e-9).is_none()
     }
@@ -756,8 +764,7 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
         }
         for a in 0..A {
             let at = Self::rotation_at(a);
-            let d = tau.differential(&rows3(xi, at));
-            p.rotation[a] = d.transpose().try_inverse()? * rows3(covector, at);
+            p.rotation[a] = tau.body_momentum(&rows3(xi, at), &rows3(covector, at))?;
         }
         for b in 0..B {
             let at = Self::direction_at(b);

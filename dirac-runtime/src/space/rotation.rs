@@ -94,6 +94,36 @@ impl Retraction {
         }
     }
 
+    /// `(ψ, κ)` with `dτ_ξ ξ = ψ(ξ) ξ` and `∇ψ(ξ) = κ ξ`: the angular velocity along the ray
+    /// `t ξ` is `ψ(tξ) ξ`. Cayley: `ψ = 4/(4 + |ξ|²)`, `κ = −ψ²/2`; exp: `ψ = 1`, `κ = 0`.
+    ///
+    /// ```
+    /// use dirac_runtime::rotation::Retraction;
+    /// use nalgebra::vector;
+    /// let xi = vector![0.3, -0.2, 0.5];
+    /// for retraction in [Retraction::Cayley, Retraction::Exp] {
+    ///     let (psi, _) = retraction.rate_factor(&xi);
+    ///     assert!((retraction.differential(&xi) * xi - xi * psi).amax() < 1e-15);
+    /// }
+    /// ```
+    pub fn rate_factor<D: Scalar>(self, xi: &Vector3<D>) -> (D, D) {
+        match self {
+            Retraction::Cayley => {
+                let psi = (xi.dot(xi) + 4.0).recip() * 4.0;
+                (psi, psi * psi * -0.5)
+            }
+            Retraction::Exp => (D::from(1.0), D::from(0.0)),
+        }
+    }
+
+    /// `dτ_ξ⁻ᵀ π`: the body momentum at `R τ(ξ)` whose pull-back to the chart at `R` is `π`
+    /// (`dτ_ξᵀ` inverted numerically; `None` where it is singular). The step's end momentum and
+    /// its first slot read it the same way: the momentum maps' conservation rests on the two
+    /// agreeing to the last bit, and closed forms of `dτ_ξ⁻ᵀ` round differently.
+    pub fn body_momentum(self, xi: &Vector3<f64>, pi: &Vector3<f64>) -> Option<Vector3<f64>> {
+        Some(self.differential(xi).transpose().try_inverse()? * pi)
+    }
+
     /// `dτ_ξ⁻¹`: the chart velocity `ξ̇` of the angular velocity `Ω`.
     pub fn differential_inverse<D: Scalar>(self, xi: &Vector3<D>) -> Matrix3<D> {
         let x = xi.dot(xi);

@@ -30,6 +30,7 @@ use crate::base::error::DiracError;
 use crate::base::float::exceeds;
 use crate::discrete::constraint::{self, ConstraintPoint, StepConstraints};
 use crate::discrete::discrete_lagrangian::DiscreteLagrangian;
+use crate::discrete::group_slots;
 use crate::discrete::layout::Layout;
 use crate::model::derivatives::{Dual, InChart, Seed, seeded};
 use crate::model::legendre;
@@ -316,7 +317,8 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
     }
 
     /// The position on the manifold (rotations orthogonal, unit vectors of unit length, to the
-    /// relative `tolerance`), the velocity tangent and finite, `L` and the energy finite, and the
+    /// relative `tolerance`), the velocity tangent and finite, `L` and the energy finite, the
+    /// model's body-frame closed forms equal to dual numbers (on `Rᴷ × SO(3)ᴬ`), and the
     /// one-forms satisfied.
     fn check_start(&self, state: &State<N, C::Manifold>, tolerance: f64) -> Result<(), DiracError> {
         let (q, p, v) = (&state.q, &state.p, &state.velocity);
@@ -369,6 +371,9 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             .space()
             .chart_velocity(q, v)
             .ok_or_else(|| DiracError::OutsideChart("the initial velocity".into()))?;
+        if self.discrete.space().group_chart().is_some() {
+            group_slots::check_closed_forms(self.discrete.system(), self.discrete.space(), q, v)?;
+        }
         self.check_one_forms(q, &xi_dot, tolerance)
     }
 
