@@ -3,8 +3,8 @@
 //! numbers involved), a wrong hand-written one refused at the start, and steps taken with them
 //! equal to steps taken with dual numbers.
 
-use dirac::LagrangianGradient;
 use dirac::prelude::*;
+use dirac::{LagrangianGradient, LagrangianHessian};
 use scenes::rigid_body::{self, HeavyTopByHand};
 
 /// Vectors and two rotations coupled in position and velocity, with potentials that are not
@@ -242,4 +242,100 @@ fn closed_forms_on_rotations_step_as_dual_numbers_do() {
             assert!(worst < 1e-13, "{name}: {worst:e}");
         }
     }
+}
+
+/// `Coupled` without its closed forms: the Lagrangian alone, differentiated by dual numbers.
+#[derive(Debug, Clone, Copy)]
+struct CoupledByDuals(Coupled);
+
+impl DiracSystem<8, Product<2, 2, 0>> for CoupledByDuals {
+    fn lagrangian<D: Scalar>(&self, q: &Configuration<D, 2, 2, 0>, v: &Rates<D, 2, 2, 0>) -> D {
+        self.0.lagrangian(q, v)
+    }
+}
+
+/// Vectors and two coupled rotations: steps with the generated closed forms against steps with
+/// dual numbers, to round-off over 200 steps (both retractions, midpoint and trapezoid).
+#[test]
+fn closed_forms_on_vectors_and_rotations_step_as_dual_numbers_do() {
+    let q = Configuration::<f64, 2, 2, 0> {
+        vector: SVector::from([0.4, -0.7]),
+        rotation: [
+            Retraction::Exp.map(&Vector3::new(0.7, 0.2, -0.4)),
+            Retraction::Exp.map(&Vector3::new(-0.3, 1.1, 0.5)),
+        ],
+        direction: [],
+    };
+    let v = Rates::<f64, 2, 2, 0> {
+        vector: SVector::from([0.3, -1.2]),
+        rotation: [Vector3::new(1.5, -0.6, 2.0), Vector3::new(-0.4, 0.9, 0.2)],
+        direction: [],
+    };
+    for space in [Product::cayley(), Product::exp()] {
+        for quadrature in [Quadrature::midpoint(), Quadrature::trapezoid()] {
+            let name = format!("{} {:?}", quadrature.name(), space.retraction());
+            let mut closed =
+                Stepper::on_manifold(COUPLED, space, quadrature.clone(), 0.01).unwrap();
+            let mut duals =
+                Stepper::on_manifold(CoupledByDuals(COUPLED), space, quadrature, 0.01).unwrap();
+            closed.start_from_velocity(q, v).unwrap();
+            duals.start_from_velocity(q, v).unwrap();
+            let mut worst = 0.0_f64;
+            for _ in 0..200 {
+                closed.step().unwrap();
+                duals.step().unwrap();
+                let (a, b) = (closed.q(), duals.q());
+                let positions = (a.vector - b.vector).amax().max(
+                    (0..2)
+                        .map(|k| (a.rotation[k] - b.rotation[k]).amax())
+                        .fold(0.0, f64::max),
+                );
+                let (p, r) = (closed.p(), duals.p());
+                let momenta = (p.vector - r.vector).amax().max(
+                    (0..2)
+                        .map(|k| (p.rotation[k] - r.rotation[k]).amax())
+                        .fold(0.0, f64::max),
+                );
+                worst = worst.max(positions).max(momenta);
+            }
+            println!("{name}: closed forms and dual numbers {worst:.1e} apart after 200 steps");
+            assert!(worst < 1e-12, "{name}: {worst:e}");
+        }
+    }
+}
+
+/// The heavy top with a wrong body-frame Hessian (one entry of `∂²L/∂w²` off by 0.01).
+#[derive(Debug, Clone, Copy)]
+struct WrongHessian(HeavyTopByHand);
+
+impl DiracSystem<3, Product<0, 1, 0>> for WrongHessian {
+    fn lagrangian<D: Scalar>(&self, q: &Configuration<D, 0, 1, 0>, v: &Rates<D, 0, 1, 0>) -> D {
+        self.0.lagrangian(q, v)
+    }
+
+    fn lagrangian_hessian(
+        &self,
+        q: &Configuration<f64, 0, 1, 0>,
+        v: &Rates<f64, 0, 1, 0>,
+    ) -> Option<LagrangianHessian<3>> {
+        let mut h = self.0.0.lagrangian_hessian(q, v)?;
+        h.qq[(0, 1)] += 0.01;
+        h.qq[(1, 0)] += 0.01;
+        Some(h)
+    }
+}
+
+#[test]
+fn a_wrong_body_frame_hessian_is_refused_at_the_start() {
+    let refused = rigid_body::started(
+        WrongHessian(HeavyTopByHand(rigid_body::PENDULUM)),
+        Product::cayley(),
+        Quadrature::midpoint(),
+        0.01,
+        rigid_body::pendulum_start(),
+    );
+    assert!(
+        matches!(refused, Err(DiracError::InconsistentDerivatives(_))),
+        "{refused:?}"
+    );
 }

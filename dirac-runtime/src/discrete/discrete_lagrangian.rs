@@ -678,7 +678,8 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     /// transitions: row 0 is `π_k + D1 L_d` through the moving chart (see
     /// [`MovingRow`](crate::model::derivatives::MovingRow)), the internal points' rows and the end
     /// covector are read in the chart at `base`. The end covector comes with the residual where a
-    /// Jacobian is asked for or the step has internal points; otherwise it is left to
+    /// Jacobian is asked for, the step has internal points, or the space is one of vectors and
+    /// rotations (its degree-1 step by the chain rule, [`group_slots`]); otherwise it is left to
     /// [`slot_covectors`](Self::slot_covectors) (`None`).
     fn euler_lagrange_moving(
         &self,

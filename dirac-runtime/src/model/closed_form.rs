@@ -283,6 +283,7 @@ fn compare<const N: usize>(
     Ok(())
 }
 
+/// The one-forms' closed-form derivatives against dual numbers at `q` (see [`check`]).
 fn check_one_forms<S: DiracSystem<N>, const N: usize>(
     system: &S,
     q: &SVector<f64, N>,

@@ -200,8 +200,9 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// ([`closed_form::check`](crate::model::closed_form::check)).
     ///
     /// On rotations the position derivatives are read in the body frame, along `R exp(ŵ)`, and
-    /// the velocity derivatives along `Ω` ([`body_frame`](crate::model::body_frame)); with unit
-    /// vectors the runtime reads no closed forms.
+    /// the velocity derivatives along `Ω` ([`body_frame`](crate::model::body_frame)); a degree-1
+    /// Lie group step reads them, and compares them with dual numbers along `R exp(ŵ)` at its
+    /// start. With unit vectors the runtime reads no closed forms.
     fn lagrangian_gradient(
         &self,
         q: &M::Point<f64>,

@@ -118,8 +118,9 @@ impl Retraction {
 
     /// `dτ_ξ⁻ᵀ π`: the body momentum at `R τ(ξ)` whose pull-back to the chart at `R` is `π`
     /// (`dτ_ξᵀ` inverted numerically; `None` where it is singular). The step's end momentum and
-    /// its first slot read it the same way: the momentum maps' conservation rests on the two
-    /// agreeing to the last bit, and closed forms of `dτ_ξ⁻ᵀ` round differently.
+    /// its first slot read it the same way: without forces, one-forms or junctions the two then
+    /// agree to the last bit, and the momentum maps are kept without drift (a closed form of
+    /// `dτ_ξ⁻ᵀ` on one side rounds differently, and made the free body's spatial momentum drift).
     pub fn body_momentum(self, xi: &Vector3<f64>, pi: &Vector3<f64>) -> Option<Vector3<f64>> {
         Some(self.differential(xi).transpose().try_inverse()? * pi)
     }
