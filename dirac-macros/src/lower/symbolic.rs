@@ -1154,16 +1154,19 @@ pub fn closed_form_in_body_frame(expr: &Expr, coordinates: &[Coordinate]) -> Opt
         match c.kind {
             Kind::Real => {
                 layout.push((c.name.clone(), reals, length));
-                reals += count;
+                reals = reals.checked_add(count)?;
             }
-            Kind::Rotation => rotations += count,
+            Kind::Rotation => rotations = rotations.checked_add(count)?,
             Kind::Direction => return None,
+        }
+        // Every pair of the variables gets a second derivative: past this many, compile time
+        // grows with their square for a Hessian the runtime can take by dual numbers.
+        if reals.saturating_mul(2) > MAX_BODY_VARIABLES || rotations > MAX_BODY_VARIABLES / 12 {
+            return None;
         }
     }
     let positions = reals + 9 * rotations;
     let n = reals + 3 * rotations;
-    // Every pair of the variables gets a second derivative: past this many, compile time grows
-    // with their square for a Hessian the runtime can take by dual numbers.
     if positions + n > MAX_BODY_VARIABLES {
         return None;
     }
