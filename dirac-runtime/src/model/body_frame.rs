@@ -1,8 +1,8 @@
 //! The closed forms of a Lagrangian on `Rᴷ × SO(3)ᴬ`, read in the body frame.
 //!
-//! On a model with rotations, [`DiracSystem::lagrangian_gradient`] and
-//! [`DiracSystem::lagrangian_hessian`] give the derivatives along `R exp(ŵ)` on each rotation
-//! (`x + w` on the vectors) and along the rates `(ẋ, Ω)` themselves:
+//! On a model with rotations, [`lagrangian_gradient`] and [`lagrangian_hessian`] give the
+//! derivatives along `R exp(ŵ)` on each rotation (`x + w` on the vectors) and along the rates
+//! `(ẋ, Ω)` themselves:
 //!
 //! ```text
 //! g_k = ∂/∂w_k L(R exp(ŵ), Ω),   H_kl = ∂²/∂w_k∂w_l L(R exp(ŵ), Ω)   at w = 0,
@@ -18,6 +18,9 @@
 //! ```
 //!
 //! the last terms from `exp(ŵ) = I + ŵ + ŵ²/2 + …` and `ê_k ê_l = e_l e_kᵀ − δ_kl I`.
+//!
+//! [`lagrangian_gradient`]: crate::model::system::DiracSystem::lagrangian_gradient
+//! [`lagrangian_hessian`]: crate::model::system::DiracSystem::lagrangian_hessian
 
 use nalgebra::{Matrix3, SVector, Vector3};
 
