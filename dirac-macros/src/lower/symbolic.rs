@@ -931,17 +931,23 @@ pub struct ClosedForm {
     pub quadratic: bool,
 }
 
+/// A coordinate's length: `Some(None)` for a single coordinate, `Some(Some(k))` for an array of
+/// literal length `k`, `None` for a length named by a constant parameter.
+fn literal_length(c: &Coordinate) -> Option<Option<usize>> {
+    match &c.length {
+        None => Some(None),
+        Some(Length::Literal(k, _)) => Some(Some(*k)),
+        Some(Length::Named(_)) => None,
+    }
+}
+
 /// Each coordinate's name, flat offset and literal length; `None` where a length is not a
 /// literal or the lengths do not add up to `n`.
 fn layout(coordinates: &[Coordinate], n: usize) -> Option<Vec<(syn::Ident, usize, Option<usize>)>> {
     let mut offset = 0usize;
     let mut layout = Vec::new();
     for c in coordinates {
-        let length = match &c.length {
-            None => None,
-            Some(Length::Literal(k, _)) => Some(*k),
-            Some(Length::Named(_)) => return None,
-        };
+        let length = literal_length(c)?;
         layout.push((c.name.clone(), offset, length));
         offset += length.unwrap_or(1);
     }
@@ -1145,11 +1151,7 @@ pub fn closed_form_in_body_frame(expr: &Expr, coordinates: &[Coordinate]) -> Opt
     let (mut reals, mut rotations) = (0usize, 0usize);
     let mut layout = Vec::new();
     for c in coordinates {
-        let length = match &c.length {
-            None => None,
-            Some(Length::Literal(k, _)) => Some(*k),
-            Some(Length::Named(_)) => return None,
-        };
+        let length = literal_length(c)?;
         let count = length.unwrap_or(1);
         match c.kind {
             Kind::Real => {
