@@ -59,6 +59,19 @@ struct AlongBody<'a, S, C: ConfigurationSpace<N>, const N: usize> {
     at: Point<C, N, f64>,
 }
 
+impl<S, C: ConfigurationSpace<N>, const N: usize> AlongBody<'_, S, C, N> {
+    /// The rates `omega` as the model's, where `w = 0` (the closed forms are read there alone).
+    fn rates_at_centre(
+        &self,
+        w: &SVector<f64, N>,
+        omega: &SVector<f64, N>,
+    ) -> Option<Tangent<C, N, f64>> {
+        w.iter()
+            .all(|x| *x == 0.0)
+            .then(|| self.space.push_forward(&self.at, w, omega))
+    }
+}
+
 impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> PhaseFunction<N>
     for AlongBody<'_, S, C, N>
 {
@@ -79,11 +92,8 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> P
         w: &SVector<f64, N>,
         omega: &SVector<f64, N>,
     ) -> Option<LagrangianGradient<N>> {
-        if w.iter().any(|x| *x != 0.0) {
-            return None;
-        }
-        let v = self.space.push_forward(&self.at, w, omega);
-        self.system.lagrangian_gradient(&self.at, &v)
+        self.system
+            .lagrangian_gradient(&self.at, &self.rates_at_centre(w, omega)?)
     }
 
     #[inline]
@@ -92,11 +102,8 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> P
         w: &SVector<f64, N>,
         omega: &SVector<f64, N>,
     ) -> Option<LagrangianHessian<N>> {
-        if w.iter().any(|x| *x != 0.0) {
-            return None;
-        }
-        let v = self.space.push_forward(&self.at, w, omega);
-        self.system.lagrangian_hessian(&self.at, &v)
+        self.system
+            .lagrangian_hessian(&self.at, &self.rates_at_centre(w, omega)?)
     }
 }
 

@@ -189,16 +189,37 @@ pub struct Crossing<const N: usize, M: Manifold<N> = Vectors> {
     pub sample: Sample<N, M>,
 }
 
-/// The root in `[0, 1]` of `g`, with `g(0) = g0` and `g(1) = g1` of opposite signs (or `g1 = 0`),
-/// by the Illinois variant of regula falsi.
+/// The root in `[0, 1]` of `g`, with `g(0) = g0` and `g(1) = g1` of opposite signs (or `g1 = 0`):
+/// the end of the [`illinois`] bracket where `|g|` is smaller.
 pub(crate) fn locate(
-    mut g: impl FnMut(f64) -> Result<f64, DiracError>,
+    g: impl FnMut(f64) -> Result<f64, DiracError>,
     g0: f64,
     g1: f64,
 ) -> Result<f64, DiracError> {
+    let Bracket { a, ga, b, gb } = illinois(g, g0, g1)?;
+    Ok(if ga.abs() < gb.abs() { a } else { b })
+}
+
+/// A bracket `[a, b]` of a root and the values kept at its ends (the Illinois rule halves them).
+pub(crate) struct Bracket {
+    pub a: f64,
+    pub ga: f64,
+    pub b: f64,
+    pub gb: f64,
+}
+
+/// The bracket in `[0, 1]` around the root of `g`, with `g(0) = g0` and `g(1) = g1` of opposite
+/// signs (or `g1 = 0`), closed by the Illinois variant of regula falsi to 4 ulps or to a point
+/// where `g` vanishes (then `b`, with `gb = 0`). The end `b` keeps the sign of `g1`: every point
+/// `g` was evaluated at where it has that sign, or vanishes, became `b` in its turn.
+pub(crate) fn illinois(
+    mut g: impl FnMut(f64) -> Result<f64, DiracError>,
+    g0: f64,
+    g1: f64,
+) -> Result<Bracket, DiracError> {
     let (mut a, mut ga, mut b, mut gb) = (0.0, g0, 1.0, g1);
     if gb == 0.0 {
-        return Ok(1.0);
+        return Ok(Bracket { a, ga, b, gb });
     }
     // Which end was kept last (−1: a, +1: b): the Illinois rule halves a value kept twice.
     let mut kept = 0;
@@ -212,7 +233,12 @@ pub(crate) fn locate(
         }
         let gc = g(c)?;
         if gc == 0.0 {
-            return Ok(c);
+            return Ok(Bracket {
+                a,
+                ga,
+                b: c,
+                gb: 0.0,
+            });
         }
         if gc.signum() == gb.signum() {
             (b, gb) = (c, gc);
@@ -228,7 +254,7 @@ pub(crate) fn locate(
             kept = 1;
         }
     }
-    Ok(if ga.abs() < gb.abs() { a } else { b })
+    Ok(Bracket { a, ga, b, gb })
 }
 
 #[cfg(test)]

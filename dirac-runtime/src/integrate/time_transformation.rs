@@ -39,6 +39,7 @@ use nalgebra::SVector;
 
 use crate::base::error::DiracError;
 use crate::base::float::{folded, two_sum, two_sum_add};
+use crate::integrate::event;
 use crate::integrate::trajectory::Trajectory;
 use crate::model::derivatives;
 use crate::model::legendre;
@@ -47,10 +48,6 @@ use crate::step::composition::Composition;
 use crate::step::dense_output::Sample;
 use crate::step::euler_lagrange::check_finite;
 use crate::step::verlet::{Kinetic, not_explicit};
-
-/// Iterations of the Illinois method that lands a run on its end time: it gains about a digit
-/// and a half per iteration, and stops where the bracket is a few ulps wide.
-const LANDING_ITERATIONS: usize = 100;
 
 /// The explicit variational step of a separable model in a fictive time `s` with
 /// `dt/ds = 1/(c − V(q))` (see the [module](self)): adaptive in `t`, symplectic in the extended
@@ -592,8 +589,9 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
     }
 
     /// The step from `at` of the fictive size that ends at `t_end`, given the whole step
-    /// `beyond` that passes it: the Illinois method on `σ ↦ t(σ) − t_end` over `(0, ds]`. The
-    /// step found ends within a few ulps of `t_end`, and its time is set to `t_end`.
+    /// `beyond` that passes it: the Illinois method ([`event::illinois`]) on
+    /// `u ↦ t(u δs) − t_end` over `(0, 1]`, keeping the last step that reaches `t_end`. The step
+    /// found ends within a few ulps of `t_end`, and its time is set to `t_end`.
     fn land(
         &self,
         motion: &Motion<N>,
@@ -601,38 +599,16 @@ impl<S: DiracSystem<N>, const N: usize> TimeTransformed<S, N> {
         beyond: Phase<N>,
         t_end: f64,
     ) -> Result<Phase<N>, DiracError> {
-        let (mut a, mut fa) = (0.0, at.t - t_end);
-        let (mut b, mut fb) = (self.ds, beyond.t - t_end);
         let mut best = beyond;
-        // The side that stayed last: its value is halved (Illinois) when it stays again.
-        let mut stayed = 0i8;
-        for _ in 0..LANDING_ITERATIONS {
-            if fb == 0.0 || (b - a) <= 4.0 * f64::EPSILON * b {
-                break;
-            }
-            let sigma = b - fb * (b - a) / (fb - fa);
-            // Round-off may put the secant's point at an end of the bracket: bisect then.
-            let sigma = if sigma > a && sigma < b {
-                sigma
-            } else {
-                0.5 * (a + b)
-            };
-            let trial = self.advance(motion, at, sigma)?;
+        let reach = |u: f64| {
+            let trial = self.advance(motion, at, u * self.ds)?;
             let f = trial.t - t_end;
             if f >= 0.0 {
-                (b, fb, best) = (sigma, f, trial);
-                if stayed == -1 {
-                    fa *= 0.5;
-                }
-                stayed = -1;
-            } else {
-                (a, fa) = (sigma, f);
-                if stayed == 1 {
-                    fb *= 0.5;
-                }
-                stayed = 1;
+                best = trial;
             }
-        }
+            Ok(f)
+        };
+        event::illinois(reach, at.t - t_end, beyond.t - t_end)?;
         let miss = best.t - t_end;
         if miss.abs() > 64.0 * f64::EPSILON * t_end.abs().max(at.t.abs()).max(1.0) {
             return Err(DiracError::InvalidRun(format!(
