@@ -13,7 +13,7 @@
 //! along `(α_x, β_x)` and `(α_y, β_y)` in `(ξ, ξ̇)` yields both gradients along those directions
 //! and the mixed second derivative in one pass.
 
-use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector3};
 
 use crate::base::error::DiracError;
 use crate::base::float::rounded_sum;
@@ -21,8 +21,8 @@ use crate::discrete::group_slots;
 use crate::discrete::state::State;
 use crate::model::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};
 use crate::model::derivatives::{
-    InChart, PhaseFunction, Seed, directional_gradient, gradients, hessian, moving_row, seeded,
-    third_derivative,
+    InChart, PhaseFunction, Seed, directional_gradient, gradient, gradients, hessian, lift,
+    moving_row, seeded, third_derivative,
 };
 use crate::model::system::DiracSystem;
 use crate::quadrature::{MAX_DEGREE, Quadrature, path_sums};
@@ -262,7 +262,14 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     /// chart, the momentum from the step's `covectors` (to which the discrete Lagrangian's own are
     /// added here when the residual left them `pending`), the velocity not yet set. `step`
     /// counts the steps before, for the error where the chart's tangent map is singular.
+    ///
+    /// `conservative`: the step's action is the discrete Lagrangian alone (no forces,
+    /// constraints or junction impulses). Each unit vector's angular momentum then advances by
+    /// the step's torque ([`torque`](Self::torque),
+    /// [`advance_momentum_turned`](ConfigurationSpace::advance_momentum_turned)), so that a
+    /// rotation the Lagrangian is invariant under keeps its momentum map to round-off.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn advanced(
         &self,
         state: &State<N, C::Manifold>,
@@ -270,21 +277,59 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         increments: &[SVector<f64, N>],
         mut covectors: StepCovectors<N>,
         pending: bool,
+        conservative: bool,
         step: u64,
     ) -> Result<State<N, C::Manifold>, DiracError> {
-        if pending {
+        let turned = conservative && self.space.unit_vectors() > 0;
+        // Where every factor is a unit vector, the torques alone advance the momentum.
+        if pending && !(turned && 2 * self.space.unit_vectors() == N) {
             covectors += self.slot_covectors(&state.q, increments);
         }
         let mut next = *state;
         self.space.advance(&mut next.q, &mut next.q_carry, xi);
-        self.space
-            .advance_momentum(&state.q, xi, &mut next.p, &mut next.p_carry, &covectors)
-            .ok_or_else(|| {
-                DiracError::OutsideChart(format!(
-                    "step {step} reaches a point where the retraction's tangent map is singular"
-                ))
-            })?;
+        let advanced = if turned {
+            self.space.advance_momentum_turned(
+                &state.q,
+                xi,
+                &next.q,
+                &mut next.p,
+                &mut next.p_carry,
+                &mut next.spin_carry,
+                &covectors,
+                |b| self.torque(&state.q, increments, b),
+            )
+        } else {
+            self.space
+                .advance_momentum(&state.q, xi, &mut next.p, &mut next.p_carry, &covectors)
+        };
+        advanced.ok_or_else(|| {
+            DiracError::OutsideChart(format!(
+                "step {step} reaches a point where the retraction's tangent map is singular"
+            ))
+        })?;
         Ok(next)
+    }
+
+    /// The torque of the step with points `ξ_1..ξ_s` (chart at `base`) on unit vector `b`:
+    /// `T = ∂/∂ω h Σ_i b_i L(X_i + ω × X_i, Ẋ_i + ω × Ẋ_i)` at `ω = 0`, which is
+    /// `h Σ_i b_i (X_i × ∂L/∂X + Ẋ_i × ∂L/∂Ẋ)` on the nodes' points and velocities.
+    pub(crate) fn torque(
+        &self,
+        base: &Point<C, N, f64>,
+        increments: &[SVector<f64, N>],
+        b: usize,
+    ) -> Vector3<f64> {
+        let omega = lift(&Vector3::zeros(), 1.0);
+        let mut torque = Vector3::zeros();
+        for (i, &weight) in self.quadrature.weights().iter().enumerate() {
+            let (xi, xi_dot) = self.node(i, increments);
+            let x = self.space.retract(base, &xi);
+            let v = self.space.push_forward(base, &xi, &xi_dot);
+            if let Some((x, v)) = self.space.turned(&x, &v, b, &omega) {
+                torque += gradient(&self.system.lagrangian(&x, &v)) * (self.h * weight);
+            }
+        }
+        torque
     }
 
     /// Refuses the end of step `step` where `L(q, v)` is not finite. The quadrature may never

@@ -34,6 +34,10 @@ pub struct State<const N: usize, M: Manifold<N> = Vectors> {
     /// Round-off left out of `q` and `p` by compensated updates.
     pub(crate) q_carry: SVector<f64, N>,
     pub(crate) p_carry: SVector<f64, N>,
+    /// What a unit vector's momentum cannot hold of its angular momentum `m = q × p + …`
+    /// (its component along `q`), where its momentum advances by torques
+    /// ([`advance_momentum_turned`](crate::space::configuration_space::ConfigurationSpace::advance_momentum_turned)).
+    pub(crate) spin_carry: SVector<f64, N>,
 }
 
 impl<const N: usize, M: Manifold<N>> State<N, M> {
@@ -47,6 +51,7 @@ impl<const N: usize, M: Manifold<N>> State<N, M> {
             velocity,
             q_carry: SVector::zeros(),
             p_carry: SVector::zeros(),
+            spin_carry: SVector::zeros(),
         }
     }
 

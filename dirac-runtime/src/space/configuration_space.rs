@@ -23,7 +23,7 @@
 
 use std::fmt::Debug;
 
-use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector3};
 
 use crate::base::scalar::Scalar;
 use crate::space::manifold::{Manifold, Vectors};
@@ -227,6 +227,50 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
         let _ = carry;
         *p = self.push_covector(q, xi, &covectors.end)?;
         Some(())
+    }
+
+    /// The number of unit-vector factors (`S²`) of a point: none by default.
+    fn unit_vectors(&self) -> usize {
+        0
+    }
+
+    /// `(q, v)` with unit vector `b` and its velocity turned by the infinitesimal rotation `ω`,
+    /// `(q_b + ω × q_b, v_b + ω × v_b)`, the other factors as they are: the derivative of a
+    /// function of `(q, v)` in `ω` at `ω = 0` is its torque about the origin. `None` where the
+    /// space has no unit vector `b`.
+    fn turned<D: Scalar>(
+        &self,
+        q: &Point<Self, N, f64>,
+        v: &Tangent<Self, N, f64>,
+        b: usize,
+        omega: &Vector3<D>,
+    ) -> Option<(Point<Self, N, D>, Tangent<Self, N, D>)> {
+        let _ = (q, v, b, omega);
+        None
+    }
+
+    /// The momentum at `next = R_q(ξ)` after a step from `(q, p)` of a model whose action is its
+    /// discrete Lagrangian alone, given the step's torque `torque(b)` on each unit vector `b`
+    /// (`h Σ_i b_i (X_i × ∂L/∂X + Ẋ_i × ∂L/∂Ẋ)` over the nodes): each unit vector's angular
+    /// momentum advances by its torque, `m_{k+1} = m_k + T`, and `p_{k+1} = m_{k+1} × q_{k+1}`
+    /// (discrete Noether: rotating the whole step changes `L_d` by `T`, so a rotation the
+    /// Lagrangian is invariant under keeps its component of `m`). `spin` carries what `p`
+    /// cannot hold of `m` from step to step. The other factors advance as in
+    /// [`advance_momentum`](Self::advance_momentum), which this is by default.
+    #[allow(clippy::too_many_arguments)]
+    fn advance_momentum_turned(
+        &self,
+        q: &Point<Self, N, f64>,
+        xi: &SVector<f64, N>,
+        next: &Point<Self, N, f64>,
+        p: &mut Tangent<Self, N, f64>,
+        carry: &mut SVector<f64, N>,
+        spin: &mut SVector<f64, N>,
+        covectors: &StepCovectors<N>,
+        torque: impl Fn(usize) -> Vector3<f64>,
+    ) -> Option<()> {
+        let _ = (next, spin, torque);
+        self.advance_momentum(q, xi, p, carry, covectors)
     }
 
     /// `R_{R_q(η)}(ζ)`: the point at `ζ` of the chart centred at `R_q(η)`.

@@ -1362,6 +1362,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             &self.increments,
             self.covectors,
             self.covectors_pending,
+            false,
             step,
         )?;
         if !self.collocated.is_empty() {

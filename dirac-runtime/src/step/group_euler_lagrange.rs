@@ -235,6 +235,12 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
         Ok(())
     }
 
+    /// Whether the step's action is the discrete Lagrangian alone: no forces, constraints or
+    /// junction impulses add to its momentum.
+    fn conservative(&self) -> bool {
+        !S::FORCES && S::ONE_FORMS == 0 && S::HOLONOMIC == 0 && self.coupling.is_none()
+    }
+
     /// The name of the variable with index `variable`.
     fn variable(&self, variable: usize) -> String {
         self.discrete.system().coordinate_name(variable)
@@ -515,6 +521,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             &self.increments,
             self.covectors,
             self.covectors_pending,
+            self.conservative(),
             step,
         )?;
         // The end's share of the junctions' impulse, in the chart at `q_{k+1}` (none to add for
