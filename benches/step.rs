@@ -361,6 +361,39 @@ fn lie_group(c: &mut Criterion) {
     group.finish();
 }
 
+/// The spherical pendulum (h = 0.01, midpoint): the generated step on `S²` with either
+/// retraction against the same pendulum in Cartesian coordinates held on the sphere by a
+/// holonomic constraint.
+fn sphere(c: &mut Criterion) {
+    use scenes::spherical_pendulum;
+    let mut group = c.benchmark_group("spherical_pendulum_step");
+    let h = 0.01;
+    for (name, space) in [("s2_cayley", Product::cayley()), ("s2_exp", Product::exp())] {
+        let started =
+            spherical_pendulum::on_sphere(space, Quadrature::midpoint(), h).expect("valid scene");
+        let mut stepper = started.clone();
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                if stepper.steps() >= 100_000 {
+                    stepper = started.clone();
+                }
+                black_box(stepper.step()).expect("step")
+            })
+        });
+    }
+    let started = spherical_pendulum::cartesian(Quadrature::midpoint(), h).expect("valid scene");
+    let mut stepper = started.clone();
+    group.bench_function("cartesian_holonomic", |b| {
+        b.iter(|| {
+            if stepper.steps() >= 100_000 {
+                stepper = started.clone();
+            }
+            black_box(stepper.step()).expect("step")
+        })
+    });
+    group.finish();
+}
+
 /// One step of the same model on the Lagrangian and the discrete Hamiltonian route: Kepler
 /// (h = 0.01) and the knife edge (h = 0.01, one one-form), midpoint and `galerkin(2)`.
 fn routes(c: &mut Criterion) {
@@ -949,6 +982,7 @@ criterion_group!(
     interconnection,
     routes,
     lie_group,
+    sphere,
     recording,
     generated_vs_hand,
     quadratures,

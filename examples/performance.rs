@@ -52,6 +52,11 @@ const GROUPS: &[(&str, &str)] = &[
         "The 3D pendulum on SO(3): the generated Lie group step against a hand-written one.",
     ),
     (
+        "spherical_pendulum_step",
+        "The spherical pendulum on S² (the Cayley and the exponential chart) against the same \
+         pendulum in Cartesian coordinates held on the sphere by a holonomic constraint.",
+    ),
+    (
         "route_step",
         "The discrete Hamiltonian route against the Lagrangian route on the same models.",
     ),
@@ -105,6 +110,7 @@ const PAIRS: &[(&str, &str)] = &[
 /// Groups whose every benchmark is divided by one of them.
 const BASELINES: &[(&str, &str)] = &[
     ("pendulum_3d_step", "hand_written_lgvi"),
+    ("spherical_pendulum_step", "cartesian_holonomic"),
     ("interconnection_step", "lc_monolithic"),
 ];
 

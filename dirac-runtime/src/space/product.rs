@@ -501,6 +501,28 @@ impl<const K: usize, const A: usize, const B: usize> Product<K, A, B> {
         }
     }
 
+    /// The vectors' and rotations' part of [`push_covector`](ConfigurationSpace::push_covector)
+    /// into `p` (the unit vectors' left as they are): `None` where a rotation's tangent map is
+    /// singular.
+    fn push_vectors_and_rotations<const N: usize>(
+        &self,
+        xi: &SVector<f64, N>,
+        covector: &SVector<f64, N>,
+        p: &mut Rates<f64, K, A, B>,
+    ) -> Option<()> {
+        const { dimension::<N, K, A, B>() };
+        for i in 0..K {
+            p.vector[i] = covector[i];
+        }
+        for a in 0..A {
+            let at = Self::rotation_at(a);
+            p.rotation[a] = self
+                .retraction
+                .body_momentum(&rows3(xi, at), &rows3(covector, at))?;
+        }
+        Some(())
+    }
+
     /// `T_ζ R_{R_q(η)} ζ̇`, or `T_ζ R_q ζ̇` without `η`.
     fn moved_velocity<D: Scalar, const N: usize>(
         &self,
@@ -756,16 +778,9 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
         xi: &SVector<f64, N>,
         covector: &SVector<f64, N>,
     ) -> Option<Rates<f64, K, A, B>> {
-        const { dimension::<N, K, A, B>() };
         let tau = self.retraction;
         let mut p = Rates::zero();
-        for i in 0..K {
-            p.vector[i] = covector[i];
-        }
-        for a in 0..A {
-            let at = Self::rotation_at(a);
-            p.rotation[a] = tau.body_momentum(&rows3(xi, at), &rows3(covector, at))?;
-        }
+        self.push_vectors_and_rotations(xi, covector, &mut p)?;
         for b in 0..B {
             let at = Self::direction_at(b);
             let base = &q.direction[b];
@@ -831,9 +846,7 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
             let kept = sphere::frame(base) * rows2(carry, at) + base * spin[at];
             base.cross(&p.direction[b]) + kept + torque(b)
         });
-        if K + A > 0 {
-            self.advance_momentum(q, xi, p, carry, covectors)?;
-        }
+        self.push_vectors_and_rotations(xi, &covectors.end, p)?;
         for (b, m) in m.iter().enumerate() {
             let (n, at) = (&next.direction[b], Self::direction_at(b));
             p.direction[b] = m.cross(n) / n.norm_squared();
