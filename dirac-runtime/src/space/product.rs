@@ -487,10 +487,14 @@ impl<const K: usize, const A: usize, const B: usize> Product<K, A, B> {
         let direction = std::array::from_fn(|b| {
             let at = Self::direction_at(b);
             let base = &q.direction[b];
-            let frame = sphere::frame(base).map(D::from);
-            let point = sphere::retract(tau, base, &(frame * rows2(zeta, at)));
+            let frame = sphere::frame(base);
+            let point = sphere::retract(tau, base, &sphere::in_frame(&frame, &rows2(zeta, at)));
             match eta {
-                Some(eta) => point + sphere::turn(base, &(frame * rows2(eta, at))).cross(&point),
+                Some(eta) => {
+                    point
+                        + sphere::turn(base, &sphere::in_frame(&frame, &rows2(eta, at)))
+                            .cross(&point)
+                }
                 None => point,
             }
         });
@@ -543,16 +547,18 @@ impl<const K: usize, const A: usize, const B: usize> Product<K, A, B> {
         let direction = std::array::from_fn(|b| {
             let at = Self::direction_at(b);
             let base = &q.direction[b];
-            let frame = sphere::frame(base).map(D::from);
+            let frame = sphere::frame(base);
             let velocity = sphere::velocity(
                 tau,
                 base,
-                &(frame * rows2(zeta, at)),
-                &(frame * rows2(zeta_dot, at)),
+                &sphere::in_frame(&frame, &rows2(zeta, at)),
+                &sphere::in_frame(&frame, &rows2(zeta_dot, at)),
             );
             match eta {
                 Some(eta) => {
-                    velocity + sphere::turn(base, &(frame * rows2(eta, at))).cross(&velocity)
+                    velocity
+                        + sphere::turn(base, &sphere::in_frame(&frame, &rows2(eta, at)))
+                            .cross(&velocity)
                 }
                 None => velocity,
             }
@@ -910,13 +916,13 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
             let at = Self::direction_at(b);
             let base = &q.direction[b];
             let frame = sphere::frame(base);
-            let lifted = frame.map(D::from);
-            let point = sphere::retract(tau, base, &(lifted * rows2(xi, at)));
+            let point = sphere::retract(tau, base, &sphere::in_frame(&frame, &rows2(xi, at)));
             // To first order in η the carrier turns the point back by −ω × point.
-            let turned = point - sphere::turn(base, &(lifted * rows2(eta, at))).cross(&point);
+            let turned = point
+                - sphere::turn(base, &sphere::in_frame(&frame, &rows2(eta, at))).cross(&point);
             let w = sphere::local(tau, base, &turned)
                 .unwrap_or_else(|| Vector3::from_element(D::from(f64::NAN)));
-            let moved = lifted.transpose() * w;
+            let moved = sphere::frame_coordinates(&frame, &w);
             // Exactly ξ at η = 0: the round trip's round-off is left out of the value.
             let own = rows2(xi, at);
             for k in 0..2 {

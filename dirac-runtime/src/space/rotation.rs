@@ -286,7 +286,7 @@ pub(crate) fn versine_ratio<D: Scalar>(x: D) -> D {
 }
 
 /// `(θ − sin θ)/θ³` as a function of `x = θ²`.
-fn sine_defect_ratio<D: Scalar>(x: D) -> D {
+pub(crate) fn sine_defect_ratio<D: Scalar>(x: D) -> D {
     if x.re() < SERIES {
         // (−1)^k / (2k + 3)!
         series(

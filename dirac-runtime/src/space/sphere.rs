@@ -18,7 +18,9 @@
 use nalgebra::{Matrix3, Matrix3x2, Vector2, Vector3};
 
 use crate::base::scalar::Scalar;
-use crate::space::rotation::{Retraction, angle_over_sine};
+use crate::space::rotation::{
+    Retraction, angle_over_sine, sine_defect_ratio, sine_ratio, versine_ratio,
+};
 
 /// An orthonormal frame `(b₁, b₂)` of the tangent plane at the unit vector `q`, with
 /// `b₁ × b₂ = q` (Duff et al.'s branch-free construction; it depends on `q` alone).
@@ -53,7 +55,32 @@ pub fn carrier<D: Scalar>(retraction: Retraction, q: &Vector3<f64>, w: &Vector3<
 /// The infinitesimal rotation `ω = q × w` that moves `q` along `w` (the carrier to first order:
 /// `τ(ω) ≈ I + ω̂`).
 pub fn turn<D: Scalar>(q: &Vector3<f64>, w: &Vector3<D>) -> Vector3<D> {
-    lift(q).cross(w)
+    Vector3::new(
+        w[2] * q[1] - w[1] * q[2],
+        w[0] * q[2] - w[2] * q[0],
+        w[1] * q[0] - w[0] * q[1],
+    )
+}
+
+/// `B z`: the tangent vector with coordinates `z` in the frame `B` (a known frame: products
+/// with numbers alone).
+pub(crate) fn in_frame<D: Scalar>(frame: &Matrix3x2<f64>, z: &Vector2<D>) -> Vector3<D> {
+    Vector3::from_fn(|r, _| z[0] * frame[(r, 0)] + z[1] * frame[(r, 1)])
+}
+
+/// `Bᵀ w`: the coordinates of `w` in the frame `B`.
+pub(crate) fn frame_coordinates<D: Scalar>(frame: &Matrix3x2<f64>, w: &Vector3<D>) -> Vector2<D> {
+    Vector2::from_fn(|c, _| w[0] * frame[(0, c)] + w[1] * frame[(1, c)] + w[2] * frame[(2, c)])
+}
+
+/// `s q` for the known vector `q`.
+fn scaled<D: Scalar>(q: &Vector3<f64>, s: D) -> Vector3<D> {
+    Vector3::from_fn(|r, _| s * q[r])
+}
+
+/// `q · w` for the known vector `q`.
+fn along<D: Scalar>(q: &Vector3<f64>, w: &Vector3<D>) -> D {
+    w[0] * q[0] + w[1] * q[1] + w[2] * q[2]
 }
 
 /// `R_q(w)` for a tangent vector `w` at `q`.
@@ -74,7 +101,18 @@ pub fn turn<D: Scalar>(q: &Vector3<f64>, w: &Vector3<D>) -> Vector3<D> {
 /// assert!((y[2] - 0.5_f64.cos()).abs() < 1e-16);
 /// ```
 pub fn retract<D: Scalar>(retraction: Retraction, q: &Vector3<f64>, w: &Vector3<D>) -> Vector3<D> {
-    carrier(retraction, q, w) * lift(q)
+    let w = tangent(q, w);
+    let x = w.dot(&w);
+    match retraction {
+        Retraction::Cayley => (scaled(q, -x + 4.0) + w * D::from(4.0)) * (x + 4.0).recip(),
+        Retraction::Exp => scaled(q, -x * versine_ratio(x) + 1.0) + w * sine_ratio(x),
+    }
+}
+
+/// The part of `w` tangent to the sphere at the unit vector `q`: the retraction reads no other
+/// (`τ(q × w)` does not see `w`'s component along `q`).
+fn tangent<D: Scalar>(q: &Vector3<f64>, w: &Vector3<D>) -> Vector3<D> {
+    w - scaled(q, along(q, w))
 }
 
 /// `R_q⁻¹(y)`: the tangent vector at `q` that the retraction takes to the unit vector `y`, `None`
@@ -84,9 +122,8 @@ pub fn local<D: Scalar>(
     q: &Vector3<f64>,
     y: &Vector3<D>,
 ) -> Option<Vector3<D>> {
-    let q = lift(q);
-    let c = y.dot(&q);
-    let tangent = y - q * c;
+    let c = along(q, y);
+    let tangent = y - scaled(q, c);
     match retraction {
         Retraction::Cayley => {
             let denominator = c + 1.0;
@@ -96,18 +133,34 @@ pub fn local<D: Scalar>(
     }
 }
 
-/// The velocity of `R_q(w(t))` for `w(t) = B ζ(t)` with `ẇ = B ζ̇`: `τ(ω) (dτ_ω ω̇ × q)` with
-/// `ω = q × w`, `ω̇ = q × ẇ`.
+/// The velocity of `R_q(w(t))` for `w(t) = B ζ(t)` with `ẇ = B ζ̇`, the time derivative of
+/// [`retract`]'s closed form (`x = |w|²`, `θ = |w|`, `y = R_q(w)`):
+///
+/// ```text
+/// Cayley: ẏ = (4ẇ − 2(w·ẇ)(q + y)) / (4 + x)
+/// exp:    ẏ = (sin θ/θ) ẇ − (w·ẇ) ((sin θ/θ) q + ((1 − cos θ)/θ² − (θ − sin θ)/θ³) w)
+/// ```
+///
+/// (equal to `τ(ω) (dτ_ω ω̇ × q)` with `ω = q × w`, `ω̇ = q × ẇ`).
 pub fn velocity<D: Scalar>(
     retraction: Retraction,
     q: &Vector3<f64>,
     w: &Vector3<D>,
     w_dot: &Vector3<D>,
 ) -> Vector3<D> {
-    let q = lift(q);
-    let omega = q.cross(w);
-    let turning = retraction.differential(&omega) * q.cross(w_dot);
-    retraction.map(&omega) * turning.cross(&q)
+    let (w, w_dot) = (tangent(q, w), tangent(q, w_dot));
+    let (x, rate) = (w.dot(&w), w.dot(&w_dot));
+    match retraction {
+        Retraction::Cayley => {
+            let d = (x + 4.0).recip();
+            let y = (scaled(q, -x + 4.0) + w * D::from(4.0)) * d;
+            (w_dot * D::from(4.0) - (scaled(q, D::from(1.0)) + y) * (rate * 2.0)) * d
+        }
+        Retraction::Exp => {
+            let sinc = sine_ratio(x);
+            w_dot * sinc - (scaled(q, sinc) + w * (versine_ratio(x) - sine_defect_ratio(x))) * rate
+        }
+    }
 }
 
 /// The chart velocities `ζ̇` at `ζ` (chart at `q` with frame `B`) whose velocity is the tangent
@@ -188,6 +241,14 @@ mod tests {
                         / (2.0 * eps);
                     let exact = velocity(retraction, &q, &w, &e);
                     assert!((fd - exact).amax() < 1e-9, "{retraction:?} {zeta} {k}");
+                    // The closed form is the carrier's turn: τ(ω) (dτ_ω ω̇ × q).
+                    let (omega, omega_dot) = (q.cross(&w), q.cross(&e));
+                    let turning = retraction.differential(&omega) * omega_dot;
+                    let carried = retraction.map(&omega) * turning.cross(&q);
+                    assert!(
+                        (carried - exact).amax() < 1e-15,
+                        "{retraction:?} {zeta} {k}"
+                    );
                     // Tangent at the moved point.
                     assert!(exact.dot(&retract(retraction, &q, &w)).abs() < 1e-15);
                 }
