@@ -336,15 +336,7 @@ fn lie_group(c: &mut Criterion) {
             (r0, omega0),
         )
         .expect("valid scene");
-        let mut stepper = started.clone();
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                if stepper.steps() >= 100_000 {
-                    stepper = started.clone();
-                }
-                black_box(stepper.step()).expect("step")
-            })
-        });
+        restarting(&mut group, &name, started);
     }
     let mut hand = HandLgvi::new(&rigid_body::PENDULUM, h, r0, omega0);
     let mut steps = 0;
@@ -371,19 +363,24 @@ fn sphere(c: &mut Criterion) {
     for (name, space) in [("s2_cayley", Product::cayley()), ("s2_exp", Product::exp())] {
         let started =
             spherical_pendulum::on_sphere(space, Quadrature::midpoint(), h).expect("valid scene");
-        let mut stepper = started.clone();
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                if stepper.steps() >= 100_000 {
-                    stepper = started.clone();
-                }
-                black_box(stepper.step()).expect("step")
-            })
-        });
+        restarting(&mut group, name, started);
     }
     let started = spherical_pendulum::cartesian(Quadrature::midpoint(), h).expect("valid scene");
+    restarting(&mut group, "cartesian_holonomic", started);
+    group.finish();
+}
+
+/// `step()` of a copy of `started`, started over every 10⁵ steps (a measurement of millions
+/// of steps would otherwise carry the scene far from where it is measured).
+fn restarting<E: StepEquations<N> + Clone, const N: usize>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    started: Stepper<E::System, N, E>,
+) where
+    E::System: Clone,
+{
     let mut stepper = started.clone();
-    group.bench_function("cartesian_holonomic", |b| {
+    group.bench_function(name, |b| {
         b.iter(|| {
             if stepper.steps() >= 100_000 {
                 stepper = started.clone();
@@ -391,7 +388,6 @@ fn sphere(c: &mut Criterion) {
             black_box(stepper.step()).expect("step")
         })
     });
-    group.finish();
 }
 
 /// One step of the same model on the Lagrangian and the discrete Hamiltonian route: Kepler

@@ -319,9 +319,9 @@ fn the_spherical_pendulum_keeps_its_vertical_momentum_to_round_off() {
     }
 }
 
-/// The same over 10⁶ steps (`cargo test --release --test suite -- --ignored million`).
+/// The same over 10⁶ steps (`cargo test --test suite -- --ignored million`, a minute).
 #[test]
-#[ignore = "10⁶ steps: run in release"]
+#[ignore = "10⁶ steps, a minute"]
 fn the_spherical_pendulum_keeps_its_vertical_momentum_over_a_million_steps() {
     for space in [Product::cayley(), Product::exp()] {
         let drift = vertical_momentum_drift(space, Quadrature::midpoint(), 1_000_000);

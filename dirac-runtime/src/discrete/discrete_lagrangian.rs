@@ -294,7 +294,7 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
                 &next.q,
                 &mut next.p,
                 &mut next.p_carry,
-                &mut next.spin_carry,
+                &mut next.q_carry,
                 &covectors,
                 |b| self.torque(&state.q, increments, b),
             )

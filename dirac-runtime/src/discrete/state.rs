@@ -31,13 +31,13 @@ pub struct State<const N: usize, M: Manifold<N> = Vectors> {
     /// A velocity near the one at `(q, p)`: the initial velocity, then the last step's velocity
     /// at its end. It seeds the first predictor and the Legendre inversion.
     pub(crate) velocity: M::Tangent<f64>,
-    /// Round-off left out of `q` and `p` by compensated updates.
+    /// Round-off left out of `q` and `p` by compensated updates. A unit vector, projected
+    /// onto its sphere rather than summed, lends its two entries of `q_carry` to its momentum:
+    /// the first holds the component along `q` of its angular momentum that a tangent `p`
+    /// cannot hold
+    /// ([`advance_momentum_turned`](crate::space::configuration_space::ConfigurationSpace::advance_momentum_turned)).
     pub(crate) q_carry: SVector<f64, N>,
     pub(crate) p_carry: SVector<f64, N>,
-    /// What a unit vector's momentum cannot hold of its angular momentum `m = q × p + …`
-    /// (its component along `q`), where its momentum advances by torques
-    /// ([`advance_momentum_turned`](crate::space::configuration_space::ConfigurationSpace::advance_momentum_turned)).
-    pub(crate) spin_carry: SVector<f64, N>,
 }
 
 impl<const N: usize, M: Manifold<N>> State<N, M> {
@@ -51,7 +51,6 @@ impl<const N: usize, M: Manifold<N>> State<N, M> {
             velocity,
             q_carry: SVector::zeros(),
             p_carry: SVector::zeros(),
-            spin_carry: SVector::zeros(),
         }
     }
 

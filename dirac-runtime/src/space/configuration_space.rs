@@ -254,7 +254,8 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
     /// (`h Σ_i b_i (X_i × ∂L/∂X + Ẋ_i × ∂L/∂Ẋ)` over the nodes): each unit vector's angular
     /// momentum advances by its torque, `m_{k+1} = m_k + T`, and `p_{k+1} = m_{k+1} × q_{k+1}`
     /// (discrete Noether: turning the whole step by `I + ω̂` changes `L_d` by `ω · T`, so a
-    /// rotation the Lagrangian is invariant under keeps its component of `m`). `spin` carries what `p`
+    /// rotation the Lagrangian is invariant under keeps its component of `m`). `spin` (the
+    /// position's carry, whose unit-vector entries the position does not use) carries what `p`
     /// cannot hold of `m` from step to step. The other factors advance as in
     /// [`advance_momentum`](Self::advance_momentum), which this is by default.
     #[allow(clippy::too_many_arguments)]

@@ -834,7 +834,9 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
 
     /// Each unit vector's angular momentum is `m = q × p + F c + r q`, with `c = carry`'s two
     /// numbers in the frame `F` of `q`'s tangent plane (the round-off of `m → p → q × p`) and
-    /// `r = spin`'s first (the component along `q` that a tangent `p` cannot hold). Without
+    /// `r = spin`'s first (the component along `q` that a tangent `p` cannot hold; `spin` is
+    /// the position's carry, which [`advance`](ConfigurationSpace::advance) uses on the
+    /// vectors alone). Without
     /// them the spherical pendulum's vertical momentum drifts by 2e-17 of itself a step.
     fn advance_momentum_turned(
         &self,
