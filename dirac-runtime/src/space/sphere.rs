@@ -49,7 +49,7 @@ pub fn frame(q: &Vector3<f64>) -> Matrix3x2<f64> {
 
 /// The rotation `τ(q × w)` that carries `q` along the tangent vector `w` (`R_q(w) = τ(q × w) q`).
 pub fn carrier<D: Scalar>(retraction: Retraction, q: &Vector3<f64>, w: &Vector3<D>) -> Matrix3<D> {
-    retraction.map(&lift(q).cross(w))
+    retraction.map(&turn(q, w))
 }
 
 /// The infinitesimal rotation `ω = q × w` that moves `q` along `w` (the carrier to first order:
@@ -104,9 +104,14 @@ pub fn retract<D: Scalar>(retraction: Retraction, q: &Vector3<f64>, w: &Vector3<
     let w = tangent(q, w);
     let x = w.dot(&w);
     match retraction {
-        Retraction::Cayley => (scaled(q, -x + 4.0) + w * D::from(4.0)) * (x + 4.0).recip(),
+        Retraction::Cayley => cayley(q, &w, x),
         Retraction::Exp => scaled(q, -x * versine_ratio(x) + 1.0) + w * sine_ratio(x),
     }
+}
+
+/// `((4 − x) q + 4w) / (4 + x)`: the Cayley retraction at the tangent `w` with `x = |w|²`.
+fn cayley<D: Scalar>(q: &Vector3<f64>, w: &Vector3<D>, x: D) -> Vector3<D> {
+    (scaled(q, -x + 4.0) + w * D::from(4.0)) * (x + 4.0).recip()
 }
 
 /// The part of `w` tangent to the sphere at the unit vector `q`: the retraction reads no other
@@ -152,9 +157,9 @@ pub fn velocity<D: Scalar>(
     let (x, rate) = (w.dot(&w), w.dot(&w_dot));
     match retraction {
         Retraction::Cayley => {
-            let d = (x + 4.0).recip();
-            let y = (scaled(q, -x + 4.0) + w * D::from(4.0)) * d;
-            (w_dot * D::from(4.0) - (scaled(q, D::from(1.0)) + y) * (rate * 2.0)) * d
+            let y = cayley(q, &w, x);
+            (w_dot * D::from(4.0) - (scaled(q, D::from(1.0)) + y) * (rate * 2.0))
+                * (x + 4.0).recip()
         }
         Retraction::Exp => {
             let sinc = sine_ratio(x);
@@ -215,10 +220,6 @@ fn velocity_map(
 /// however long the run.
 pub fn normalised(q: &Vector3<f64>) -> Vector3<f64> {
     q / q.norm()
-}
-
-fn lift<D: Scalar>(q: &Vector3<f64>) -> Vector3<D> {
-    q.map(D::from)
 }
 
 #[cfg(test)]
