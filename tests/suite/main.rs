@@ -20,6 +20,7 @@ mod extremes;
 mod field;
 mod first_order;
 mod golden;
+mod group_derivatives;
 mod hamiltonian;
 mod interconnection;
 mod invariants;

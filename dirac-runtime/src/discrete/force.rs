@@ -5,8 +5,9 @@
 
 use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
 
+use crate::base::scalar::Scalar;
 use crate::space::configuration_space::{ConfigurationSpace, Point, StepCovectors};
-use crate::space::manifold::Vectors;
+use crate::space::manifold::{Manifold, Vectors};
 use num_dual::{Dual64, HyperDual64};
 
 use crate::discrete::discrete_lagrangian::{DiscreteLagrangian, SlotBlocks};
@@ -65,6 +66,50 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
             }
         }
         (StepCovectors { impulse, end }, scale)
+    }
+
+    /// The forces on every point of the step, `f_j = h Σ_i b_i ℓ_j(c_i) F̃_i` (`j = 0..=s`), in the
+    /// chart at `base` carried by `g(δ)` to a start at `R_q(δ)`
+    /// ([`ConfigurationSpace::carried`]), over any scalar: their derivatives in `δ`, the
+    /// points `ξ_1..ξ_s` and the inputs `u` by dual numbers. `None` where the space's charts
+    /// are not carried. `t` is the time at the start of the step.
+    pub(crate) fn carried_forces<D: Scalar>(
+        &self,
+        base: &Point<C, N, f64>,
+        points: &[SVector<D, N>],
+        delta: &SVector<D, N>,
+        t: f64,
+        inputs: &[D],
+    ) -> Option<Vec<SVector<D, N>>> {
+        let quad = self.quadrature();
+        let (h, s, space) = (self.h(), quad.degree(), self.space());
+        let zero = D::from(0.0);
+        let mut forces = vec![SVector::<D, N>::from_element(zero); s + 1];
+        for (i, (&b, &c)) in quad.weights().iter().zip(quad.nodes()).enumerate() {
+            let mut xi = SVector::<D, N>::from_element(zero);
+            let mut xi_dot = SVector::<D, N>::from_element(zero);
+            for (j, point) in points.iter().enumerate() {
+                let (a, d) = (quad.ell(i, j + 1), quad.ell_prime(i, j + 1) / h);
+                xi += point * D::from(a);
+                xi_dot += point * D::from(d);
+            }
+            let point = space.retract(base, &xi);
+            let v = space.push_forward(base, &xi, &xi_dot);
+            let (q, v) = space.carried(base, delta, &point, &v)?;
+            let force = self.system().force(&q, &v, t + c * h, inputs);
+            // F̃: the force paired with the carried chart's coordinate directions.
+            let mut pulled = SVector::<D, N>::from_element(zero);
+            for r in 0..N {
+                let e = SVector::<D, N>::from_fn(|k, _| D::from(if k == r { 1.0 } else { 0.0 }));
+                let direction = space.push_forward(base, &xi, &e);
+                let (_, direction) = space.carried(base, delta, &point, &direction)?;
+                pulled[r] = <C::Manifold as Manifold<N>>::pair(&force, &direction);
+            }
+            for (j, f) in forces.iter_mut().enumerate() {
+                *f += pulled * D::from(h * b * quad.ell(i, j));
+            }
+        }
+        Some(forces)
     }
 
     /// The forces' work over the step on each chart coordinate `r`,

@@ -15,6 +15,7 @@ use crate::model::hamiltonian_system::HamiltonianSystem;
 use crate::model::system::DiracSystem;
 use crate::quadrature::Quadrature;
 use crate::space::configuration_space::{ConfigurationSpace, Point};
+use crate::space::manifold::Manifold;
 
 /// A function of `(q, v)` over any scalar: the model's Lagrangian, or the Lagrangian in a chart.
 pub(crate) trait PhaseFunction<const N: usize> {
@@ -167,11 +168,21 @@ where
             SVector::<Dual<N>, N>::from_fn(|i, _| Dual::<N>::new(0.0, Derivative::some(unit(i))));
         let lifted: Vec<SVector<Dual<N>, N>> =
             points.iter().map(|x| x.map(Dual::<N>::from)).collect();
-        moving_action(system, space, base, quadrature, h, &eta, &lifted, |term| {
-            let g = gradient(&term);
-            out.row += g;
-            out.magnitude += g.abs();
-        });
+        moving_action(
+            system,
+            space,
+            base,
+            quadrature,
+            h,
+            &eta,
+            &lifted,
+            None,
+            |term| {
+                let g = gradient(&term);
+                out.row += g;
+                out.magnitude += g.abs();
+            },
+        );
         return out;
     }
     type H<const N: usize> = HyperDualSVec64<N, N>;
@@ -202,23 +213,132 @@ where
             })
             .collect();
         let (mut slot, mut block) = (SVector::zeros(), SMatrix::zeros());
-        moving_action(system, space, base, quadrature, h, &eta, &seeded, |term| {
-            let g = term.eps1.unwrap_generic(Const::<N>, U1);
-            if m == 0 {
-                out.row += g;
-                out.magnitude += g.abs();
-            }
-            slot += term.eps2.unwrap_generic(U1, Const::<N>).transpose();
-            block += term.eps1eps2.unwrap_generic(Const::<N>, Const::<N>);
-        });
+        moving_action(
+            system,
+            space,
+            base,
+            quadrature,
+            h,
+            &eta,
+            &seeded,
+            None,
+            |term| {
+                let g = term.eps1.unwrap_generic(Const::<N>, U1);
+                if m == 0 {
+                    out.row += g;
+                    out.magnitude += g.abs();
+                }
+                slot += term.eps2.unwrap_generic(U1, Const::<N>).transpose();
+                block += term.eps1eps2.unwrap_generic(Const::<N>, Const::<N>);
+            },
+        );
         out.slots.push(slot);
         out.blocks.push(block);
     }
     out
 }
 
+/// The second derivatives of a step's action that its step-map derivatives need beyond
+/// Newton's Jacobian, for the model `system` on `space` from `base` with the step's points
+/// `points` (`ξ_1..ξ_s` in the chart at `base`). With rows `r_0 = ∂Λ/∂η` at `η = 0` (see
+/// [`MovingRow`]) and `r_j = ∂L_d/∂ξ_j` (`j = 1..=s`), and the start moved to `R_q(δ)` with the
+/// chart carried there by `g(δ)` ([`ConfigurationSpace::carried`]), one hyper-dual pass per
+/// block.
+pub(crate) struct StartBlocks<const N: usize> {
+    /// `∂r_j/∂δ` (`j = 0..=s`; rows: `r_j`'s components).
+    pub start: Vec<SMatrix<f64, N, N>>,
+    /// `r_s = ∂L_d/∂ξ_s`, the end covector.
+    pub end: SVector<f64, N>,
+    /// `∂r_s/∂ξ_m` (`m = 1..=s`).
+    pub end_blocks: Vec<SMatrix<f64, N, N>>,
+}
+
+/// [`StartBlocks`] of a step (`None` where the space's charts are not carried).
+pub(crate) fn start_blocks<S, C, const N: usize>(
+    system: &S,
+    space: &C,
+    base: &Point<C, N, f64>,
+    quadrature: &Quadrature,
+    h: f64,
+    points: &[SVector<f64, N>],
+) -> Option<StartBlocks<N>>
+where
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+{
+    type H<const N: usize> = HyperDualSVec64<N, N>;
+    let unit = |i: usize| SVector::<f64, N>::from_fn(|r, _| if r == i { 1.0 } else { 0.0 });
+    // A number seeded along component `first` of the first direction and `second` of the second.
+    let seeded = |re: f64, first: Option<usize>, second: Option<usize>| {
+        H::<N>::new(
+            re,
+            Derivative::new(first.map(unit)),
+            Derivative::new(second.map(|c| unit(c).transpose())),
+            Derivative::none(),
+        )
+    };
+    // Row `row` (0: η; j: ξ_j) against `column` (0: δ; m: ξ_m): `(r_row, ∂r_row/∂column)`.
+    let pass = |row: usize, column: usize| -> Option<(SVector<f64, N>, SMatrix<f64, N, N>)> {
+        let eta = SVector::<H<N>, N>::from_fn(|i, _| seeded(0.0, (row == 0).then_some(i), None));
+        let delta = SVector::<H<N>, N>::from_fn(|i, _| seeded(0.0, None, Some(i)));
+        space.carried(
+            base,
+            &delta,
+            &space.retract(base, &eta),
+            &C::Manifold::zero(),
+        )?;
+        let moved: Vec<SVector<H<N>, N>> = points
+            .iter()
+            .enumerate()
+            .map(|(j, x)| {
+                SVector::from_fn(|c, _| {
+                    seeded(
+                        x[c],
+                        (row == j + 1).then_some(c),
+                        (column == j + 1).then_some(c),
+                    )
+                })
+            })
+            .collect();
+        let start = (column == 0).then_some(&delta);
+        let (mut value, mut block) = (SVector::zeros(), SMatrix::zeros());
+        moving_action(
+            system,
+            space,
+            base,
+            quadrature,
+            h,
+            &eta,
+            &moved,
+            start,
+            |term| {
+                value += term.eps1.unwrap_generic(Const::<N>, U1);
+                block += term.eps1eps2.unwrap_generic(Const::<N>, Const::<N>);
+            },
+        );
+        Some((value, block))
+    };
+    let s = points.len();
+    let start = (0..=s)
+        .map(|j| pass(j, 0).map(|(_, block)| block))
+        .collect::<Option<Vec<_>>>()?;
+    let mut end = SVector::zeros();
+    let mut end_blocks = Vec::with_capacity(s);
+    for m in 1..=s {
+        let (value, block) = pass(s, m)?;
+        end = value;
+        end_blocks.push(block);
+    }
+    Some(StartBlocks {
+        start,
+        end,
+        end_blocks,
+    })
+}
+
 /// The terms `h b_i ℓ^{R_q(η)}(ζ_i, ζ̇_i)` of `Λ(η; ξ_1..ξ_s)` (see [`MovingRow`]), handed to
-/// `term` node by node.
+/// `term` node by node; with `start`, of the step whose chart is carried by `g(δ)` to a start
+/// at `R_q(δ)` ([`ConfigurationSpace::carried`]: every point and velocity moved by `g(δ)`).
 #[allow(clippy::too_many_arguments)]
 fn moving_action<S, C, D, const N: usize>(
     system: &S,
@@ -228,6 +348,7 @@ fn moving_action<S, C, D, const N: usize>(
     h: f64,
     eta: &SVector<D, N>,
     points: &[SVector<D, N>],
+    start: Option<&SVector<D, N>>,
     mut term: impl FnMut(D),
 ) where
     S: DiracSystem<N, C::Manifold>,
@@ -251,7 +372,11 @@ fn moving_action<S, C, D, const N: usize>(
         }
         let q = space.retract_moved(base, eta, &zeta);
         let v = space.push_forward_moved(base, eta, &zeta, &rate);
-        term(system.lagrangian(&q, &v) * (h * b));
+        let value = match start.and_then(|delta| space.carried(base, delta, &q, &v)) {
+            Some((q, v)) => system.lagrangian(&q, &v),
+            None => system.lagrangian(&q, &v),
+        };
+        term(value * (h * b));
     }
 }
 

@@ -313,6 +313,35 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
         let _ = q;
         xi - eta
     }
+
+    /// `(g x, g v)`: the point `x` and a tangent vector `v` at it moved by the motion `g(δ)`
+    /// that carries the chart centred at `q` to a chart centred at `R_q(δ)`,
+    /// `R_{R_q(δ)}(ζ) = g(δ) R_q(ζ)`, to first order in `δ` (the step map's derivatives move
+    /// the start of a step so; with dual numbers whose `δ`-parts square to zero, exactly). On
+    /// vectors a translation by `δ`; on a rotation the turn `q τ(δ) qᵀ` on the left (body
+    /// velocities unchanged); on a unit vector the carrier `τ(q × Bδ)`. `None` where the
+    /// space's charts are not carried so (the default).
+    fn carried<D: Scalar>(
+        &self,
+        q: &Point<Self, N, f64>,
+        delta: &SVector<D, N>,
+        x: &Point<Self, N, D>,
+        v: &Tangent<Self, N, D>,
+    ) -> Option<(Point<Self, N, D>, Tangent<Self, N, D>)> {
+        let _ = (q, delta, x, v);
+        None
+    }
+
+    /// [`local`](Self::local) of a point over dual numbers: `R_q⁻¹(y)`, `None` outside the chart
+    /// or where the space does not offer it (the default).
+    fn local_over<D: Scalar>(
+        &self,
+        q: &Point<Self, N, f64>,
+        y: &Point<Self, N, D>,
+    ) -> Option<SVector<D, N>> {
+        let _ = (q, y);
+        None
+    }
 }
 
 pub(crate) mod sealed {
@@ -461,6 +490,24 @@ impl<const N: usize> ConfigurationSpace<N> for Euclidean {
         compensated_add(p, carry, &covectors.impulse);
         Some(())
     }
+
+    fn carried<D: Scalar>(
+        &self,
+        _q: &SVector<f64, N>,
+        delta: &SVector<D, N>,
+        x: &SVector<D, N>,
+        v: &SVector<D, N>,
+    ) -> Option<(SVector<D, N>, SVector<D, N>)> {
+        Some((x + delta, *v))
+    }
+
+    fn local_over<D: Scalar>(
+        &self,
+        q: &SVector<f64, N>,
+        y: &SVector<D, N>,
+    ) -> Option<SVector<D, N>> {
+        Some(SVector::from_fn(|i, _| y[i] - q[i]))
+    }
 }
 
 /// The positive orthant as the multiplicative group `R₊ⁿ`, with `R_q(ξ) = q ⊙ exp(ξ)` (left
@@ -527,6 +574,30 @@ impl<const N: usize> ConfigurationSpace<N> for Positive {
         covector: &SVector<f64, N>,
     ) -> Option<SVector<f64, N>> {
         covector_by_tangent_map(self, q, xi, covector)
+    }
+
+    /// `R_{R_q(δ)}(ζ) = exp(δ) ⊙ R_q(ζ)`: points and velocities scale by `exp δ`.
+    fn carried<D: Scalar>(
+        &self,
+        _q: &SVector<f64, N>,
+        delta: &SVector<D, N>,
+        x: &SVector<D, N>,
+        v: &SVector<D, N>,
+    ) -> Option<(SVector<D, N>, SVector<D, N>)> {
+        let scale = delta.map(|d| d.exp());
+        Some((x.component_mul(&scale), v.component_mul(&scale)))
+    }
+
+    fn local_over<D: Scalar>(
+        &self,
+        q: &SVector<f64, N>,
+        y: &SVector<D, N>,
+    ) -> Option<SVector<D, N>> {
+        let ratio = SVector::<D, N>::from_fn(|i, _| y[i] / q[i]);
+        ratio
+            .iter()
+            .all(|r| r.re() > 0.0 && r.re().is_finite())
+            .then(|| ratio.map(|r| r.ln()))
     }
 }
 

@@ -933,6 +933,69 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
         }
         out
     }
+
+    fn carried<D: Scalar>(
+        &self,
+        q: &Configuration<f64, K, A, B>,
+        delta: &SVector<D, N>,
+        x: &Configuration<D, K, A, B>,
+        v: &Rates<D, K, A, B>,
+    ) -> Option<(Configuration<D, K, A, B>, Rates<D, K, A, B>)> {
+        const { dimension::<N, K, A, B>() };
+        let (mut x, mut v) = (x.clone(), v.clone());
+        for i in 0..K {
+            x.vector[i] += delta[i];
+        }
+        for a in 0..A {
+            // q τ(δ) qᵀ = I + (q δ)^ to first order: the turn δ read in space.
+            let turn = rows3(delta, Self::rotation_at(a));
+            let spatial = Vector3::from_fn(|r, _| {
+                turn[0] * q.rotation[a][(r, 0)]
+                    + turn[1] * q.rotation[a][(r, 1)]
+                    + turn[2] * q.rotation[a][(r, 2)]
+            });
+            x.rotation[a] += rotation::product(&rotation::hat(&spatial), &x.rotation[a]);
+        }
+        for b in 0..B {
+            let base = &q.direction[b];
+            let turn = sphere::turn(
+                base,
+                &sphere::in_frame(&sphere::frame(base), &rows2(delta, Self::direction_at(b))),
+            );
+            x.direction[b] += turn.cross(&x.direction[b]);
+            v.direction[b] += turn.cross(&v.direction[b]);
+        }
+        Some((x, v))
+    }
+
+    fn local_over<D: Scalar>(
+        &self,
+        q: &Configuration<f64, K, A, B>,
+        y: &Configuration<D, K, A, B>,
+    ) -> Option<SVector<D, N>> {
+        const { dimension::<N, K, A, B>() };
+        let tau = self.retraction;
+        let mut xi = SVector::<D, N>::from_element(D::from(0.0));
+        for i in 0..K {
+            xi[i] = y.vector[i] - q.vector[i];
+        }
+        for a in 0..A {
+            let relative = rotation::product_known(&q.rotation[a].transpose(), &y.rotation[a]);
+            let x = tau.inverse(&relative)?;
+            for k in 0..3 {
+                xi[Self::rotation_at(a) + k] = x[k];
+            }
+        }
+        for b in 0..B {
+            let base = &q.direction[b];
+            let w = sphere::local(tau, base, &y.direction[b])?;
+            let z = sphere::frame_coordinates(&sphere::frame(base), &w);
+            for k in 0..2 {
+                xi[Self::direction_at(b) + k] = z[k];
+            }
+        }
+        Some(xi)
+    }
 }
 
 #[cfg(test)]

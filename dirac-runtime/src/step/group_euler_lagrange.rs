@@ -22,7 +22,10 @@
 //! `(T_{ξ_s} R)ᵀ p_{k+1} = ∂L_d/∂ξ_s + f_s + (1 − σ) Ãᵀμ`: for a rotation,
 //! `Π_{k+1} = dτ_{ξ_s}⁻ᵀ (∂L_d/∂ξ_s + …)`.
 //!
-//! Holonomic constraints and step-map derivatives are not offered on these spaces yet.
+//! The step map's derivatives `A` and `B` are read in the tangent chart (see
+//! [`group_linearisation`](crate::step::group_linearisation)) for models without one-forms or
+//! junctions. Holonomic constraints are not offered on these spaces: their differentials are
+//! held as one-forms.
 
 use nalgebra::{DMatrix, DVector, SVector};
 
@@ -39,6 +42,8 @@ use crate::solve::newton::{Newton, NewtonFailure};
 use crate::space::configuration_space::{ConfigurationSpace, Point, StepCovectors, Tangent};
 use crate::space::manifold::Manifold;
 use crate::step::dense_output::{ChartPath, Sample, chart_path};
+use crate::step::group_linearisation;
+use crate::step::step_derivatives::StepDerivatives;
 use crate::step::step_equations::{State, StepEquations, StepWork};
 
 /// The discrete Euler–Lagrange equations of a [`DiracSystem`] on a configuration space `C` whose
@@ -620,6 +625,31 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             .ok_or_else(|| not_finite("initial velocity read in the chart"))?;
         self.covector(q, &zero, self.chart_momentum(q, &zero, &xi_dot))
             .ok_or_else(|| not_finite("initial momentum"))
+    }
+
+    /// `A` and `B` in the cotangent lifts of the charts centred at `q_k` and `q_{k+1}` (see
+    /// [`group_linearisation`](crate::step::group_linearisation)): perturbations
+    /// `(δ, dμ)` of `(R_{q_k}(δ), p)` with `(T_δ R_{q_k})ᵀ p = μ`. Refused with `Unsupported` for
+    /// one-forms and for a component of an interconnection.
+    fn linearise(
+        &self,
+        state: &State<N, C::Manifold>,
+        x: &DVector<f64>,
+        newton: &Newton,
+    ) -> Result<StepDerivatives<N>, DiracError> {
+        if S::ONE_FORMS > 0 {
+            return Err(DiracError::Unsupported(
+                "derivatives of the step map with constraint one-forms on rotations or unit \
+                 vectors"
+                    .into(),
+            ));
+        }
+        if self.coupling.is_some() {
+            return Err(DiracError::Unsupported(
+                "derivatives of the step map of one component of an interconnection".into(),
+            ));
+        }
+        group_linearisation::linearise(&self.discrete, &self.layout, &self.inputs, state, x, newton)
     }
 
     fn inputs(&self) -> &[f64] {

@@ -11,6 +11,7 @@ pub mod dense_output;
 pub mod euler_lagrange;
 pub mod field;
 pub mod group_euler_lagrange;
+pub(crate) mod group_linearisation;
 pub mod hamilton;
 pub mod ledger;
 pub mod modular;

@@ -1,0 +1,349 @@
+//! Derivatives of the step map on rotations and unit vectors: `A = ∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)`
+//! and `B = ∂(q_{k+1}, p_{k+1})/∂u` of a [`GroupEulerLagrange`](crate::group_euler_lagrange::GroupEulerLagrange)
+//! step, read in the tangent chart.
+//!
+//! **Coordinates.** Near a point `q` the state is read in the cotangent lift of the chart
+//! centred at `q`: `(ζ, μ) ↦ (R_q(ζ), p)` with `(T_ζ R_q)ᵀ p = μ`. These coordinates are
+//! canonical, so `A` of a conservative model is symplectic for `J = [[0, I], [−I, 0]]`; at
+//! `ζ = 0`, `μ` is the momentum read in the chart (on a rotation, the body angular momentum).
+//! `A` maps perturbations `(δ, dμ_k)` in the chart at `q_k` to `(ε, dμ_{k+1})` in the chart at
+//! `q_{k+1}`, the chart the next step starts in, so the derivatives of consecutive steps
+//! compose.
+//!
+//! **The moved start.** A step from `R_q(δ)` is the step from `q` in the chart carried there by
+//! the motion `g(δ)`, `R_{R_q(δ)}(ζ) = g(δ) R_q(ζ)`
+//! ([`carried`](crate::configuration_space::ConfigurationSpace::carried): a translation, a turn
+//! on the left of a rotation, the carrier of a unit vector). Its residual is the step's own
+//! with every point and velocity of the path moved by `g(δ)`, so its derivative in `δ` comes
+//! from one more seed of the dual numbers, and its unknowns `ξ'` live in the carried chart.
+//! With `ξ'(ζ) = R_q⁻¹(g(δ)⁻¹ R_q(ζ))` the carried chart's coordinates of a point, the momentum
+//! read there is `π' = C⁻ᵀ μ`, `C = ∂ξ'/∂ζ` at `ζ = δ` (the identity at `δ = 0`), so
+//!
+//! ```text
+//! dπ' = dμ − P dδ,     P_ra = Σ_m π_m ∂²ξ'_m/∂ζ_r∂δ_a.
+//! ```
+//!
+//! **The implicit function theorem.** The residual `r(δ, ξ', π', u)` (rows `π' + D1 L_d + f_0`
+//! and `∂L_d/∂ξ_j + f_j`, `j = 1..s−1`) vanishes along the perturbed steps, so
+//! `dξ' = −J⁻¹ (∂r/∂δ dδ + [dπ'; 0] + ∂r/∂u du)` with Newton's Jacobian `J = ∂r/∂ξ'` factorised
+//! at the root.
+//!
+//! **The end.** The new point is `g(δ) R_q(ξ'_s)`, read in the chart at `q_{k+1}` as
+//! `ε = R_{q_{k+1}}⁻¹(g(δ) R_q(ξ'_s))`. Its momentum has the end covector
+//! `E = ∂L_d/∂ξ'_s + f_s` as its pull-back to the carried chart, so
+//! `μ_{k+1} = Zᵀ E` with `Z = ∂ξ'/∂z` at `z = 0` for `ξ'(z) = R_q⁻¹(g(δ)⁻¹ R_{q_{k+1}}(ε + z))`:
+//!
+//! ```text
+//! dμ_{k+1} = Z₀ᵀ dE + P_δ dδ + P_ε dε,   (P_δ)_ra = Σ_m E_m ∂²ξ'_m/∂z_r∂δ_a,  likewise P_ε.
+//! ```
+//!
+//! Every second derivative is taken by hyper-dual numbers, exact to round-off; the tests check
+//! `A` and `B` against central differences through the retraction, `A`'s symplecticity, and the
+//! derivatives on `Rⁿ` against the vector step's.
+
+use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
+use num_dual::{Derivative, HyperDualSVec64};
+
+use crate::base::error::DiracError;
+use crate::discrete::discrete_lagrangian::DiscreteLagrangian;
+use crate::discrete::layout::Layout;
+use crate::discrete::state::State;
+use crate::model::derivatives::{Dual, start_blocks};
+use crate::model::system::DiracSystem;
+use crate::solve::newton::Newton;
+use crate::space::configuration_space::{ConfigurationSpace, Point};
+use crate::space::manifold::Manifold;
+use crate::step::step_derivatives::StepDerivatives;
+
+/// The derivatives of the step from `state` solved by `x` (Newton's root, its Jacobian
+/// factorised there) of a model without one-forms or junctions (see the [module](self)).
+pub(crate) fn linearise<S, C, const N: usize>(
+    discrete: &DiscreteLagrangian<S, N, C>,
+    layout: &Layout,
+    inputs: &[f64],
+    state: &State<N, C::Manifold>,
+    x: &DVector<f64>,
+    newton: &Newton,
+) -> Result<StepDerivatives<N>, DiracError>
+where
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+{
+    let not_carried = || {
+        DiracError::Unsupported(
+            "derivatives of the step map on a space whose charts no motion carries".into(),
+        )
+    };
+    let outside =
+        || DiracError::OutsideChart("the step's end, read in the chart at the new point".into());
+    let (space, system) = (discrete.space(), discrete.system());
+    let (quadrature, h) = (discrete.quadrature(), discrete.h());
+    let s = layout.points();
+    let q = &state.q;
+    let points: Vec<SVector<f64, N>> = (1..=s)
+        .map(|j| x.fixed_rows::<N>(layout.point(j)).into_owned())
+        .collect();
+    let end_point = points[s - 1];
+    let mut next = state.q.clone();
+    let mut carry = state.q_carry;
+    space.advance(&mut next, &mut carry, &end_point);
+
+    let action = start_blocks(system, space, q, quadrature, h, &points).ok_or_else(not_carried)?;
+    let forces = if S::FORCES {
+        force_derivatives(discrete, q, &points, state.t, inputs).ok_or_else(not_carried)?
+    } else {
+        ForceDerivatives::none(s, inputs.len())
+    };
+    let pi = space.pull_back(q, &SVector::zeros(), &state.p);
+    let (_, reading, _) = chart_change(space, q, q, &pi).ok_or_else(outside)?;
+    let end = action.end + forces.end;
+    let (turn, end_start, end_end) = chart_change(space, q, &next, &end).ok_or_else(outside)?;
+    let (position_start, position_end) =
+        end_position(space, q, &next, &end_point).ok_or_else(outside)?;
+
+    // ∂r/∂z for z = (δ, μ_k, u), one column each.
+    let n_in = inputs.len();
+    let parameters = 2 * N + n_in;
+    let mut dx = DMatrix::zeros(layout.len(), parameters);
+    for j in 0..s {
+        let mut block = action.start[j] + forces.start[j];
+        if j == 0 {
+            block -= reading;
+        }
+        let row = layout.point(j + 1);
+        dx.view_mut((row, 0), (N, N)).copy_from(&block);
+        dx.view_mut((row, 2 * N), (N, n_in))
+            .copy_from(&forces.inputs[j]);
+    }
+    for i in 0..N {
+        dx[(i, N + i)] = 1.0;
+    }
+    newton.implicit_derivatives(x, &mut dx).ok_or_else(|| {
+        DiracError::Unsupported(
+            "derivatives of a step whose Jacobian is not factorised at its root".into(),
+        )
+    })?;
+
+    let end_moving = action.start[s] + forces.start[s];
+    let mut derivatives = StepDerivatives::<N> {
+        q_q: SMatrix::zeros(),
+        q_p: SMatrix::zeros(),
+        p_q: SMatrix::zeros(),
+        p_p: SMatrix::zeros(),
+        q_u: DMatrix::zeros(N, n_in),
+        p_u: DMatrix::zeros(N, n_in),
+        pivot_ratio: newton.pivot_ratio(),
+    };
+    for c in 0..parameters {
+        let d_end = dx.fixed_view::<N, 1>(layout.end_point(), c).into_owned();
+        let mut d_position = position_end * d_end;
+        let mut d_covector = SVector::<f64, N>::zeros();
+        for m in 0..s {
+            let d_point = dx.fixed_view::<N, 1>(layout.point(m + 1), c);
+            d_covector += (action.end_blocks[m] + forces.end_blocks[m]) * d_point;
+        }
+        if c < N {
+            d_position += position_start.column(c);
+            d_covector += end_moving.column(c);
+        } else if c >= 2 * N {
+            d_covector += forces.inputs[s].column(c - 2 * N);
+        }
+        let mut d_momentum = turn.transpose() * d_covector + end_end * d_position;
+        if c < N {
+            d_momentum += end_start.column(c);
+        }
+        let d = &mut derivatives;
+        match c {
+            c if c < N => {
+                d.q_q.set_column(c, &d_position);
+                d.p_q.set_column(c, &d_momentum);
+            }
+            c if c < 2 * N => {
+                d.q_p.set_column(c - N, &d_position);
+                d.p_p.set_column(c - N, &d_momentum);
+            }
+            c => {
+                d.q_u.set_column(c - 2 * N, &d_position);
+                d.p_u.set_column(c - 2 * N, &d_momentum);
+            }
+        }
+    }
+    let blocks = [
+        derivatives.q_q,
+        derivatives.q_p,
+        derivatives.p_q,
+        derivatives.p_p,
+    ];
+    let finite = blocks.iter().all(|m| m.iter().all(|v| v.is_finite()))
+        && derivatives
+            .q_u
+            .iter()
+            .chain(derivatives.p_u.iter())
+            .all(|v| v.is_finite());
+    if !finite {
+        return Err(DiracError::NonFinite {
+            what: "a derivative of the step map".into(),
+            value: f64::NAN,
+        });
+    }
+    Ok(derivatives)
+}
+
+/// The forces' part of the derivatives: `∂f_j/∂δ` (`j = 0..=s`), `f_s`, `∂f_s/∂ξ_m`
+/// (`m = 1..=s`) and `∂f_j/∂u`.
+struct ForceDerivatives<const N: usize> {
+    start: Vec<SMatrix<f64, N, N>>,
+    end: SVector<f64, N>,
+    end_blocks: Vec<SMatrix<f64, N, N>>,
+    inputs: Vec<DMatrix<f64>>,
+}
+
+impl<const N: usize> ForceDerivatives<N> {
+    /// A model without forces.
+    fn none(s: usize, inputs: usize) -> Self {
+        Self {
+            start: vec![SMatrix::zeros(); s + 1],
+            end: SVector::zeros(),
+            end_blocks: vec![SMatrix::zeros(); s],
+            inputs: vec![DMatrix::zeros(N, inputs); s + 1],
+        }
+    }
+}
+
+/// `e_i` as the derivative part of a dual number.
+fn unit<const N: usize>(i: usize) -> SVector<f64, N> {
+    SVector::from_fn(|r, _| if r == i { 1.0 } else { 0.0 })
+}
+
+/// `x` as dual numbers seeded along their own components.
+fn seeded<const N: usize>(x: &SVector<f64, N>) -> SVector<Dual<N>, N> {
+    SVector::from_fn(|i, _| Dual::<N>::new(x[i], Derivative::some(unit(i))))
+}
+
+/// The Jacobian of dual numbers (rows: the numbers).
+fn jacobian<const N: usize>(f: &SVector<Dual<N>, N>) -> SMatrix<f64, N, N> {
+    SMatrix::from_fn(|i, j| f[i].eps.unwrap_generic(Const::<N>, U1)[j])
+}
+
+/// [`ForceDerivatives`] by first-order duals through
+/// [`carried_forces`](DiscreteLagrangian::carried_forces); `None` where the charts are not
+/// carried.
+fn force_derivatives<S, C, const N: usize>(
+    discrete: &DiscreteLagrangian<S, N, C>,
+    q: &Point<C, N, f64>,
+    points: &[SVector<f64, N>],
+    t: f64,
+    inputs: &[f64],
+) -> Option<ForceDerivatives<N>>
+where
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+{
+    let s = points.len();
+    let constant: Vec<SVector<Dual<N>, N>> = points.iter().map(|x| x.map(Dual::from)).collect();
+    let held: Vec<Dual<N>> = inputs.iter().map(|&u| Dual::from(u)).collect();
+    let still = SVector::from_element(Dual::from(0.0));
+    let moved = discrete.carried_forces(q, &constant, &seeded(&SVector::zeros()), t, &held)?;
+    let mut out = ForceDerivatives::none(s, inputs.len());
+    for (j, f) in moved.iter().enumerate() {
+        out.start[j] = jacobian(f);
+    }
+    out.end = moved[s].map(|f| f.re);
+    for m in 0..s {
+        let mut varied = constant.clone();
+        varied[m] = seeded(&points[m]);
+        let f = discrete.carried_forces(q, &varied, &still, t, &held)?;
+        out.end_blocks[m] = jacobian(&f[s]);
+    }
+    for first in (0..inputs.len()).step_by(N) {
+        let chunk = first..(first + N).min(inputs.len());
+        let lifted: Vec<Dual<N>> = inputs
+            .iter()
+            .enumerate()
+            .map(|(k, &u)| match chunk.contains(&k) {
+                true => Dual::<N>::new(u, Derivative::some(unit(k - first))),
+                false => Dual::from(u),
+            })
+            .collect();
+        let f = discrete.carried_forces(q, &constant, &still, t, &lifted)?;
+        for (j, f) in f.iter().enumerate() {
+            let d = jacobian(f);
+            for k in chunk.clone() {
+                out.inputs[j].set_column(k, &d.column(k - first));
+            }
+        }
+    }
+    Some(out)
+}
+
+/// For `ξ'(δ, ε, z) = R_q⁻¹(g(δ)⁻¹ R_target(ε + z))`, the carried chart's coordinates of the
+/// point at `ε + z` of the chart at `target`: `(Z₀, P_δ, P_ε)` with `Z₀ = ∂ξ'/∂z`,
+/// `(P_δ)_ra = Σ_m w_m ∂²ξ'_m/∂z_r∂δ_a` and `P_ε` likewise, at `δ = ε = z = 0`. `None` outside
+/// the chart at `q` or where the charts are not carried.
+#[allow(clippy::type_complexity)]
+fn chart_change<C: ConfigurationSpace<N>, const N: usize>(
+    space: &C,
+    q: &Point<C, N, f64>,
+    target: &Point<C, N, f64>,
+    w: &SVector<f64, N>,
+) -> Option<(SMatrix<f64, N, N>, SMatrix<f64, N, N>, SMatrix<f64, N, N>)> {
+    type H<const N: usize> = HyperDualSVec64<N, N>;
+    let first = |i: usize| {
+        H::<N>::new(
+            0.0,
+            Derivative::some(unit(i)),
+            Derivative::none(),
+            Derivative::none(),
+        )
+    };
+    let second = |i: usize| {
+        H::<N>::new(
+            0.0,
+            Derivative::none(),
+            Derivative::some(unit::<N>(i).transpose()),
+            Derivative::none(),
+        )
+    };
+    let zero = SVector::<H<N>, N>::from_element(H::<N>::from(0.0));
+    let z = SVector::<H<N>, N>::from_fn(|i, _| first(i));
+    let moved = SVector::<H<N>, N>::from_fn(|i, _| second(i));
+    let mut turn = SMatrix::<f64, N, N>::zeros();
+    let mut pairs = [SMatrix::<f64, N, N>::zeros(); 2];
+    for (k, pair) in pairs.iter_mut().enumerate() {
+        let (delta, eps) = if k == 0 {
+            (&moved, &zero)
+        } else {
+            (&zero, &moved)
+        };
+        let y = space.retract(target, &(eps + z));
+        let (y, _) = space.carried(q, &(-delta), &y, &C::Manifold::zero())?;
+        let xi = space.local_over(q, &y)?;
+        for m in 0..N {
+            let d1 = xi[m].eps1.unwrap_generic(Const::<N>, U1);
+            let d2 = xi[m].eps1eps2.unwrap_generic(Const::<N>, Const::<N>);
+            turn.set_row(m, &d1.transpose());
+            *pair += d2 * w[m];
+        }
+    }
+    let [start, end] = pairs;
+    Some((turn, start, end))
+}
+
+/// `∂ε/∂δ` and `∂ε/∂ξ_s` of `ε = R_next⁻¹(g(δ) R_q(ξ_s))`, the step's end read in the chart at
+/// `next`. `None` outside that chart or where the charts are not carried.
+fn end_position<C: ConfigurationSpace<N>, const N: usize>(
+    space: &C,
+    q: &Point<C, N, f64>,
+    next: &Point<C, N, f64>,
+    end: &SVector<f64, N>,
+) -> Option<(SMatrix<f64, N, N>, SMatrix<f64, N, N>)> {
+    let read = |delta: &SVector<Dual<N>, N>, xi: &SVector<Dual<N>, N>| {
+        let y = space.retract(q, xi);
+        let (y, _) = space.carried(q, delta, &y, &C::Manifold::zero())?;
+        space.local_over(next, &y).map(|e| jacobian(&e))
+    };
+    let still = SVector::from_element(Dual::from(0.0));
+    let start = read(&seeded(&SVector::zeros()), &end.map(Dual::from))?;
+    let along = read(&still, &seeded(end))?;
+    Some((start, along))
+}
