@@ -28,6 +28,7 @@ pub mod pendulum;
 pub mod port;
 pub mod ports;
 pub mod progress;
+pub mod reaction_wheels;
 pub mod rigid_body;
 pub mod rigid_chain;
 pub mod rlc_ladder;

@@ -300,3 +300,43 @@ fn derivatives_with_one_forms_on_groups_are_refused() {
     );
     assert_eq!(ball.steps(), 0);
 }
+
+/// LQR on the derivatives on `R³ × SO(3)` stabilises a satellite with three reaction wheels:
+/// at the target `A` is marginal on the attitude and the wheels' momenta (spectral radius 1)
+/// and `A − BK` contracts; from rest 0.78 rad away the closed loop (the feedback computed inside
+/// the run) brings the attitude within 1e-2 rad in 20 s, and the spatial angular momentum stays
+/// zero to round-off (the motors' torques are internal).
+#[test]
+fn lqr_on_the_group_derivatives_stabilises_a_satellite_with_reaction_wheels() {
+    use scenes::reaction_wheels::{self, REGULATED};
+    let h = 0.05;
+    let regulator = reaction_wheels::regulator(h, 0.01).unwrap();
+    let regulated = |m: &DMatrix<f64>| {
+        DMatrix::from_fn(REGULATED.len(), REGULATED.len(), |i, j| {
+            m[(REGULATED[i], REGULATED[j])]
+        })
+    };
+    let radius = |m: &DMatrix<f64>| {
+        m.complex_eigenvalues()
+            .iter()
+            .map(|e| e.norm())
+            .fold(0.0, f64::max)
+    };
+    let open = radius(&regulated(&regulator.a));
+    let closed = radius(&regulated(&(&regulator.a - &regulator.b * &regulator.k)));
+    assert!(
+        (open - 1.0).abs() < 1e-9 && closed < 0.995,
+        "{open} {closed}"
+    );
+    let tilt = Vector3::new(0.5, -0.4, 0.45);
+    let samples = reaction_wheels::stabilised(&regulator.k, tilt, h, 20.0, 20).unwrap();
+    let (first, last) = (samples[0], samples[samples.len() - 1]);
+    let momentum = samples.iter().map(|s| s.momentum).fold(0.0, f64::max);
+    println!(
+        "angle {:.2e} → {:.2e} rad, |Ω| {:.1e}, momentum ≤ {momentum:.1e}",
+        first.angle, last.angle, last.rate
+    );
+    assert!((first.angle - tilt.norm()).abs() < 1e-12);
+    assert!(last.angle < 1e-2 && last.rate < 5e-3, "{last:?}");
+    assert!(momentum < 1e-13, "{momentum:.1e}");
+}
