@@ -27,7 +27,7 @@ fn main() -> Result<(), DiracError> {
         radius(&regulated(&regulator.a)),
         radius(&regulated(&closed))
     );
-    let tilt = Vector3::new(0.5, -0.4, 0.45);
+    let tilt = reaction_wheels::tilt();
     let samples = reaction_wheels::stabilised(&regulator.k, tilt, h, 30.0, 40)?;
     println!("\nfrom rest at {:.2} rad from the target:", tilt.norm());
     for s in &samples {

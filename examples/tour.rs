@@ -9,7 +9,8 @@
 //! `output/cart_pole_lqr.png`, `output/long_horizon_energy.png`, `output/heavy_top.png`,
 //! `output/heavy_top_invariants.png`. Models on rotations and unit vectors: the heavy top (both
 //! retractions), the 3D pendulum against a quaternion reference, the spherical pendulum on `S²`
-//! beside the Cartesian one, the rolling ball at each constraint point and a satellite's slew.
+//! beside the Cartesian one, the rolling ball at each constraint point, a satellite's slew and a satellite with reaction
+//! wheels held by LQR on the step map's derivatives.
 //!
 //! `cargo run --release --example tour`
 
@@ -85,6 +86,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     reports.push(scenes::shafted_body::report()?);
     reports.push(scenes::satellite::report()?);
+    reports.push(scenes::reaction_wheels::report()?);
     // A field: the sine-Gordon kink–antikink collision.
     reports.push(scenes::field::report()?);
     scenes::print_table(&reports);

@@ -13,7 +13,7 @@ use dirac::configuration_space::ConfigurationSpace;
 use dirac::nalgebra::DMatrix;
 use dirac::prelude::*;
 
-use crate::lqr;
+use crate::{Report, lqr};
 
 /// A rigid body of inertia `j` (wheels included) with a wheel of axial inertia `i` on each body
 /// axis: `L = ½ Ωᵀ J Ω + ½ i Σ_k (Ω_k + ẇ_k)²`.
@@ -138,4 +138,31 @@ pub fn stabilised(
             wheels: v.vector.fixed_rows::<3>(0).into_owned(),
         })
         .collect())
+}
+
+/// The tilt the example and the tour start from, 0.78 rad.
+pub fn tilt() -> Vector3<f64> {
+    Vector3::new(0.5, -0.4, 0.45)
+}
+
+/// The tour's row: the regulator at h = 0.05 and the closed loop from [`tilt`] over 20 s.
+pub fn report() -> Result<Report, DiracError> {
+    let (h, t_end) = (0.05, 20.0);
+    let start = std::time::Instant::now();
+    let regulator = regulator(h, 0.01)?;
+    let samples = stabilised(&regulator.k, tilt(), h, t_end, 20)?;
+    let momentum = samples.iter().map(|s| s.momentum).fold(0.0, f64::max);
+    let (first, last) = (samples[0], samples[samples.len() - 1]);
+    Ok(Report {
+        scene: "satellite LQR, reaction wheels",
+        quadrature: "midpoint, Cayley".into(),
+        h,
+        steps: (t_end / h).round() as u64,
+        max_energy_error: None,
+        wall: start.elapsed(),
+        check: format!(
+            "attitude {:.2} → {:.1e} rad, |L| ≤ {momentum:.0e}",
+            first.angle, last.angle
+        ),
+    })
 }

@@ -121,7 +121,7 @@ where
     C: ConfigurationSpace<N>,
 {
     stepper.set_inputs(inputs).unwrap();
-    stepper.start_from_velocity(q.clone(), v).unwrap();
+    stepper.start_from_velocity(q, v).unwrap();
     let p = stepper.p();
     let derivatives = stepper.step_linearised().unwrap();
     let (a, b) = central_differences(&mut stepper, &q, &p, inputs, 1e-5, 1);
@@ -328,7 +328,7 @@ fn lqr_on_the_group_derivatives_stabilises_a_satellite_with_reaction_wheels() {
         (open - 1.0).abs() < 1e-9 && closed < 0.995,
         "{open} {closed}"
     );
-    let tilt = Vector3::new(0.5, -0.4, 0.45);
+    let tilt = reaction_wheels::tilt();
     let samples = reaction_wheels::stabilised(&regulator.k, tilt, h, 20.0, 20).unwrap();
     let (first, last) = (samples[0], samples[samples.len() - 1]);
     let momentum = samples.iter().map(|s| s.momentum).fold(0.0, f64::max);

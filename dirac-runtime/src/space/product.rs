@@ -942,7 +942,7 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
         v: &Rates<D, K, A, B>,
     ) -> Option<(Configuration<D, K, A, B>, Rates<D, K, A, B>)> {
         const { dimension::<N, K, A, B>() };
-        let (mut x, mut v) = (x.clone(), v.clone());
+        let (mut x, mut v) = (*x, *v);
         for i in 0..K {
             x.vector[i] += delta[i];
         }

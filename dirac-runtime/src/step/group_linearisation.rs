@@ -84,7 +84,7 @@ where
         .map(|j| x.fixed_rows::<N>(layout.point(j)).into_owned())
         .collect();
     let end_point = points[s - 1];
-    let mut next = state.q.clone();
+    let mut next = state.q;
     let mut carry = state.q_carry;
     space.advance(&mut next, &mut carry, &end_point);
 
