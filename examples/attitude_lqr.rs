@@ -1,5 +1,5 @@
 //! Attitude control by LQR on the step map's derivatives on `R³ × SO(3)`: a satellite with three
-//! reaction wheels, tilted 0.8 rad from its target at rest, is brought back by the feedback
+//! reaction wheels, tilted 0.78 rad from its target at rest, is brought back by the feedback
 //! `u = −K z` computed inside the run, `K` the discrete LQR gain of the exact `A`, `B` at the
 //! target. The wheels' torques are internal: the spatial angular momentum stays zero while the
 //! body turns. `cargo run --release --example attitude_lqr`.

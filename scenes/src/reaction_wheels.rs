@@ -101,7 +101,8 @@ pub struct Sample {
 
 /// The closed loop from rest at the attitude `Exp(tilt)`: the feedback `u = −K z` computed
 /// inside the run before every step of `h` (midpoint, Cayley) until `t_end`, every
-/// `every`-th step sampled.
+/// `every`-th step sampled. Where the attitude is a half turn from the target (outside the
+/// chart there) the feedback is zero.
 pub fn stabilised(
     gain: &DMatrix<f64>,
     tilt: Vector3<f64>,

@@ -7,7 +7,7 @@ use dirac::configuration_space::{ConfigurationSpace, Point, Positive, Tangent};
 use dirac::nalgebra::DMatrix;
 use dirac::prelude::*;
 use dirac::product::Product;
-use scenes::{double_pendulum, rigid_body, satellite, spherical_pendulum};
+use scenes::{double_pendulum, rigid_body, rigid_chain, satellite, spherical_pendulum};
 
 /// A mass on a spring, a body and a pendulum, `(r, R, n) ∈ R × SO(3) × S²`, coupled, with a
 /// damper on every coordinate and two inputs (a force on `r`, a torque on the body).
@@ -220,6 +220,72 @@ fn conservative_steps_on_groups_are_symplectic() {
     }
 }
 
+/// A double spherical pendulum, `(n₀, n₁) ∈ S² × S²`, coupled to a body `R` and a spring `θ`:
+/// two unit vectors, a rotation and a vector, conservative (the unit vectors' momenta then
+/// advance by the torque path).
+#[dirac_system(
+    coordinates(theta, R: SO3, n[2]: S2),
+    lagrangian = 0.5 * dot(theta) * dot(theta) + 0.5 * dot(omega(R), j * omega(R))
+        + 0.5 * dot(dot(n[0]), dot(n[0]))
+        + 0.25 * dot(dot(n[0]) + dot(n[1]), dot(n[0]) + dot(n[1]))
+        - g * (1.5 * n[0][2] + 0.5 * n[1][2]) - c * dot(R * [0.0, 0.0, 1.0], n[1])
+        - 0.5 * k * theta * theta,
+)]
+#[derive(Debug, Clone, Copy)]
+struct Hung {
+    j: [[f64; 3]; 3],
+    g: f64,
+    c: f64,
+    k: f64,
+}
+
+/// Two rotations (the rigid chain) and two unit vectors with a rotation and a vector (`Hung`):
+/// `A` against central differences and symplectic, at the midpoint, trapezoid and Galerkin(3)
+/// rules.
+#[test]
+fn derivatives_with_several_rotations_and_unit_vectors() {
+    let hung = Hung {
+        j: [[2.0, 0.0, 0.1], [0.0, 3.0, 0.0], [0.1, 0.0, 4.0]],
+        g: 2.0,
+        c: 0.8,
+        k: 1.5,
+    };
+    let n0 = Vector3::new(0.6, 0.0, -0.8);
+    let n1 = Vector3::new(0.0, 0.8, -0.6);
+    let q = Configuration::new(
+        vector![0.2],
+        [Retraction::Exp.map(&Vector3::new(0.2, 0.5, -0.3))],
+        [n0, n1],
+    );
+    let v = Rates::new(
+        vector![0.4],
+        [Vector3::new(0.3, -0.6, 0.9)],
+        [Vector3::new(0.0, 0.7, 0.0), Vector3::new(0.5, 0.0, 0.0)],
+    );
+    let (chain_q, chain_v) = rigid_chain::start();
+    for quadrature in [
+        Quadrature::midpoint(),
+        Quadrature::trapezoid(),
+        Quadrature::galerkin(3).unwrap(),
+    ] {
+        let name = quadrature.name();
+        let stepper = Stepper::on_manifold(hung, Product::exp(), quadrature.clone(), 0.02);
+        let (a, _, defect) = check(stepper.unwrap(), q, v, &[]);
+        println!("S² × S² × SO(3) × R {name}: A {a:.1e}, defect {defect:.1e}");
+        assert!(
+            a < 1e-7 && defect < 1e-12,
+            "hung {name}: {a:.1e} {defect:.1e}"
+        );
+        let chain = Stepper::on_manifold(rigid_chain::CHAIN, Product::cayley(), quadrature, 0.005);
+        let (a, _, defect) = check(chain.unwrap(), chain_q, chain_v, &[]);
+        println!("rigid chain {name}: A {a:.1e}, defect {defect:.1e}");
+        assert!(
+            a < 1e-7 && defect < 1e-12,
+            "chain {name}: {a:.1e} {defect:.1e}"
+        );
+    }
+}
+
 /// The derivatives read the end in the chart the next step starts in: two steps' `A_2 A_1` and
 /// `A_2 B_1 + B_2` are the two-step map's, by central differences.
 #[test]
@@ -324,8 +390,10 @@ fn lqr_on_the_group_derivatives_stabilises_a_satellite_with_reaction_wheels() {
     };
     let open = radius(&regulated(&regulator.a));
     let closed = radius(&regulated(&(&regulator.a - &regulator.b * &regulator.k)));
+    // A's eigenvalue 1 is defective (the attitude drifts at a constant rate): round-off moves it
+    // by about √ε.
     assert!(
-        (open - 1.0).abs() < 1e-9 && closed < 0.995,
+        (open - 1.0).abs() < 1e-6 && closed < 0.995,
         "{open} {closed}"
     );
     let tilt = reaction_wheels::tilt();

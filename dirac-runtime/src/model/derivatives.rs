@@ -15,7 +15,6 @@ use crate::model::hamiltonian_system::HamiltonianSystem;
 use crate::model::system::DiracSystem;
 use crate::quadrature::Quadrature;
 use crate::space::configuration_space::{ConfigurationSpace, Point};
-use crate::space::manifold::Manifold;
 
 /// A function of `(q, v)` over any scalar: the model's Lagrangian, or the Lagrangian in a chart.
 pub(crate) trait PhaseFunction<const N: usize> {
@@ -168,7 +167,8 @@ where
             SVector::<Dual<N>, N>::from_fn(|i, _| Dual::<N>::new(0.0, Derivative::some(unit(i))));
         let lifted: Vec<SVector<Dual<N>, N>> =
             points.iter().map(|x| x.map(Dual::<N>::from)).collect();
-        moving_action(
+        // Without a moved start every node is evaluated: `Some` always.
+        let _ = moving_action(
             system,
             space,
             base,
@@ -213,7 +213,7 @@ where
             })
             .collect();
         let (mut slot, mut block) = (SVector::zeros(), SMatrix::zeros());
-        moving_action(
+        let _ = moving_action(
             system,
             space,
             base,
@@ -281,12 +281,6 @@ where
     let pass = |row: usize, column: usize| -> Option<(SVector<f64, N>, SMatrix<f64, N, N>)> {
         let eta = SVector::<H<N>, N>::from_fn(|i, _| seeded(0.0, (row == 0).then_some(i), None));
         let delta = SVector::<H<N>, N>::from_fn(|i, _| seeded(0.0, None, Some(i)));
-        space.carried(
-            base,
-            &delta,
-            &space.retract(base, &eta),
-            &C::Manifold::zero(),
-        )?;
         let moved: Vec<SVector<H<N>, N>> = points
             .iter()
             .enumerate()
@@ -315,7 +309,7 @@ where
                 value += term.eps1.unwrap_generic(Const::<N>, U1);
                 block += term.eps1eps2.unwrap_generic(Const::<N>, Const::<N>);
             },
-        );
+        )?;
         Some((value, block))
     };
     let s = points.len();
@@ -338,7 +332,8 @@ where
 
 /// The terms `h b_i ℓ^{R_q(η)}(ζ_i, ζ̇_i)` of `Λ(η; ξ_1..ξ_s)` (see [`MovingRow`]), handed to
 /// `term` node by node; with `start`, of the step whose chart is carried by `g(δ)` to a start
-/// at `R_q(δ)` ([`ConfigurationSpace::carried`]: every point and velocity moved by `g(δ)`).
+/// at `R_q(δ)` ([`ConfigurationSpace::carried`]: every point and velocity moved by `g(δ)`), and
+/// `None` where the space does not carry its charts.
 #[allow(clippy::too_many_arguments)]
 fn moving_action<S, C, D, const N: usize>(
     system: &S,
@@ -350,7 +345,8 @@ fn moving_action<S, C, D, const N: usize>(
     points: &[SVector<D, N>],
     start: Option<&SVector<D, N>>,
     mut term: impl FnMut(D),
-) where
+) -> Option<()>
+where
     S: DiracSystem<N, C::Manifold>,
     C: ConfigurationSpace<N>,
     D: Scalar,
@@ -372,12 +368,16 @@ fn moving_action<S, C, D, const N: usize>(
         }
         let q = space.retract_moved(base, eta, &zeta);
         let v = space.push_forward_moved(base, eta, &zeta, &rate);
-        let value = match start.and_then(|delta| space.carried(base, delta, &q, &v)) {
-            Some((q, v)) => system.lagrangian(&q, &v),
+        let value = match start {
+            Some(delta) => {
+                let (q, v) = space.carried(base, delta, &q, &v)?;
+                system.lagrangian(&q, &v)
+            }
             None => system.lagrangian(&q, &v),
         };
         term(value * (h * b));
     }
+    Some(())
 }
 
 /// A direction in `(q, v)`: moving the seeded variable by `δ` moves `q` by `position · δ` and `v`

@@ -319,8 +319,10 @@ pub trait ConfigurationSpace<const N: usize>: sealed::Sealed + Clone + Debug {
     /// `R_{R_q(δ)}(ζ) = g(δ) R_q(ζ)`, to first order in `δ` (the step map's derivatives move
     /// the start of a step so; with dual numbers whose `δ`-parts square to zero, exactly). On
     /// vectors a translation by `δ`; on a rotation the turn `q τ(δ) qᵀ` on the left (body
-    /// velocities unchanged); on a unit vector the carrier `τ(q × Bδ)`. `None` where the
-    /// space's charts are not carried so (the default).
+    /// velocities unchanged); on a unit vector the carrier `τ(q × Bδ)`, whose chart at `R_q(δ)`
+    /// has the frame `τ(q × Bδ) B` (a step does not see its chart's frame). First order only:
+    /// with plain numbers the result is off the manifold by `O(|δ|²)`; it is meant for dual
+    /// numbers. `None` where the space's charts are not carried so (the default).
     fn carried<D: Scalar>(
         &self,
         q: &Point<Self, N, f64>,

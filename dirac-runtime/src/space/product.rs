@@ -614,23 +614,7 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Configurati
         q: &Configuration<f64, K, A, B>,
         q1: &Configuration<f64, K, A, B>,
     ) -> Option<SVector<f64, N>> {
-        const { dimension::<N, K, A, B>() };
-        let tau = self.retraction;
-        let mut xi = SVector::<f64, N>::zeros();
-        for i in 0..K {
-            xi[i] = q1.vector[i] - q.vector[i];
-        }
-        for a in 0..A {
-            let x = tau.inverse(&(q.rotation[a].transpose() * q1.rotation[a]))?;
-            xi.fixed_rows_mut::<3>(Self::rotation_at(a)).copy_from(&x);
-        }
-        for b in 0..B {
-            let w = sphere::local(tau, &q.direction[b], &q1.direction[b])?;
-            let frame = sphere::frame(&q.direction[b]);
-            xi.fixed_rows_mut::<2>(Self::direction_at(b))
-                .copy_from(&(frame.transpose() * w));
-        }
-        Some(xi)
+        self.local_over(q, q1)
     }
 
     /// The exponential chart of a rotation or a unit vector is one-to-one for turns below π

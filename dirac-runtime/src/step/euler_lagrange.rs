@@ -702,9 +702,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             || (Self::constrained() && self.layout.points() > 1)
         {
             return Err(DiracError::Unsupported(
-                "derivatives of the step map on a configuration space other than Rⁿ, of a \
-                 Lagrangian linear in the velocities, or with constraints at internal points or \
-                 nodes"
+                "derivatives of the step map on a configuration space other than Rⁿ (step it \
+                 with Stepper::on_manifold, whose derivatives cover Positive, rotations and unit \
+                 vectors), of a Lagrangian linear in the velocities, or with constraints at \
+                 internal points or nodes"
                     .into(),
             ));
         }

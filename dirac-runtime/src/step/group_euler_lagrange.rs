@@ -22,9 +22,9 @@
 //! `(T_{ξ_s} R)ᵀ p_{k+1} = ∂L_d/∂ξ_s + f_s + (1 − σ) Ãᵀμ`: for a rotation,
 //! `Π_{k+1} = dτ_{ξ_s}⁻ᵀ (∂L_d/∂ξ_s + …)`.
 //!
-//! The step map's derivatives `A` and `B` are read in the tangent chart (see
-//! [`group_linearisation`](crate::step::group_linearisation)) for models without one-forms or
-//! junctions. Holonomic constraints are not offered on these spaces: their differentials are
+//! The step map's derivatives `A` and `B` are read in the tangent chart (the cotangent lift of
+//! the chart at each end of the step; the mathematics guide derives them) for models without
+//! one-forms or junctions. Holonomic constraints are not offered on these spaces: their differentials are
 //! held as one-forms.
 
 use nalgebra::{DMatrix, DVector, SVector};
@@ -627,9 +627,8 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
             .ok_or_else(|| not_finite("initial momentum"))
     }
 
-    /// `A` and `B` in the cotangent lifts of the charts centred at `q_k` and `q_{k+1}` (see
-    /// [`group_linearisation`](crate::step::group_linearisation)): perturbations
-    /// `(δ, dμ)` of `(R_{q_k}(δ), p)` with `(T_δ R_{q_k})ᵀ p = μ`. Refused with `Unsupported` for
+    /// `A` and `B` in the cotangent lifts of the charts centred at `q_k` and `q_{k+1}`:
+    /// perturbations `(δ, dμ)` of `(R_{q_k}(δ), p)` with `(T_δ R_{q_k})ᵀ p = μ`. Refused with `Unsupported` for
     /// one-forms and for a component of an interconnection.
     fn linearise(
         &self,

@@ -1,6 +1,8 @@
-//! Derivatives of the step map on rotations and unit vectors: `A = ∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)`
-//! and `B = ∂(q_{k+1}, p_{k+1})/∂u` of a [`GroupEulerLagrange`](crate::group_euler_lagrange::GroupEulerLagrange)
-//! step, read in the tangent chart.
+//! Derivatives of the step map on configuration spaces whose charts a motion carries (rotations,
+//! unit vectors, their products with vectors, `Positive`):
+//! `A = ∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)` and `B = ∂(q_{k+1}, p_{k+1})/∂u` of a
+//! [`GroupEulerLagrange`](crate::group_euler_lagrange::GroupEulerLagrange) step, read in the
+//! tangent chart.
 //!
 //! **Coordinates.** Near a point `q` the state is read in the cotangent lift of the chart
 //! centred at `q`: `(ζ, μ) ↦ (R_q(ζ), p)` with `(T_ζ R_q)ᵀ p = μ`. These coordinates are
@@ -13,7 +15,11 @@
 //! **The moved start.** A step from `R_q(δ)` is the step from `q` in the chart carried there by
 //! the motion `g(δ)`, `R_{R_q(δ)}(ζ) = g(δ) R_q(ζ)`
 //! ([`carried`](crate::configuration_space::ConfigurationSpace::carried): a translation, a turn
-//! on the left of a rotation, the carrier of a unit vector). Its residual is the step's own
+//! on the left of a rotation, the carrier of a unit vector). On a unit vector the carried chart's
+//! frame `g B` is not the frame `B(R_q(δ))` the step at `R_q(δ)` takes, but the step does not see
+//! the frame: the retraction is equivariant (`R_{gq}(g w) = g R_q(w)`), and a change of frame is
+//! a linear change of the chart coordinates, which commutes with the path's interpolation and
+//! turns the rows as covectors. Its residual is the step's own
 //! with every point and velocity of the path moved by `g(δ)`, so its derivative in `δ` comes
 //! from one more seed of the dual numbers, and its unknowns `ξ'` live in the carried chart.
 //! With `ξ'(ζ) = R_q⁻¹(g(δ)⁻¹ R_q(ζ))` the carried chart's coordinates of a point, the momentum
@@ -48,11 +54,12 @@ use crate::base::error::DiracError;
 use crate::discrete::discrete_lagrangian::DiscreteLagrangian;
 use crate::discrete::layout::Layout;
 use crate::discrete::state::State;
-use crate::model::derivatives::{Dual, start_blocks};
+use crate::model::derivatives::{Dual, gradient, lift, start_blocks};
 use crate::model::system::DiracSystem;
 use crate::solve::newton::Newton;
 use crate::space::configuration_space::{ConfigurationSpace, Point};
 use crate::space::manifold::Manifold;
+use crate::step::euler_lagrange::stale_factorisation;
 use crate::step::step_derivatives::StepDerivatives;
 
 /// The derivatives of the step from `state` solved by `x` (Newton's root, its Jacobian
@@ -95,9 +102,9 @@ where
         ForceDerivatives::none(s, inputs.len())
     };
     let pi = space.pull_back(q, &SVector::zeros(), &state.p);
-    let (_, reading, _) = chart_change(space, q, q, &pi).ok_or_else(outside)?;
+    let (_, p_in, _) = chart_change(space, q, q, &pi).ok_or_else(outside)?;
     let end = action.end + forces.end;
-    let (turn, end_start, end_end) = chart_change(space, q, &next, &end).ok_or_else(outside)?;
+    let (z0, p_delta, p_eps) = chart_change(space, q, &next, &end).ok_or_else(outside)?;
     let (position_start, position_end) =
         end_position(space, q, &next, &end_point).ok_or_else(outside)?;
 
@@ -108,8 +115,9 @@ where
     for j in 0..s {
         let mut block = action.start[j] + forces.start[j];
         if j == 0 {
-            block -= reading;
+            block -= p_in;
         }
+        // The rows of point j's equation sit where the unknowns of point j + 1 do.
         let row = layout.point(j + 1);
         dx.view_mut((row, 0), (N, N)).copy_from(&block);
         dx.view_mut((row, 2 * N), (N, n_in))
@@ -118,11 +126,9 @@ where
     for i in 0..N {
         dx[(i, N + i)] = 1.0;
     }
-    newton.implicit_derivatives(x, &mut dx).ok_or_else(|| {
-        DiracError::Unsupported(
-            "derivatives of a step whose Jacobian is not factorised at its root".into(),
-        )
-    })?;
+    newton
+        .implicit_derivatives(x, &mut dx)
+        .ok_or_else(stale_factorisation)?;
 
     let end_moving = action.start[s] + forces.start[s];
     let mut derivatives = StepDerivatives::<N> {
@@ -148,9 +154,9 @@ where
         } else if c >= 2 * N {
             d_covector += forces.inputs[s].column(c - 2 * N);
         }
-        let mut d_momentum = turn.transpose() * d_covector + end_end * d_position;
+        let mut d_momentum = z0.transpose() * d_covector + p_eps * d_position;
         if c < N {
-            d_momentum += end_start.column(c);
+            d_momentum += p_delta.column(c);
         }
         let d = &mut derivatives;
         match c {
@@ -215,14 +221,9 @@ fn unit<const N: usize>(i: usize) -> SVector<f64, N> {
     SVector::from_fn(|r, _| if r == i { 1.0 } else { 0.0 })
 }
 
-/// `x` as dual numbers seeded along their own components.
-fn seeded<const N: usize>(x: &SVector<f64, N>) -> SVector<Dual<N>, N> {
-    SVector::from_fn(|i, _| Dual::<N>::new(x[i], Derivative::some(unit(i))))
-}
-
-/// The Jacobian of dual numbers (rows: the numbers).
-fn jacobian<const N: usize>(f: &SVector<Dual<N>, N>) -> SMatrix<f64, N, N> {
-    SMatrix::from_fn(|i, j| f[i].eps.unwrap_generic(Const::<N>, U1)[j])
+/// The derivatives of dual numbers, a row each.
+fn derivatives_of<const N: usize>(f: &SVector<Dual<N>, N>) -> SMatrix<f64, N, N> {
+    SMatrix::from_fn(|i, j| gradient(&f[i])[j])
 }
 
 /// [`ForceDerivatives`] by first-order duals through
@@ -243,17 +244,17 @@ where
     let constant: Vec<SVector<Dual<N>, N>> = points.iter().map(|x| x.map(Dual::from)).collect();
     let held: Vec<Dual<N>> = inputs.iter().map(|&u| Dual::from(u)).collect();
     let still = SVector::from_element(Dual::from(0.0));
-    let moved = discrete.carried_forces(q, &constant, &seeded(&SVector::zeros()), t, &held)?;
+    let moved = discrete.carried_forces(q, &constant, &lift(&SVector::zeros(), 1.0), t, &held)?;
     let mut out = ForceDerivatives::none(s, inputs.len());
     for (j, f) in moved.iter().enumerate() {
-        out.start[j] = jacobian(f);
+        out.start[j] = derivatives_of(f);
     }
     out.end = moved[s].map(|f| f.re);
     for m in 0..s {
         let mut varied = constant.clone();
-        varied[m] = seeded(&points[m]);
+        varied[m] = lift(&points[m], 1.0);
         let f = discrete.carried_forces(q, &varied, &still, t, &held)?;
-        out.end_blocks[m] = jacobian(&f[s]);
+        out.end_blocks[m] = derivatives_of(&f[s]);
     }
     for first in (0..inputs.len()).step_by(N) {
         let chunk = first..(first + N).min(inputs.len());
@@ -267,7 +268,7 @@ where
             .collect();
         let f = discrete.carried_forces(q, &constant, &still, t, &lifted)?;
         for (j, f) in f.iter().enumerate() {
-            let d = jacobian(f);
+            let d = derivatives_of(f);
             for k in chunk.clone() {
                 out.inputs[j].set_column(k, &d.column(k - first));
             }
@@ -340,10 +341,10 @@ fn end_position<C: ConfigurationSpace<N>, const N: usize>(
     let read = |delta: &SVector<Dual<N>, N>, xi: &SVector<Dual<N>, N>| {
         let y = space.retract(q, xi);
         let (y, _) = space.carried(q, delta, &y, &C::Manifold::zero())?;
-        space.local_over(next, &y).map(|e| jacobian(&e))
+        space.local_over(next, &y).map(|e| derivatives_of(&e))
     };
     let still = SVector::from_element(Dual::from(0.0));
-    let start = read(&seeded(&SVector::zeros()), &end.map(Dual::from))?;
-    let along = read(&still, &seeded(end))?;
+    let start = read(&lift(&SVector::zeros(), 1.0), &end.map(Dual::from))?;
+    let along = read(&still, &lift(end, 1.0))?;
     Some((start, along))
 }
