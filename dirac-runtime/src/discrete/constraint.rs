@@ -24,12 +24,13 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 pub use crate::base::constraint_point::ConstraintPoint;
 use crate::base::error::DiracError;
+use crate::base::scalar::Scalar;
 use crate::discrete::layout::Layout;
 use crate::model::derivatives::{gradient, lift};
 use crate::model::system::DiracSystem;
 use crate::quadrature::Quadrature;
 use crate::space::configuration_space::{ConfigurationSpace, Euclidean, Point, StepCovectors};
-use crate::space::manifold::Vectors;
+use crate::space::manifold::{Manifold, Vectors};
 
 /// One-form `a` read in the chart centred at `base`, at `xi`: the row `Ã_a(ξ)` and its
 /// derivative `∂Ã_a,i/∂ξ_j` (row `i`, column `j`), `None` for a constant one-form on a
@@ -54,6 +55,37 @@ pub(crate) fn one_form_in_chart<
     let value = row.map(|x| x.re);
     let derivative = SMatrix::<f64, N, N>::from_fn(|i, j| gradient(&row[i])[j]);
     (value, Some(derivative))
+}
+
+/// One-form `a` read in the chart at `base` carried by `g(δ)` to `R_q(δ)`
+/// ([`ConfigurationSpace::carried`]), at `xi`: the model's form at `g(δ) R_q(ξ)` paired with the
+/// carried chart's coordinate directions, over any scalar (its derivatives in `δ` and `ξ` by
+/// dual numbers). `None` where the space does not carry its charts.
+pub(crate) fn carried_one_form<
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+    D: Scalar,
+    const N: usize,
+>(
+    system: &S,
+    space: &C,
+    base: &Point<C, N, f64>,
+    xi: &SVector<D, N>,
+    delta: &SVector<D, N>,
+    a: usize,
+) -> Option<SVector<D, N>> {
+    let point = space.retract(base, xi);
+    let zero = <C::Manifold as Manifold<N>>::zero();
+    let (moved, _) = space.carried(base, delta, &point, &zero)?;
+    let form = system.one_form(&moved, a);
+    let mut row = SVector::<D, N>::from_element(D::from(0.0));
+    for r in 0..N {
+        let e = SVector::<D, N>::from_fn(|k, _| D::from(if k == r { 1.0 } else { 0.0 }));
+        let (_, direction) =
+            space.carried(base, delta, &point, &space.push_forward(base, xi, &e))?;
+        row[r] = <C::Manifold as Manifold<N>>::pair(&form, &direction);
+    }
+    Some(row)
 }
 
 /// One-form `a` read in the chart centred at `base`, at `xi`: the row `Ã_a(ξ)` alone, without

@@ -23,8 +23,8 @@
 //! `Π_{k+1} = dτ_{ξ_s}⁻ᵀ (∂L_d/∂ξ_s + …)`.
 //!
 //! The step map's derivatives `A` and `B` are read in the tangent chart (the cotangent lift of
-//! the chart at each end of the step; the mathematics guide derives them) for models without
-//! one-forms or junctions. Holonomic constraints are not offered on these spaces: their differentials are
+//! the chart at each end of the step; the mathematics guide derives them) for every model but a
+//! component of an interconnection. Holonomic constraints are not offered on these spaces: their differentials are
 //! held as one-forms.
 
 use nalgebra::{DMatrix, DVector, SVector};
@@ -628,27 +628,28 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize> S
     }
 
     /// `A` and `B` in the cotangent lifts of the charts centred at `q_k` and `q_{k+1}`:
-    /// perturbations `(δ, dμ)` of `(R_{q_k}(δ), p)` with `(T_δ R_{q_k})ᵀ p = μ`. Refused with `Unsupported` for
-    /// one-forms and for a component of an interconnection.
+    /// perturbations `(δ, dμ)` of `(R_{q_k}(δ), p)` with `(T_δ R_{q_k})ᵀ p = μ`. Refused with
+    /// `Unsupported` for a component of an interconnection.
     fn linearise(
         &self,
         state: &State<N, C::Manifold>,
         x: &DVector<f64>,
         newton: &Newton,
     ) -> Result<StepDerivatives<N>, DiracError> {
-        if S::ONE_FORMS > 0 {
-            return Err(DiracError::Unsupported(
-                "derivatives of the step map with constraint one-forms on rotations or unit \
-                 vectors"
-                    .into(),
-            ));
-        }
         if self.coupling.is_some() {
             return Err(DiracError::Unsupported(
                 "derivatives of the step map of one component of an interconnection".into(),
             ));
         }
-        group_linearisation::linearise(&self.discrete, &self.layout, &self.inputs, state, x, newton)
+        group_linearisation::linearise(
+            &self.discrete,
+            &self.layout,
+            self.point,
+            &self.inputs,
+            state,
+            x,
+            newton,
+        )
     }
 
     fn inputs(&self) -> &[f64] {

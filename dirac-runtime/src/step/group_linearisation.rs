@@ -29,14 +29,15 @@
 //! dπ' = dμ − P dδ,     P_ra = Σ_m π_m ∂²ξ'_m/∂ζ_r∂δ_a.
 //! ```
 //!
-//! **The implicit function theorem.** The residual `r(δ, ξ', π', u)` (rows `π' + D1 L_d + f_0`
-//! and `∂L_d/∂ξ_j + f_j`, `j = 1..s−1`) vanishes along the perturbed steps, so
-//! `dξ' = −J⁻¹ (∂r/∂δ dδ + [dπ'; 0] + ∂r/∂u du)` with Newton's Jacobian `J = ∂r/∂ξ'` factorised
-//! at the root.
+//! **The implicit function theorem.** The residual `r(δ, ξ', μ_a, π', u)` (rows
+//! `π' + D1 L_d + f_0 + σ Σ_a μ_a Ã_a`, `∂L_d/∂ξ_j + f_j` for `j = 1..s−1`, and the one-forms'
+//! `Ã_a · ξ'_s`, each `Ã_a` read in the carried chart at the constraint point `θ ξ'_s`) vanishes
+//! along the perturbed steps, so `d(ξ', μ) = −J⁻¹ (∂r/∂δ dδ + [dπ'; 0] + ∂r/∂u du)` with
+//! Newton's Jacobian `J` factorised at the root.
 //!
 //! **The end.** The new point is `g(δ) R_q(ξ'_s)`, read in the chart at `q_{k+1}` as
 //! `ε = R_{q_{k+1}}⁻¹(g(δ) R_q(ξ'_s))`. Its momentum has the end covector
-//! `E = ∂L_d/∂ξ'_s + f_s` as its pull-back to the carried chart, so
+//! `E = ∂L_d/∂ξ'_s + f_s + (1 − σ) Σ_a μ_a Ã_a` as its pull-back to the carried chart, so
 //! `μ_{k+1} = Zᵀ E` with `Z = ∂ξ'/∂z` at `z = 0` for `ξ'(z) = R_q⁻¹(g(δ)⁻¹ R_{q_{k+1}}(ε + z))`:
 //!
 //! ```text
@@ -50,7 +51,9 @@
 use nalgebra::{Const, DMatrix, DVector, SMatrix, SVector, U1};
 use num_dual::{Derivative, HyperDualSVec64};
 
+use crate::base::constraint_point::ConstraintPoint;
 use crate::base::error::DiracError;
+use crate::discrete::constraint::carried_one_form;
 use crate::discrete::discrete_lagrangian::DiscreteLagrangian;
 use crate::discrete::layout::Layout;
 use crate::discrete::state::State;
@@ -63,10 +66,13 @@ use crate::step::euler_lagrange::stale_factorisation;
 use crate::step::step_derivatives::StepDerivatives;
 
 /// The derivatives of the step from `state` solved by `x` (Newton's root, its Jacobian
-/// factorised there) of a model without one-forms or junctions (see the [module](self)).
+/// factorised there) of a model without junctions, its one-forms (on a degree-1 step) held at
+/// `point` (see the [module](self)).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn linearise<S, C, const N: usize>(
     discrete: &DiscreteLagrangian<S, N, C>,
     layout: &Layout,
+    point: ConstraintPoint,
     inputs: &[f64],
     state: &State<N, C::Manifold>,
     x: &DVector<f64>,
@@ -101,9 +107,16 @@ where
     } else {
         ForceDerivatives::none(s, inputs.len())
     };
+    let (theta, share) = (point.theta(), point.share());
+    let forms = one_forms(discrete, q, &(end_point * theta)).ok_or_else(not_carried)?;
+    let multipliers: Vec<f64> = (0..S::ONE_FORMS).map(|a| x[layout.one_form(a)]).collect();
     let pi = space.pull_back(q, &SVector::zeros(), &state.p);
     let (_, p_in, _) = chart_change(space, q, q, &pi).ok_or_else(outside)?;
-    let end = action.end + forces.end;
+    // The end covector takes the one-forms' impulse's share `1 − σ`.
+    let mut end = action.end + forces.end;
+    for (form, mu) in forms.iter().zip(&multipliers) {
+        end += form.value * (mu * (1.0 - share));
+    }
     let (z0, p_delta, p_eps) = chart_change(space, q, &next, &end).ok_or_else(outside)?;
     let (position_start, position_end) =
         end_position(space, q, &next, &end_point).ok_or_else(outside)?;
@@ -116,6 +129,9 @@ where
         let mut block = action.start[j] + forces.start[j];
         if j == 0 {
             block -= p_in;
+            for (form, mu) in forms.iter().zip(&multipliers) {
+                block += form.start * (mu * share);
+            }
         }
         // The rows of point j's equation sit where the unknowns of point j + 1 do.
         let row = layout.point(j + 1);
@@ -125,6 +141,12 @@ where
     }
     for i in 0..N {
         dx[(i, N + i)] = 1.0;
+    }
+    // The one-form rows `Ã_a(θ ξ'_s) · ξ'_s` move with the start as `ξ'_sᵀ ∂Ã_a/∂δ`.
+    for (a, form) in forms.iter().enumerate() {
+        let row = form.start.transpose() * end_point;
+        dx.view_mut((layout.one_form(a), 0), (1, N))
+            .copy_from(&row.transpose());
     }
     newton
         .implicit_derivatives(x, &mut dx)
@@ -153,6 +175,14 @@ where
             d_covector += end_moving.column(c);
         } else if c >= 2 * N {
             d_covector += forces.inputs[s].column(c - 2 * N);
+        }
+        for (a, (form, mu)) in forms.iter().zip(&multipliers).enumerate() {
+            let d_mu = dx[(layout.one_form(a), c)];
+            let mut d_form = form.along * d_end * theta;
+            if c < N {
+                d_form += form.start.column(c);
+            }
+            d_covector += (form.value * d_mu + d_form * *mu) * (1.0 - share);
         }
         let mut d_momentum = z0.transpose() * d_covector + p_eps * d_position;
         if c < N {
@@ -193,6 +223,47 @@ where
         });
     }
     Ok(derivatives)
+}
+
+/// A one-form at the step's constraint point `ξ_c` read in the carried chart: its row `Ã_a`,
+/// `∂Ã_a/∂δ` and `∂Ã_a/∂ξ_c`.
+struct OneForm<const N: usize> {
+    value: SVector<f64, N>,
+    start: SMatrix<f64, N, N>,
+    along: SMatrix<f64, N, N>,
+}
+
+/// The model's one-forms at `xi_c` with their derivatives in the start and the point, by
+/// first-order duals through [`carried_one_form`]; `None` where the charts are not carried.
+fn one_forms<S, C, const N: usize>(
+    discrete: &DiscreteLagrangian<S, N, C>,
+    q: &Point<C, N, f64>,
+    xi_c: &SVector<f64, N>,
+) -> Option<Vec<OneForm<N>>>
+where
+    S: DiracSystem<N, C::Manifold>,
+    C: ConfigurationSpace<N>,
+{
+    let (system, space) = (discrete.system(), discrete.space());
+    let still = SVector::from_element(Dual::from(0.0));
+    (0..S::ONE_FORMS)
+        .map(|a| {
+            let moved = carried_one_form(
+                system,
+                space,
+                q,
+                &xi_c.map(Dual::from),
+                &lift(&SVector::zeros(), 1.0),
+                a,
+            )?;
+            let along = carried_one_form(system, space, q, &lift(xi_c, 1.0), &still, a)?;
+            Some(OneForm {
+                value: moved.map(|f| f.re),
+                start: derivatives_of(&moved),
+                along: derivatives_of(&along),
+            })
+        })
+        .collect()
 }
 
 /// The forces' part of the derivatives: `∂f_j/∂δ` (`j = 0..=s`), `f_s`, `∂f_s/∂ξ_m`
