@@ -1632,15 +1632,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             *block = g.row(s)[m + 1];
         }
         end_blocks[s - 1] += end_turning * theta;
-        let mut derivatives = StepDerivatives::<N> {
-            q_q: SMatrix::zeros(),
-            q_p: SMatrix::zeros(),
-            p_q: SMatrix::zeros(),
-            p_p: SMatrix::zeros(),
-            q_u: DMatrix::zeros(N, inputs),
-            p_u: DMatrix::zeros(N, inputs),
-            pivot_ratio: newton.pivot_ratio(),
-        };
+        let mut derivatives = StepDerivatives::<N>::zeros(inputs, newton.pivot_ratio());
         // Column by column (q_k, p_k, u): fixed-size products, no allocation.
         for c in 0..2 * N + inputs {
             // q_{k+1} = q_k + ξ_s.
@@ -1663,43 +1655,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             for (a, row) in end_rows.iter().enumerate() {
                 dp += row * dx[(layout.one_form(a), c)];
             }
-            let d = &mut derivatives;
-            match c {
-                c if c < N => {
-                    d.q_q.set_column(c, &dq);
-                    d.p_q.set_column(c, &dp);
-                }
-                c if c < 2 * N => {
-                    d.q_p.set_column(c - N, &dq);
-                    d.p_p.set_column(c - N, &dp);
-                }
-                c => {
-                    d.q_u.set_column(c - 2 * N, &dq);
-                    d.p_u.set_column(c - 2 * N, &dp);
-                }
-            }
+            derivatives.set_column(c, &dq, &dp);
         }
-        let finite = |m: &SMatrix<f64, N, N>| m.iter().all(|v| v.is_finite());
-        if ![
-            derivatives.q_q,
-            derivatives.q_p,
-            derivatives.p_q,
-            derivatives.p_p,
-        ]
-        .iter()
-        .all(finite)
-            || !derivatives
-                .q_u
-                .iter()
-                .chain(derivatives.p_u.iter())
-                .all(|v| v.is_finite())
-        {
-            return Err(DiracError::NonFinite {
-                what: "a derivative of the step map".into(),
-                value: f64::NAN,
-            });
-        }
-        Ok(derivatives)
+        derivatives.finite()
     }
 }
 

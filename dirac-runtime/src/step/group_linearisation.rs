@@ -153,15 +153,7 @@ where
         .ok_or_else(stale_factorisation)?;
 
     let end_moving = action.start[s] + forces.start[s];
-    let mut derivatives = StepDerivatives::<N> {
-        q_q: SMatrix::zeros(),
-        q_p: SMatrix::zeros(),
-        p_q: SMatrix::zeros(),
-        p_p: SMatrix::zeros(),
-        q_u: DMatrix::zeros(N, n_in),
-        p_u: DMatrix::zeros(N, n_in),
-        pivot_ratio: newton.pivot_ratio(),
-    };
+    let mut derivatives = StepDerivatives::<N>::zeros(n_in, newton.pivot_ratio());
     for c in 0..parameters {
         let d_end = dx.fixed_view::<N, 1>(layout.end_point(), c).into_owned();
         let mut d_position = position_end * d_end;
@@ -188,41 +180,9 @@ where
         if c < N {
             d_momentum += p_delta.column(c);
         }
-        let d = &mut derivatives;
-        match c {
-            c if c < N => {
-                d.q_q.set_column(c, &d_position);
-                d.p_q.set_column(c, &d_momentum);
-            }
-            c if c < 2 * N => {
-                d.q_p.set_column(c - N, &d_position);
-                d.p_p.set_column(c - N, &d_momentum);
-            }
-            c => {
-                d.q_u.set_column(c - 2 * N, &d_position);
-                d.p_u.set_column(c - 2 * N, &d_momentum);
-            }
-        }
+        derivatives.set_column(c, &d_position, &d_momentum);
     }
-    let blocks = [
-        derivatives.q_q,
-        derivatives.q_p,
-        derivatives.p_q,
-        derivatives.p_p,
-    ];
-    let finite = blocks.iter().all(|m| m.iter().all(|v| v.is_finite()))
-        && derivatives
-            .q_u
-            .iter()
-            .chain(derivatives.p_u.iter())
-            .all(|v| v.is_finite());
-    if !finite {
-        return Err(DiracError::NonFinite {
-            what: "a derivative of the step map".into(),
-            value: f64::NAN,
-        });
-    }
-    Ok(derivatives)
+    derivatives.finite()
 }
 
 /// A one-form at the step's constraint point `ξ_c` read in the carried chart: its row `Ã_a`,

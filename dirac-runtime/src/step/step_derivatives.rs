@@ -8,7 +8,9 @@
 //! along. Second derivatives take the third slot derivatives of `L_d` (hyper-hyper-dual
 //! numbers) through the same factorisation.
 
-use nalgebra::{DMatrix, SMatrix};
+use nalgebra::{DMatrix, SMatrix, SVector};
+
+use crate::base::error::DiracError;
 
 /// `A_k = ∂(q_{k+1}, p_{k+1})/∂(q_k, p_k)` of one step, by blocks, and
 /// `B_k = ∂(q_{k+1}, p_{k+1})/∂u_k` for the model's inputs (held over the step).
@@ -54,6 +56,57 @@ pub struct StepDerivatives<const N: usize> {
 }
 
 impl<const N: usize> StepDerivatives<N> {
+    /// Zero derivatives for a model with `inputs` inputs, to be filled column by column.
+    pub(crate) fn zeros(inputs: usize, pivot_ratio: f64) -> Self {
+        Self {
+            q_q: SMatrix::zeros(),
+            q_p: SMatrix::zeros(),
+            p_q: SMatrix::zeros(),
+            p_p: SMatrix::zeros(),
+            q_u: DMatrix::zeros(N, inputs),
+            p_u: DMatrix::zeros(N, inputs),
+            pivot_ratio,
+        }
+    }
+
+    /// Sets column `c` of `[A B]` (`c < N`: along `q_k`; `c < 2N`: along `p_k`; else along input
+    /// `c − 2N`) to the derivatives `dq` and `dp` of `q_{k+1}` and `p_{k+1}`.
+    pub(crate) fn set_column(&mut self, c: usize, dq: &SVector<f64, N>, dp: &SVector<f64, N>) {
+        match c {
+            c if c < N => {
+                self.q_q.set_column(c, dq);
+                self.p_q.set_column(c, dp);
+            }
+            c if c < 2 * N => {
+                self.q_p.set_column(c - N, dq);
+                self.p_p.set_column(c - N, dp);
+            }
+            c => {
+                self.q_u.set_column(c - 2 * N, dq);
+                self.p_u.set_column(c - 2 * N, dp);
+            }
+        }
+    }
+
+    /// An error where a derivative is not finite.
+    pub(crate) fn finite(self) -> Result<Self, DiracError> {
+        let blocks = [self.q_q, self.q_p, self.p_q, self.p_p];
+        let finite = blocks.iter().all(|m| m.iter().all(|v| v.is_finite()))
+            && self
+                .q_u
+                .iter()
+                .chain(self.p_u.iter())
+                .all(|v| v.is_finite());
+        if finite {
+            Ok(self)
+        } else {
+            Err(DiracError::NonFinite {
+                what: "a derivative of the step map".into(),
+                value: f64::NAN,
+            })
+        }
+    }
+
     /// The `2N × 2N` matrix `[[q_q, q_p], [p_q, p_p]]`.
     pub fn matrix(&self) -> DMatrix<f64> {
         let mut a = DMatrix::zeros(2 * N, 2 * N);
