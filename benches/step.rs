@@ -338,6 +338,24 @@ fn lie_group(c: &mut Criterion) {
         .expect("valid scene");
         restarting(&mut group, &name, started);
     }
+    // The same midpoint step with its derivatives A in the tangent chart (`step_linearised`).
+    let started = rigid_body::started(
+        rigid_body::PENDULUM,
+        Product::cayley(),
+        Quadrature::midpoint(),
+        h,
+        (r0, omega0),
+    )
+    .expect("valid scene");
+    let mut linearised = started.clone();
+    group.bench_function("generated_midpoint_with_derivatives", |b| {
+        b.iter(|| {
+            if linearised.steps() >= 100_000 {
+                linearised = started.clone();
+            }
+            black_box(linearised.step_linearised()).expect("step")
+        })
+    });
     let mut hand = HandLgvi::new(&rigid_body::PENDULUM, h, r0, omega0);
     let mut steps = 0;
     group.bench_function("hand_written_lgvi", |b| {

@@ -49,7 +49,9 @@ const GROUPS: &[(&str, &str)] = &[
     ),
     (
         "pendulum_3d_step",
-        "The 3D pendulum on SO(3): the generated Lie group step against a hand-written one.",
+        "The 3D pendulum on SO(3): the generated Lie group step against a hand-written one, and \
+         the generated midpoint step with its derivatives `A` in the tangent chart \
+         (`step_linearised`).",
     ),
     (
         "spherical_pendulum_step",

@@ -9,8 +9,8 @@
 //! `output/cart_pole_lqr.png`, `output/long_horizon_energy.png`, `output/heavy_top.png`,
 //! `output/heavy_top_invariants.png`. Models on rotations and unit vectors: the heavy top (both
 //! retractions), the 3D pendulum against a quaternion reference, the spherical pendulum on `S²`
-//! beside the Cartesian one, the rolling ball at each constraint point, a satellite's slew and a satellite with reaction
-//! wheels held by LQR on the step map's derivatives.
+//! beside the Cartesian one, the rolling ball at each constraint point, a satellite's slew, and
+//! a satellite with reaction wheels held by LQR on the step map's derivatives.
 //!
 //! `cargo run --release --example tour`
 

@@ -660,6 +660,8 @@ impl<S: DiracSystem<N, C::Manifold>, C: ConfigurationSpace<N>, const N: usize>
     pub fn with_constraint_point(mut self, point: ConstraintPoint) -> Self {
         self.settle_violation();
         self.equations.set_constraint_point(point);
+        // The constraint rows change: a Jacobian kept from them no longer fits.
+        self.newton.forget_jacobian();
         self
     }
 
