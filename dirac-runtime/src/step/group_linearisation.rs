@@ -111,13 +111,14 @@ where
     let forms = one_forms(discrete, q, &(end_point * theta)).ok_or_else(not_carried)?;
     let multipliers: Vec<f64> = (0..S::ONE_FORMS).map(|a| x[layout.one_form(a)]).collect();
     let pi = space.pull_back(q, &SVector::zeros(), &state.p);
-    let (_, p_in, _) = chart_change(space, q, q, &pi).ok_or_else(outside)?;
+    let (_, p_in) = chart_change(space, q, q, &pi, Moved::Start).ok_or_else(outside)?;
     // The end covector takes the one-forms' impulse's share `1 − σ`.
     let mut end = action.end + forces.end;
     for (form, mu) in forms.iter().zip(&multipliers) {
         end += form.value * (mu * (1.0 - share));
     }
-    let (z0, p_delta, p_eps) = chart_change(space, q, &next, &end).ok_or_else(outside)?;
+    let (z0, p_delta) = chart_change(space, q, &next, &end, Moved::Start).ok_or_else(outside)?;
+    let (_, p_eps) = chart_change(space, q, &next, &end, Moved::Point).ok_or_else(outside)?;
     let (position_start, position_end) =
         end_position(space, q, &next, &end_point).ok_or_else(outside)?;
 
@@ -308,57 +309,53 @@ where
     Some(out)
 }
 
+/// Which first argument of `ξ'(δ, ε, z)` a [`chart_change`] pass moves.
+#[derive(Clone, Copy, PartialEq)]
+enum Moved {
+    /// The start, `δ`.
+    Start,
+    /// The point read in the chart at the target, `ε`.
+    Point,
+}
+
 /// For `ξ'(δ, ε, z) = R_q⁻¹(g(δ)⁻¹ R_target(ε + z))`, the carried chart's coordinates of the
-/// point at `ε + z` of the chart at `target`: `(Z₀, P_δ, P_ε)` with `Z₀ = ∂ξ'/∂z`,
-/// `(P_δ)_ra = Σ_m w_m ∂²ξ'_m/∂z_r∂δ_a` and `P_ε` likewise, at `δ = ε = z = 0`. `None` outside
-/// the chart at `q` or where the charts are not carried.
-#[allow(clippy::type_complexity)]
+/// point at `ε + z` of the chart at `target`: `(Z₀, P)` with `Z₀ = ∂ξ'/∂z` and
+/// `P_ra = Σ_m w_m ∂²ξ'_m/∂z_r∂x_a` for `x` the argument `moved` (`δ` or `ε`), at
+/// `δ = ε = z = 0`. `None` outside the chart at `q` or where the charts are not carried.
 fn chart_change<C: ConfigurationSpace<N>, const N: usize>(
     space: &C,
     q: &Point<C, N, f64>,
     target: &Point<C, N, f64>,
     w: &SVector<f64, N>,
-) -> Option<(SMatrix<f64, N, N>, SMatrix<f64, N, N>, SMatrix<f64, N, N>)> {
+    moved: Moved,
+) -> Option<(SMatrix<f64, N, N>, SMatrix<f64, N, N>)> {
     type H<const N: usize> = HyperDualSVec64<N, N>;
-    let first = |i: usize| {
+    let z = SVector::<H<N>, N>::from_fn(|i, _| {
         H::<N>::new(
             0.0,
             Derivative::some(unit(i)),
             Derivative::none(),
             Derivative::none(),
         )
-    };
-    let second = |i: usize| {
-        H::<N>::new(
-            0.0,
-            Derivative::none(),
-            Derivative::some(unit::<N>(i).transpose()),
-            Derivative::none(),
-        )
-    };
+    });
+    let x = SVector::<H<N>, N>::from_fn(|i, _| {
+        let seed = Derivative::some(unit::<N>(i).transpose());
+        H::<N>::new(0.0, Derivative::none(), seed, Derivative::none())
+    });
     let zero = SVector::<H<N>, N>::from_element(H::<N>::from(0.0));
-    let z = SVector::<H<N>, N>::from_fn(|i, _| first(i));
-    let moved = SVector::<H<N>, N>::from_fn(|i, _| second(i));
-    let mut turn = SMatrix::<f64, N, N>::zeros();
-    let mut pairs = [SMatrix::<f64, N, N>::zeros(); 2];
-    for (k, pair) in pairs.iter_mut().enumerate() {
-        let (delta, eps) = if k == 0 {
-            (&moved, &zero)
-        } else {
-            (&zero, &moved)
-        };
-        let y = space.retract(target, &(eps + z));
-        let (y, _) = space.carried(q, &(-delta), &y, &C::Manifold::zero())?;
-        let xi = space.local_over(q, &y)?;
-        for m in 0..N {
-            let d1 = xi[m].eps1.unwrap_generic(Const::<N>, U1);
-            let d2 = xi[m].eps1eps2.unwrap_generic(Const::<N>, Const::<N>);
-            turn.set_row(m, &d1.transpose());
-            *pair += d2 * w[m];
-        }
+    let (delta, eps) = match moved {
+        Moved::Start => (&x, &zero),
+        Moved::Point => (&zero, &x),
+    };
+    let y = space.retract(target, &(eps + z));
+    let (y, _) = space.carried(q, &(-delta), &y, &C::Manifold::zero())?;
+    let xi = space.local_over(q, &y)?;
+    let (mut z0, mut pairing) = (SMatrix::<f64, N, N>::zeros(), SMatrix::<f64, N, N>::zeros());
+    for m in 0..N {
+        z0.set_row(m, &xi[m].eps1.unwrap_generic(Const::<N>, U1).transpose());
+        pairing += xi[m].eps1eps2.unwrap_generic(Const::<N>, Const::<N>) * w[m];
     }
-    let [start, end] = pairs;
-    Some((turn, start, end))
+    Some((z0, pairing))
 }
 
 /// `∂ε/∂δ` and `∂ε/∂ξ_s` of `ε = R_next⁻¹(g(δ) R_q(ξ_s))`, the step's end read in the chart at
