@@ -129,7 +129,8 @@ fn chain_growth(c: &mut Criterion) {
 
 /// Constrained steps (midpoint, h = 0.01) beside the unconstrained double pendulum: the LC circuit
 /// (4 coordinates, 2 constant one-forms, KKT 6×6, its hidden constraint projected at each step's
-/// end; linear, so one factorised Jacobian serves the run, and again with one per step), the
+/// end; linear, so stepped by a step map read off once per run, and again by Newton's method
+/// with one factorised Jacobian for the run and with one per step), the
 /// knife edge (3 coordinates, one configuration-dependent one-form, KKT 4×4), and the
 /// Cartesian pendulum under SHAKE and RATTLE.
 fn constrained(c: &mut Criterion) {
@@ -146,8 +147,23 @@ fn constrained(c: &mut Criterion) {
     group.bench_function("lc_circuit", |b| {
         b.iter(|| black_box(lc.step()).expect("step"))
     });
-    // The same steps with a Jacobian evaluated and factorised at each (Newton's method), against
-    // the one the linear circuit keeps by default.
+    // The same steps by Newton's method with one Jacobian kept for the run, and with a Jacobian
+    // evaluated and factorised at each, against the step map the linear circuit is stepped by
+    // by default.
+    let kept = NewtonOptions {
+        jacobian_reuse: Some(1.0),
+        ..Default::default()
+    };
+    let mut lc_kept = Stepper::new(scenes::circuit::LC, Quadrature::midpoint(), 0.01)
+        .expect("valid scene")
+        .with_newton_options(kept)
+        .expect("valid options");
+    lc_kept
+        .start_from_velocity(scenes::circuit::q0(), SVector::zeros())
+        .expect("consistent start");
+    group.bench_function("lc_circuit_kept_jacobian", |b| {
+        b.iter(|| black_box(lc_kept.step()).expect("step"))
+    });
     let newton = NewtonOptions {
         jacobian_reuse: Some(0.0),
         ..Default::default()

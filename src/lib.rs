@@ -53,7 +53,7 @@ pub mod prelude {
         ExplicitSystem, Feedback, Field, FirstOrderScheme, HamiltonianSystem, HolonomicScheme,
         Input, Interconnected, Interconnection, Junction, ManifoldStepper, Modular, NewtonOptions,
         Positive, Product, Progress, Quadrature, Rates, Repeated, Retraction, Rule, Run, Sample,
-        Scalar, SeparableDensity, Solution, Status, Stepper, TimeTransformed, Trajectory,
+        Scalar, SeparableDensity, Solution, Solver, Status, Stepper, TimeTransformed, Trajectory,
     };
 }
 

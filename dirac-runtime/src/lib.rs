@@ -55,7 +55,7 @@ pub use base::scalar::Scalar;
 pub use discrete::discrete_lagrangian::DiscreteLagrangian;
 pub use integrate::event::{Crossing, Direction, Event};
 pub use integrate::run::{Feedback, Progress, Run, Solution, Status};
-pub use integrate::stepper::{ManifoldStepper, Stepper};
+pub use integrate::stepper::{ManifoldStepper, Solver, Stepper};
 pub use integrate::time_transformation::TimeTransformed;
 pub use integrate::trajectory::{EnergyBalance, Interrupted, Metadata, Trajectory};
 pub use model::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian};

@@ -33,8 +33,11 @@ use crate::model::legendre;
 use crate::model::system::DiracSystem;
 use crate::quadrature::MAX_DEGREE;
 use crate::solve::newton::{Newton, NewtonFailure};
-use crate::space::configuration_space::{ConfigurationSpace, StepCovectors};
+use crate::space::configuration_space::{ConfigurationSpace, StepCovectors, compensated_add};
 use crate::space::manifold::Vectors;
+use crate::solve::jacobian::{Dense, Jacobian};
+use crate::solve::newton::NewtonOptions;
+use crate::step::affine_step::{self, AffineStep};
 use crate::step::dense_output::{ChartPath, Sample, chart_path};
 use crate::step::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step::step_equations::{State, StepEquations, StepWork};
@@ -106,6 +109,12 @@ pub struct EulerLagrange<S, const N: usize, C> {
     /// The impulse of the junctions on a component of a modular interconnection (see
     /// [`set_coupling`](Self::set_coupling)), `None` for a model stepped on its own.
     coupling: Option<(SVector<f64, N>, f64)>,
+    /// The run's step map, where its equations are linear with constant coefficients and it has
+    /// been read off (see [`affine_step`](crate::step::affine_step)); `None` before the first
+    /// step of a run.
+    affine: Option<AffineStep>,
+    /// The run's equations were found not to give a step map (the steps go to Newton).
+    affine_refused: Option<String>,
 }
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
@@ -163,6 +172,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             covectors_pending: false,
             scratch: DMatrix::zeros(0, 0),
             coupling: None,
+            affine: None,
+            affine_refused: None,
             discrete,
         })
     }
@@ -180,6 +191,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// Evaluates the one-forms at `point` of each step.
     pub fn set_constraint_point(&mut self, point: ConstraintPoint) {
         self.point = point;
+        self.forget_step_map();
     }
 
     /// What a step does with the momentum of a model with holonomic constraints.
@@ -190,6 +202,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// Sets what a step does with the momentum of a model with holonomic constraints.
     pub fn set_holonomic_scheme(&mut self, scheme: HolonomicScheme) {
         self.holonomic_scheme = scheme;
+        self.forget_step_map();
     }
 
     /// Which step a Lagrangian linear in the velocities is advanced by.
@@ -201,6 +214,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// run begins).
     pub fn set_first_order_scheme(&mut self, scheme: FirstOrderScheme) {
         self.first_order_scheme = scheme;
+        self.forget_step_map();
+    }
+
+    /// Forgets the run's step map: the next step reads it off again.
+    fn forget_step_map(&mut self) {
+        self.affine = None;
+        self.affine_refused = None;
     }
 
     /// Whether the run's steps are projected onto `p = ϑ(q)` by the multipliers at the end of
@@ -296,6 +316,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// What a run takes up at its start besides the degenerate coordinates: closed forms and
     /// the first-order scheme.
     fn begin_run(&mut self, state: &State<N>) {
+        self.forget_step_map();
         let system = self.discrete.system();
         // Closed forms serve only a translation chart (elsewhere `L` is read in the chart).
         self.closed_form = C::TRANSLATION
@@ -585,6 +606,131 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         state.velocity = v;
         Ok(())
     }
+
+    /// Why the run's steps are not read off a step map
+    /// ([`affine_step`](crate::step::affine_step)), or `Ok(())` where they are: `L` quadratic
+    /// with constant coefficients on `Rⁿ`, constant one-forms, and nothing else in a step (no
+    /// forces, whose time and inputs change the step; no holonomic constraints or coupling).
+    /// A projection after the solve (hidden constraints, collocated rows) is linear too, and
+    /// part of the map.
+    fn refuse_step_map(&self) -> Result<(), String> {
+        let system = self.discrete.system();
+        let why = if !S::QUADRATIC {
+            "the Lagrangian is not quadratic with constant coefficients (QUADRATIC)"
+        } else if !C::TRANSLATION {
+            "the configuration space is not a vector space"
+        } else if S::FORCES {
+            "the model has forces (their time and inputs change the step from one step to the next)"
+        } else if S::HOLONOMIC > 0 {
+            "the model has holonomic constraints"
+        } else if self.coupling.is_some() {
+            "the model is a component of an interconnection"
+        } else if !(0..S::ONE_FORMS).all(|a| system.one_form_is_constant(a)) {
+            "a constraint one-form depends on the position"
+        } else if let Some(why) = &self.affine_refused {
+            return Err(why.clone());
+        } else {
+            return Ok(());
+        };
+        Err(why.to_string())
+    }
+
+    /// Reading `reading` of the run's step map at `state` (see [`AffineStep`]), or why there is
+    /// none.
+    fn read_step_map(&mut self, state: &State<N>, reading: u64) -> Result<AffineStep, String> {
+        let m = self.unknowns();
+        let (mut x, mut residual) = (DVector::zeros(m), DVector::zeros(m));
+        let origin = State::new(state.t, SVector::zeros(), SVector::zeros(), SVector::zeros());
+        self.predict(&origin, None, &mut x);
+        x.fill(0.0);
+        let mut jacobian = Dense::new(m);
+        self.assemble(&origin, &x, &mut residual, Some(jacobian.matrix()));
+        jacobian
+            .factorise(NewtonOptions::default().singular_tolerance)
+            .map_err(|_| "the step's Jacobian is singular".to_string())?;
+        let z: Vec<f64> = state.q.iter().chain(state.p.iter()).copied().collect();
+        AffineStep::read(&z, reading, |z| {
+            self.probe(state.t, z, &jacobian, &mut x, &mut residual)
+        })
+    }
+
+    /// The stacked outputs of the step from `z = (q_k, p_k)` solved by one update of `x = 0` with
+    /// the factorised `jacobian`: the unknowns, the momentum's impulse and end covector, the
+    /// constraints' impulse. `Err` where the update does not reach a root.
+    fn probe(
+        &mut self,
+        t: f64,
+        z: &[f64],
+        jacobian: &Dense,
+        x: &mut DVector<f64>,
+        residual: &mut DVector<f64>,
+    ) -> Result<DVector<f64>, String> {
+        let q = SVector::<f64, N>::from_column_slice(&z[..N]);
+        let p = SVector::<f64, N>::from_column_slice(&z[N..]);
+        let state = State::new(t, q, p, SVector::zeros());
+        self.predict(&state, None, x);
+        x.fill(0.0);
+        self.assemble(&state, x, residual, None);
+        affine_step::correction(jacobian, residual);
+        *x -= &*residual;
+        self.assemble(&state, x, residual, None);
+        affine_step::correction(jacobian, residual);
+        if !affine_step::is_root(x.as_slice(), residual.as_slice()) {
+            return Err(format!(
+                "one update does not solve the step from a unit state (the correction left is \
+                 {:.1e}): the step equations are not linear",
+                residual.amax()
+            ));
+        }
+        let next = self.advance(&state, x, 0).map_err(|e| e.to_string())?;
+        let m = x.len();
+        let mut y = DVector::zeros(m + 3 * N);
+        y.rows_mut(0, m).copy_from(x);
+        y.fixed_rows_mut::<N>(m)
+            .copy_from(&(next.q - q + next.q_carry));
+        y.fixed_rows_mut::<N>(m + N)
+            .copy_from(&(next.p - p + next.p_carry));
+        y.fixed_rows_mut::<N>(m + 2 * N)
+            .copy_from(&self.constraint_impulse);
+        Ok(y)
+    }
+
+    /// The step from `state` by the run's step map `map`: its solution into `x` and the
+    /// equations' record of the step (for its work), and the new state by the compensated sums
+    /// of the map's increments.
+    fn step_by_map(
+        &mut self,
+        map: &mut AffineStep,
+        state: &State<N>,
+        x: &mut DVector<f64>,
+        step: u64,
+    ) -> Result<State<N>, DiracError> {
+        let m = x.len();
+        let y = map.apply(state.q.as_slice(), state.p.as_slice());
+        x.copy_from(&y.rows(0, m));
+        let dq = y.fixed_rows::<N>(m).into_owned();
+        let dp = y.fixed_rows::<N>(m + N).into_owned();
+        let constraint_impulse = y.fixed_rows::<N>(m + 2 * N).into_owned();
+        self.momentum = self
+            .discrete
+            .space()
+            .pull_back(&state.q, &SVector::zeros(), &state.p);
+        for (j, z) in self.increments.iter_mut().enumerate() {
+            z.copy_from(&x.fixed_rows::<N>(self.layout.point(j + 1)));
+        }
+        self.constraint_impulse = constraint_impulse;
+        let xi = self.end_increment(x);
+        let (space, system) = (self.discrete.space(), self.discrete.system());
+        let mut next = *state;
+        space.advance(&mut next.q, &mut next.q_carry, &dq);
+        compensated_add(&mut next.p, &mut next.p_carry, &dp);
+        check_finite(system, "new position", &next.q)?;
+        check_finite(system, "new momentum", &next.p)?;
+        next.velocity = space.push_forward(&state.q, &xi, &(xi / self.discrete.h()));
+        self.discrete.check_end(&next.q, &next.velocity, step)?;
+        Ok(next)
+    }
+
 
     /// Second derivatives of the step from `state` solved by `x` with respect to `(q_k, p_k)`,
     /// `newton` holding the Jacobian factorised at `x`: for models on `Rⁿ` without constraints
@@ -1388,6 +1534,54 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         }
         self.discrete.check_end(&next.q, &next.velocity, step)?;
         Ok(next)
+    }
+
+    fn affine_step(
+        &mut self,
+        state: &State<N>,
+        x: &mut DVector<f64>,
+        step: u64,
+    ) -> Option<Result<State<N>, DiracError>> {
+        if let Err(why) = self.refuse_step_map() {
+            return Some(Err(DiracError::Unsupported(format!("a step map: {why}"))));
+        }
+        let claim = |why: &str| {
+            DiracError::InconsistentDerivatives(format!(
+                "the model claims step equations linear with constant coefficients (QUADRATIC), \
+                 but at step {step} the step map cannot be read: {why}"
+            ))
+        };
+        let mut map = match self.affine.take() {
+            None => match self.read_step_map(state, 0) {
+                Ok(map) => map,
+                Err(why) => {
+                    let error = claim(&why);
+                    self.affine_refused = Some(why);
+                    return Some(Err(error));
+                }
+            },
+            Some(mut map) => match map.serve() {
+                None => map,
+                Some(reading) => match self.read_step_map(state, reading) {
+                    Ok(map) => map,
+                    Err(why) => {
+                        let error = claim(&format!(
+                            "{why}; the steps since step {} may be wrong too",
+                            step.saturating_sub(u64::from(affine_step::READ_EVERY))
+                        ));
+                        self.affine_refused = Some(why);
+                        return Some(Err(error));
+                    }
+                },
+            },
+        };
+        let taken = self.step_by_map(&mut map, state, x, step);
+        self.affine = Some(map);
+        Some(taken)
+    }
+
+    fn step_map_refusal(&self) -> Result<(), String> {
+        self.refuse_step_map()
     }
 
     fn violation(&self, from: &State<N>, to: &State<N>, x: &DVector<f64>) -> f64 {

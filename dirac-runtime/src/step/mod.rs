@@ -6,6 +6,7 @@
 //!
 //! Uses every layer below it, up to [`discrete`](crate::discrete). A new scheme goes here.
 
+pub mod affine_step;
 pub mod composition;
 pub mod dense_output;
 pub mod euler_lagrange;

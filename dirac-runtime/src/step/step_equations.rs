@@ -215,6 +215,28 @@ pub trait StepEquations<const N: usize> {
         None
     }
 
+    /// The step from `state` by the step map of equations linear with constant coefficients,
+    /// read off once per run (see [`affine_step`](crate::step::affine_step)): writes the
+    /// step's solution into `x` and returns the state [`advance`](Self::advance) would give,
+    /// or the error of a step that fails. `None` (the default) where the equations give no
+    /// step map: the step is then predicted, solved by Newton's method and advanced. `step`
+    /// counts the steps before this one.
+    fn affine_step(
+        &mut self,
+        state: &State<N, Self::Manifold>,
+        x: &mut DVector<f64>,
+        step: u64,
+    ) -> Option<Result<State<N, Self::Manifold>, DiracError>> {
+        let _ = (state, x, step);
+        None
+    }
+
+    /// `Ok(())` where the steps are taken by a step map ([`affine_step`](Self::affine_step)),
+    /// else why not. By default the equations give none.
+    fn step_map_refusal(&self) -> Result<(), String> {
+        Err(format!("{} give no step map", Self::NAME))
+    }
+
     /// The constraint violation of the step from `from` to `to` that `x` solved (`to` as
     /// [`advance`](Self::advance) returned it): 0 for equations without constraints. A
     /// [`Stepper`](crate::Stepper) measures it only when asked
