@@ -129,8 +129,8 @@ fn chain_growth(c: &mut Criterion) {
 
 /// Constrained steps (midpoint, h = 0.01) beside the unconstrained double pendulum: the LC circuit
 /// (4 coordinates, 2 constant one-forms, KKT 6×6, its hidden constraint projected at each step's
-/// end; linear, so stepped by a step map read off once per run, and again by Newton's method
-/// with one factorised Jacobian for the run and with one per step), the
+/// end; linear, so stepped by its step map (`with_step_map`), and by Newton's method with one
+/// factorised Jacobian for the run and with one per step), the
 /// knife edge (3 coordinates, one configuration-dependent one-form, KKT 4×4), and the
 /// Cartesian pendulum under SHAKE and RATTLE.
 fn constrained(c: &mut Criterion) {

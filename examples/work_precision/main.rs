@@ -3,7 +3,8 @@
 //!
 //! Per scene and horizon: a reference, the closed form where the scene has one, else Dop853 at
 //! `rtol = atol = 1e-13` (its error estimated by the run at 1e-12); dirac's `midpoint`,
-//! `galerkin(2)` and `galerkin(3)` at the scene's steps, for a separable model the explicit
+//! `galerkin(2)` and `galerkin(3)` at the scene's steps (to `galerkin(5)` at T = 10⁴ on the
+//! circuit), also by their step maps where the model is linear (the circuit), for a separable model the explicit
 //! compositions of orders 2 to 8 as well, and on Kepler's orbits those compositions
 //! time-transformed (`dt/ds = |q|`) at the scene's fictive steps, measured by `Study`; Dop853
 //! and Dopri5 (ode_solvers) at tolerances 1e-4 … 1e-12 on the hand-derived first-order form;

@@ -3,11 +3,12 @@
 //! Jacobian for a run of linear step equations (the LC circuit, a driven RLC ladder, a driven
 //! damped oscillator) and steps as Newton's method does, to round-off; a wrong claim costs
 //! iterations, not accuracy. Where nothing changes the step from one step to the next (no
-//! forces), the stepper reads the step map off once per run and steps by it, as Newton's method
-//! to round-off, checking the claim it rests on.
+//! forces), a stepper `with_step_map` reads the step map off the step and steps by it, as
+//! Newton's method to round-off, checking the claim it rests on at every reading.
 
 use dirac::StepEquations;
 use dirac::prelude::*;
+use scenes::circuit::LcCircuit;
 use scenes::{
     cartesian_pendulum, circuit, components, knife_edge, oscillator, pendulum, rlc_ladder,
 };
@@ -365,7 +366,13 @@ fn lc_long(
     let (q, p) = (stepper.q(), stepper.p());
     let end = SVector::<f64, 8>::from_fn(|i, _| if i < 4 { q[i] } else { p[i - 4] });
     let balance = stepper.energy_balance_error().unwrap();
-    (end, stepper.multipliers().to_vec(), balance, iterations, stepper.solver())
+    (
+        end,
+        stepper.multipliers().to_vec(),
+        balance,
+        iterations,
+        stepper.solver(),
+    )
 }
 
 #[test]
@@ -377,8 +384,7 @@ fn linear_step_equations_are_stepped_by_a_map_read_off_the_step() {
         Quadrature::galerkin(3).unwrap(),
     ] {
         let name = quadrature.name();
-        let (mapped, mu, balance, iterations, solver) =
-            lc_long(&quadrature, h, steps, true);
+        let (mapped, mu, balance, iterations, solver) = lc_long(&quadrature, h, steps, true);
         let (solved, mu_solved, balance_solved, iterations_solved, newton) =
             lc_long(&quadrature, h, steps, false);
         assert_eq!(solver, Solver::StepMap, "{name}");
@@ -480,6 +486,13 @@ fn a_step_map_checks_the_claim_it_rests_on() {
         "{failed}"
     );
     assert_eq!(claimed.steps(), 0);
+    // And so does every later step of the run.
+    let again = claimed.step().unwrap_err();
+    assert!(
+        matches!(again, DiracError::InconsistentDerivatives(_)),
+        "{again}"
+    );
+    assert_eq!(claimed.solver(), Solver::StepMap);
     // A claim wrong only far from the start: a later reading of the map stops the run there,
     // and the state is kept.
     let mut faint = Stepper::new(Faint, Quadrature::midpoint(), 0.1)
@@ -517,9 +530,59 @@ fn a_step_map_checks_the_claim_it_rests_on() {
 }
 
 /// Why a stepper was refused its step map.
-fn refusal<S: DiracSystem<N>, const N: usize>(stepper: Result<Stepper<S, N>, DiracError>) -> String {
+fn refusal<S: DiracSystem<N>, const N: usize>(
+    stepper: Result<Stepper<S, N>, DiracError>,
+) -> String {
     match stepper {
         Err(DiracError::Unsupported(why)) => why,
         other => panic!("{:?}", other.map(|s| s.solver())),
+    }
+}
+
+#[test]
+fn a_step_maps_steps_serve_derivatives_dense_output_and_restarts_as_newtons_do() {
+    // The midpoint rule: derivatives of constrained steps are of degree 1.
+    let quadrature = Quadrature::midpoint();
+    let start = |stepper: &mut Stepper<LcCircuit, 4>| {
+        stepper
+            .start_from_velocity(circuit::q0(), SVector::zeros())
+            .unwrap()
+    };
+    let mut mapped = Stepper::new(circuit::LC, quadrature.clone(), 0.05)
+        .unwrap()
+        .with_step_map()
+        .unwrap();
+    let mut solved = Stepper::new(circuit::LC, quadrature, 0.05).unwrap();
+    for restart in 0..2 {
+        start(&mut mapped);
+        start(&mut solved);
+        // Past a reading (every 1 024 steps), then a step with its derivatives.
+        for _ in 0..1_500 {
+            mapped.step().unwrap();
+            solved.step().unwrap();
+        }
+        let (a, b) = (
+            mapped.step_linearised().unwrap(),
+            solved.step_linearised().unwrap(),
+        );
+        let gap = (a.matrix() - b.matrix()).amax();
+        assert!(gap <= 1e-12, "restart {restart}: A differs by {gap:e}");
+        let t = mapped.t() - 0.02;
+        let (inside, newton) = (
+            mapped.interpolate(t).unwrap(),
+            solved.interpolate(t).unwrap(),
+        );
+        let gap = (inside.q - newton.q)
+            .amax()
+            .max((inside.v - newton.v).amax());
+        assert!(
+            gap <= 1e-12,
+            "restart {restart}: dense output differs by {gap:e}"
+        );
+        let violation = mapped.constraint_violation();
+        assert!(
+            violation <= 1e-13,
+            "restart {restart}: violation {violation:e}"
+        );
     }
 }

@@ -22,17 +22,21 @@ fn oscillator_at(t: f64) -> Sample<1> {
 
 const STEPS: [f64; 4] = [0.2, 0.1, 0.05, 0.025];
 
-/// `|(q, p)(T) − exact|` by a stepper run here, not by the study, with the quadrature or the
-/// explicit composition called `method`.
+/// `|(q, p)(T) − exact|` by a stepper run here, not by the study, with the quadrature (by
+/// Newton's method or by its step map) or the explicit composition called `method`.
 fn direct_error(method: &str, h: f64, horizon: f64) -> f64 {
     let exact = oscillator_at(horizon);
     let error =
         |q: SVector<f64, 1>, p: SVector<f64, 1>| (q - exact.q).amax().max((p - exact.p).amax());
-    if let Some(quadrature) = scenes::quadratures()
-        .into_iter()
-        .find(|q| q.name() == method)
-    {
+    let (name, mapped) = match method.strip_suffix(", step map") {
+        Some(name) => (name, true),
+        None => (method, false),
+    };
+    if let Some(quadrature) = scenes::quadratures().into_iter().find(|q| q.name() == name) {
         let mut stepper = Stepper::new(Oscillator, quadrature, h).unwrap();
+        if mapped {
+            stepper = stepper.with_step_map().unwrap();
+        }
         stepper
             .start_from_velocity(vector![1.0], vector![0.0])
             .unwrap();
@@ -64,8 +68,9 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
     .run()
     .unwrap();
     assert!(study.failures.is_empty(), "{:?}", study.failures);
-    // Three quadratures, and the oscillator being separable, four explicit compositions.
-    assert_eq!(study.measurements.len(), 28);
+    // Three quadratures, by Newton's method and, the oscillator being quadratic, by their step
+    // maps; and the oscillator being separable, four explicit compositions.
+    assert_eq!(study.measurements.len(), 40);
     for m in &study.measurements {
         let direct = direct_error(&m.quadrature, m.h, horizon);
         assert!(
@@ -77,8 +82,13 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
         let implicit = scenes::quadratures()
             .iter()
             .any(|q| q.name() == m.quadrature);
-        if implicit {
-            assert!(m.newton_iterations >= 1.0, "{m:?}");
+        let mapped = m.quadrature.ends_with(", step map");
+        if implicit || mapped {
+            if mapped {
+                assert_eq!(m.newton_iterations, 0.0, "{m:?}");
+            } else {
+                assert!(m.newton_iterations >= 1.0, "{m:?}");
+            }
             // A quadratic energy: the Gauss rules keep it to round-off.
             assert!(m.energy_error < 1e-13, "{m:?}");
         } else {
@@ -126,7 +136,7 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
     let mut csv = Vec::new();
     study.write_csv(&mut csv).unwrap();
     let text = String::from_utf8(csv).unwrap();
-    assert_eq!(text.lines().count(), 29);
+    assert_eq!(text.lines().count(), 41);
     assert!(text.starts_with("quadrature,h,steps,error,energy_error,"));
 }
 

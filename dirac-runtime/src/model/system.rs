@@ -119,10 +119,12 @@ pub trait DiracSystem<const N: usize, M: Manifold<N> = Vectors> {
     /// linear with constant coefficients, and a [`Stepper`](crate::Stepper) keeps their
     /// factorised Jacobian from one step to the next rather than evaluating it at every step.
     /// `false` by default;
-    /// `#[dirac_system]` derives it from a Lagrangian written as an expression. A wrong claim
-    /// never gives a wrong answer: a kept Jacobian that is not the equations' is evaluated
-    /// again where it contracts too slowly, and a solve that still cannot converge fails as
-    /// any other.
+    /// `#[dirac_system]` derives it from a Lagrangian written as an expression. To Newton's
+    /// method a wrong claim never gives a wrong answer: a kept Jacobian that is not the
+    /// equations' is evaluated again where it contracts too slowly, and a solve that still
+    /// cannot converge fails as any other. A stepper
+    /// [`with_step_map`](crate::Stepper::with_step_map) trusts the claim between the readings
+    /// of its map, which check it (up to 1 024 steps).
     ///
     /// ```
     /// use dirac_runtime::{DiracSystem, Scalar};

@@ -20,20 +20,21 @@
 //! **Round-off.** Each of `M`'s entries carries the round-off of its solve, and a fixed map
 //! applies the same error at every step: the energy then drifts by about `ε` a step (measured
 //! 3.5e-11 over 10⁶ steps of the LC circuit, where Newton's method stays at 1.5e-14). So the
-//! map is read again every [`READ_EVERY`] steps, from probes scaled by `s_i ∈ [1, 2)` that
+//! map is read again every 1 024 steps, from probes scaled by `s_i ∈ [1, 2)` that
 //! change with every reading: each reading's round-off is then another, and the energy's
 //! round-off walks at random over the readings instead of drifting (2.0e-12 after 10⁶ steps of
 //! the LC circuit: a walk of about 1 000 readings, each of which drifts for 1 024 steps).
 //! A reading costs about `2N + 2` Newton steps, about a tenth of the steps it serves.
 //!
-//! **Checked, not trusted.** That the equations are linear is the model's claim
-//! ([`DiracSystem::QUADRATIC`](crate::DiracSystem::QUADRATIC)). Every reading checks it: each
-//! probe's solution must be a root to round-off (the Newton correction there at most
-//! [`ROOT_TOLERANCE`] of its size), and the map must give the solve from the current state to
-//! the same tolerance. Where the first reading fails the steps go to Newton's method; a later
-//! one that fails stops the run with
-//! [`DiracError::InconsistentDerivatives`](crate::DiracError): the claim is wrong, and the steps
-//! since the last reading may be too.
+//! **Checked at every reading.** That the equations are linear is the model's claim
+//! ([`DiracSystem::QUADRATIC`](crate::DiracSystem::QUADRATIC), derived by `#[dirac_system]`
+//! from the Lagrangian's expression). Every reading checks it: each probe, solved by an update
+//! of `x = 0` and one refinement, must be a root to round-off (the Newton correction left at
+//! most 1e-9 of `1 + ‖x‖∞`), and the map must give the solve from the current state to 1e-9 of
+//! the outputs' size. A reading that fails stops the run with
+//! [`DiracError::InconsistentDerivatives`](crate::DiracError), and so does every later step of
+//! the run. Between readings the claim is trusted: a model that wrongly claims to be quadratic
+//! can take up to 1 024 wrong steps before a reading stops it.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -92,13 +93,15 @@ impl AffineStep {
             served: 0,
         };
         let solved = probe(start)?;
+        // The size of the terms of `y₀ + M z`, whose round-off the gap may hold.
+        let terms = step.offset.amax() + step.map.amax() * step.state.amax() * n as f64;
         let read = step.apply_to_state();
-        let size = solved.amax().max(read.amax()).max(1.0);
+        let size = solved.amax().max(read.amax()).max(terms).max(1.0);
         let miss = (&solved - read).amax();
         if !(miss <= ROOT_TOLERANCE * size) {
             return Err(format!(
-                "the step read off unit states misses the step from the current state by \
-                 {miss:.1e} (of {size:.1e}): the step equations are not affine in the state"
+                "the step read off scaled unit states misses the step from the current state \
+                 by {miss:.1e} (of {size:.1e}): the step equations are not linear"
             ));
         }
         Ok(step)
@@ -122,7 +125,7 @@ impl AffineStep {
     /// Counts a step; the number of the next reading where this one has served its steps.
     pub(crate) fn serve(&mut self) -> Option<u64> {
         self.served += 1;
-        (self.served > READ_EVERY).then_some(self.reading + 1)
+        (self.served >= READ_EVERY).then_some(self.reading + 1)
     }
 }
 
@@ -161,7 +164,7 @@ mod tests {
         assert!((y - DVector::from_vec(vec![0.0, 15.0])).amax() < 1e-14);
         let curved = |z: &[f64]| Ok(DVector::from_vec(vec![z[0] * z[0], z[1]]));
         let refused = AffineStep::read(&[0.3, -1.5], 0, curved).unwrap_err();
-        assert!(refused.contains("not affine"), "{refused}");
+        assert!(refused.contains("not linear"), "{refused}");
         // Each reading probes at scales of its own.
         let scales: Vec<f64> = (0..6).map(probe_scale).collect();
         assert!(scales.iter().all(|s| (1.0..2.0).contains(s)));

@@ -32,11 +32,11 @@ use crate::model::derivatives::{Dual, Seed, seeded};
 use crate::model::legendre;
 use crate::model::system::DiracSystem;
 use crate::quadrature::MAX_DEGREE;
+use crate::solve::jacobian::{Dense, Jacobian};
+use crate::solve::newton::NewtonOptions;
 use crate::solve::newton::{Newton, NewtonFailure};
 use crate::space::configuration_space::{ConfigurationSpace, StepCovectors, compensated_add};
 use crate::space::manifold::Vectors;
-use crate::solve::jacobian::{Dense, Jacobian};
-use crate::solve::newton::NewtonOptions;
 use crate::step::affine_step::{self, AffineStep};
 use crate::step::dense_output::{ChartPath, Sample, chart_path};
 use crate::step::step_derivatives::{StepDerivatives, StepHessians};
@@ -113,7 +113,7 @@ pub struct EulerLagrange<S, const N: usize, C> {
     /// been read off (see [`affine_step`](crate::step::affine_step)); `None` before the first
     /// step of a run.
     affine: Option<AffineStep>,
-    /// The run's equations were found not to give a step map (the steps go to Newton).
+    /// Why a reading of the run's step map failed (every later step of the run fails so).
     affine_refused: Option<String>,
 }
 
@@ -620,15 +620,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         } else if !C::TRANSLATION {
             "the configuration space is not a vector space"
         } else if S::FORCES {
-            "the model has forces (their time and inputs change the step from one step to the next)"
+            "the model has forces (a force's time and inputs change the step from one step to \
+             the next; forces of the state alone, such as a damper, are refused too for now)"
         } else if S::HOLONOMIC > 0 {
             "the model has holonomic constraints"
         } else if self.coupling.is_some() {
             "the model is a component of an interconnection"
         } else if !(0..S::ONE_FORMS).all(|a| system.one_form_is_constant(a)) {
             "a constraint one-form depends on the position"
-        } else if let Some(why) = &self.affine_refused {
-            return Err(why.clone());
         } else {
             return Ok(());
         };
@@ -640,7 +639,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     fn read_step_map(&mut self, state: &State<N>, reading: u64) -> Result<AffineStep, String> {
         let m = self.unknowns();
         let (mut x, mut residual) = (DVector::zeros(m), DVector::zeros(m));
-        let origin = State::new(state.t, SVector::zeros(), SVector::zeros(), SVector::zeros());
+        let origin = State::new(
+            state.t,
+            SVector::zeros(),
+            SVector::zeros(),
+            SVector::zeros(),
+        );
         self.predict(&origin, None, &mut x);
         x.fill(0.0);
         let mut jacobian = Dense::new(m);
@@ -670,15 +674,19 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let state = State::new(t, q, p, SVector::zeros());
         self.predict(&state, None, x);
         x.fill(0.0);
-        self.assemble(&state, x, residual, None);
-        affine_step::correction(jacobian, residual);
-        *x -= &*residual;
+        // An update from x = 0 and one refinement (a root to round-off, however conditioned
+        // `J` is, where the equations are linear), the last point assembled.
+        for _ in 0..2 {
+            self.assemble(&state, x, residual, None);
+            affine_step::correction(jacobian, residual);
+            *x -= &*residual;
+        }
         self.assemble(&state, x, residual, None);
         affine_step::correction(jacobian, residual);
         if !affine_step::is_root(x.as_slice(), residual.as_slice()) {
             return Err(format!(
-                "one update does not solve the step from a unit state (the correction left is \
-                 {:.1e}): the step equations are not linear",
+                "an update and a refinement do not solve the step from a unit state (the \
+                 correction left is {:.1e}): the step equations are not linear",
                 residual.amax()
             ));
         }
@@ -724,13 +732,16 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let mut next = *state;
         space.advance(&mut next.q, &mut next.q_carry, &dq);
         compensated_add(&mut next.p, &mut next.p_carry, &dp);
+        for &d in &self.collocated {
+            // The primary constraint p = ϑ(q), kept as Newton's steps keep it: no carry.
+            next.p_carry[d] = 0.0;
+        }
         check_finite(system, "new position", &next.q)?;
         check_finite(system, "new momentum", &next.p)?;
         next.velocity = space.push_forward(&state.q, &xi, &(xi / self.discrete.h()));
         self.discrete.check_end(&next.q, &next.velocity, step)?;
         Ok(next)
     }
-
 
     /// Second derivatives of the step from `state` solved by `x` with respect to `(q_k, p_k)`,
     /// `newton` holding the Jacobian factorised at `x`: for models on `Rⁿ` without constraints
@@ -1551,6 +1562,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                  but at step {step} the step map cannot be read: {why}"
             ))
         };
+        if let Some(why) = &self.affine_refused {
+            return Some(Err(claim(why)));
+        }
         let mut map = match self.affine.take() {
             None => match self.read_step_map(state, 0) {
                 Ok(map) => map,

@@ -216,11 +216,13 @@ pub trait StepEquations<const N: usize> {
     }
 
     /// The step from `state` by the step map of equations linear with constant coefficients,
-    /// read off once per run (see [`affine_step`](crate::step::affine_step)): writes the
+    /// read off the step (see [`affine_step`](crate::step::affine_step)), for a stepper
+    /// [`with_step_map`](crate::Stepper::with_step_map): writes the
     /// step's solution into `x` and returns the state [`advance`](Self::advance) would give,
     /// or the error of a step that fails. `None` (the default) where the equations give no
-    /// step map: the step is then predicted, solved by Newton's method and advanced. `step`
-    /// counts the steps before this one.
+    /// step map (and so refuse it in [`step_map_refusal`](Self::step_map_refusal)): the step
+    /// is then predicted, solved by Newton's method and advanced. `step` counts the steps
+    /// before this one.
     fn affine_step(
         &mut self,
         state: &State<N, Self::Manifold>,

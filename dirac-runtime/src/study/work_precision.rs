@@ -1,6 +1,7 @@
 //! The trade between speed and accuracy, measured for the user's own model: a grid of
-//! methods (quadratures, and for a separable model the explicit compositions, at a fixed step or
-//! time-transformed) × steps run to a horizon, each run's error against a reference, its energy error,
+//! methods (quadratures, also by their step map where the step equations are linear with
+//! constant coefficients, and for a separable model the explicit compositions, at a fixed step
+//! or time-transformed) × steps run to a horizon, each run's error against a reference, its energy error,
 //! constraint violation, Newton iterations and wall time per unit of simulated time; and the
 //! cheapest run meeting a target.
 //!
@@ -344,6 +345,21 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
             for &h in &self.steps {
                 let stepper = || self.stepper(quadrature, h);
                 record(quadrature.name(), h, self.measure(&stepper, h, &reference));
+            }
+            // Where the model's step equations are linear with constant coefficients, the same
+            // steps by their step map (left out, without failures, where they are not).
+            let mapped = |h| self.stepper(quadrature, h).and_then(Stepper::with_step_map);
+            if mapped(self.steps[0]).is_err() {
+                continue;
+            }
+            for &h in &self.steps {
+                let name = format!("{}, step map", quadrature.name());
+                let measured = self.measure(&|| mapped(h), h, &reference);
+                let named = measured.map(|m| Measurement {
+                    quadrature: name.clone(),
+                    ..m
+                });
+                record(name, h, named);
             }
         }
         // The default compositions are left out, without failures, for a separable model the
