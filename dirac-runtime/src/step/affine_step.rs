@@ -38,6 +38,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::base::float::exceeds;
 use crate::solve::jacobian::{Dense, Jacobian};
 
 /// The largest Newton correction at a probe's solution, relative to `1 + ‖x‖∞`, that still
@@ -98,7 +99,7 @@ impl AffineStep {
         let read = step.apply_to_state();
         let size = solved.amax().max(read.amax()).max(terms).max(1.0);
         let miss = (&solved - read).amax();
-        if !(miss <= ROOT_TOLERANCE * size) {
+        if exceeds(miss, ROOT_TOLERANCE * size) {
             return Err(format!(
                 "the step read off scaled unit states misses the step from the current state \
                  by {miss:.1e} (of {size:.1e}): the step equations are not linear"
