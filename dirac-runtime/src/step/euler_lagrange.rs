@@ -613,6 +613,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     /// forces, whose time and inputs change the step; no holonomic constraints or coupling).
     /// A projection after the solve (hidden constraints, collocated rows) is linear too, and
     /// part of the map.
+    /// Whether the model's kind allows a step map (the part of
+    /// [`refuse_step_map`](Self::refuse_step_map) known when it is compiled).
+    const MAY_MAP: bool = S::QUADRATIC && C::TRANSLATION && !S::FORCES && S::HOLONOMIC == 0;
+
     fn refuse_step_map(&self) -> Result<(), String> {
         let system = self.discrete.system();
         let why = if !S::QUADRATIC {
@@ -1553,6 +1557,13 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         x: &mut DVector<f64>,
         step: u64,
     ) -> Option<Result<State<N>, DiracError>> {
+        // Known when the model is compiled: models that cannot have a step map compile none.
+        if !Self::MAY_MAP {
+            return Some(Err(DiracError::Unsupported(format!(
+                "a step map: {}",
+                self.refuse_step_map().err().unwrap_or_default()
+            ))));
+        }
         if let Err(why) = self.refuse_step_map() {
             return Some(Err(DiracError::Unsupported(format!("a step map: {why}"))));
         }
