@@ -548,6 +548,43 @@ fn a_particle_drifting_in_a_magnetic_field() {
     }
 }
 
+/// The drift by its step map (quadratic `L`, every row collocated, and under the symmetric
+/// projection the multipliers of `p = ϑ(q)` among the unknowns): the steps of Newton's method to
+/// round-off, past a reading of the map, with the primary constraint held.
+#[test]
+fn a_drift_by_its_step_map_steps_as_newtons_method_does() {
+    for scheme in [
+        FirstOrderScheme::default(),
+        FirstOrderScheme::SymmetricProjection,
+    ] {
+        let stepper = || {
+            Stepper::new(MagneticDrift, Quadrature::galerkin(2).unwrap(), 0.05)
+                .unwrap()
+                .with_first_order_scheme(scheme)
+        };
+        let mut mapped = stepper().with_step_map().unwrap();
+        let mut solved = stepper();
+        mapped.start_from_position(vector![1.0, 0.0]).unwrap();
+        solved.start_from_position(vector![1.0, 0.0]).unwrap();
+        for _ in 0..2_000 {
+            mapped.step().unwrap();
+            solved.step().unwrap();
+        }
+        let gap = (mapped.q() - solved.q())
+            .amax()
+            .max((mapped.p() - solved.p()).amax());
+        assert!(gap <= 1e-12, "{scheme:?}: the runs differ by {gap:e}");
+        // p = ϑ(q) = (−y, x)/2, and the orbit the unit circle.
+        let (q, p) = (mapped.q(), mapped.p());
+        let theta = vector![-q[1], q[0]] * 0.5;
+        assert!(
+            (p - theta).amax() <= 1e-14,
+            "{scheme:?}: {p} against {theta}"
+        );
+        assert!((q.norm_squared() - 1.0).abs() <= 1e-12, "{scheme:?}: {q}");
+    }
+}
+
 /// Lotka–Volterra coupled to an oscillator with kinetic energy: L = ϑ(q)·q̇ + ẋ²/2 − H with
 /// H = H_LV(q) + x²/2 + ε x q1. The rows of q1, q2 (linear in their velocities) are
 /// collocated, the row of x stays variational. Its equations: q̇1 = q1 q2 ∂H/∂q2,

@@ -166,9 +166,22 @@ mod tests {
         let curved = |z: &[f64]| Ok(DVector::from_vec(vec![z[0] * z[0], z[1]]));
         let refused = AffineStep::read(&[0.3, -1.5], 0, curved).unwrap_err();
         assert!(refused.contains("not linear"), "{refused}");
-        // Each reading probes at scales of its own.
-        let scales: Vec<f64> = (0..6).map(probe_scale).collect();
-        assert!(scales.iter().all(|s| (1.0..2.0).contains(s)));
-        assert!(scales.windows(2).all(|w| w[0] != w[1]));
+        // Each reading probes at scales of its own, in [1, 2).
+        let probed = |reading| {
+            let mut states = Vec::new();
+            AffineStep::read(&[0.3, -1.5], reading, |z: &[f64]| {
+                states.push(z.to_vec());
+                affine(z)
+            })
+            .unwrap();
+            states
+        };
+        let (first, second) = (probed(0), probed(1));
+        assert_eq!(first.len(), 4); // the origin, two unit directions, the start
+        for (a, b) in first[1..3].iter().zip(&second[1..3]) {
+            let (sa, sb) = (a[0] + a[1], b[0] + b[1]);
+            assert!((1.0..2.0).contains(&sa) && (1.0..2.0).contains(&sb));
+            assert_ne!(sa, sb);
+        }
     }
 }
