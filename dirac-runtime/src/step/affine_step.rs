@@ -55,8 +55,6 @@ pub(crate) const READ_EVERY: u32 = 1024;
 pub(crate) struct AffineStep {
     map: DMatrix<f64>,
     offset: DVector<f64>,
-    /// The state `(q_k, p_k)` of the step being taken (workspace).
-    state: DVector<f64>,
     /// `y` of the step being taken (workspace).
     output: DVector<f64>,
     /// Which reading this is (0 for the first of a run): it sets the probes' scales.
@@ -87,7 +85,6 @@ impl AffineStep {
         }
         let mut step = Self {
             output: offset.clone(),
-            state: DVector::from_column_slice(start),
             map,
             offset,
             reading,
@@ -95,8 +92,9 @@ impl AffineStep {
         };
         let solved = probe(start)?;
         // The size of the terms of `y₀ + M z`, whose round-off the gap may hold.
-        let terms = step.offset.amax() + step.map.amax() * step.state.amax() * n as f64;
-        let read = step.apply_to_state();
+        let size_z = start.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let terms = step.offset.amax() + step.map.amax() * size_z * n as f64;
+        let read = step.apply(&start[..n / 2], &start[n / 2..]);
         let size = solved.amax().max(read.amax()).max(terms).max(1.0);
         let miss = (&solved - read).amax();
         if exceeds(miss, ROOT_TOLERANCE * size) {
@@ -108,18 +106,27 @@ impl AffineStep {
         Ok(step)
     }
 
-    /// `y` of the step from `(q, p)`.
+    /// `y` of the step from `(q, p)`: `y₀ + M z`, column by column, the first column writing
+    /// over the output (no copy of `y₀` or of the state on the way).
     #[inline]
     pub(crate) fn apply(&mut self, q: &[f64], p: &[f64]) -> &DVector<f64> {
-        let n = q.len();
-        self.state.as_mut_slice()[..n].copy_from_slice(q);
-        self.state.as_mut_slice()[n..].copy_from_slice(p);
-        self.apply_to_state()
-    }
-
-    fn apply_to_state(&mut self) -> &DVector<f64> {
-        self.output.copy_from(&self.offset);
-        self.output.gemv(1.0, &self.map, &self.state, 1.0);
+        let rows = self.offset.len();
+        let output = self.output.as_mut_slice();
+        let mut columns = self
+            .map
+            .as_slice()
+            .chunks_exact(rows)
+            .zip(q.iter().chain(p));
+        if let Some((column, &z)) = columns.next() {
+            for ((y, &y0), &m) in output.iter_mut().zip(self.offset.as_slice()).zip(column) {
+                *y = y0 + m * z;
+            }
+        }
+        for (column, &z) in columns {
+            for (y, &m) in output.iter_mut().zip(column) {
+                *y += m * z;
+            }
+        }
         &self.output
     }
 

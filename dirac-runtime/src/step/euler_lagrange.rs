@@ -112,7 +112,8 @@ pub struct EulerLagrange<S, const N: usize, C> {
     /// The run's step map, where its equations are linear with constant coefficients and it has
     /// been read off (see [`affine_step`](crate::step::affine_step)); `None` before the first
     /// step of a run.
-    affine: Option<AffineStep>,
+    /// (Boxed: a step takes it out and puts it back, moving a pointer.)
+    affine: Option<Box<AffineStep>>,
     /// Why a reading of the run's step map failed (every later step of the run fails so).
     affine_refused: Option<String>,
 }
@@ -640,7 +641,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
 
     /// Reading `reading` of the run's step map at `state` (see [`AffineStep`]), or why there is
     /// none.
-    fn read_step_map(&mut self, state: &State<N>, reading: u64) -> Result<AffineStep, String> {
+    fn read_step_map(&mut self, state: &State<N>, reading: u64) -> Result<Box<AffineStep>, String> {
         let m = self.unknowns();
         let (mut x, mut residual) = (DVector::zeros(m), DVector::zeros(m));
         let origin = State::new(
@@ -660,6 +661,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         AffineStep::read(&z, reading, |z| {
             self.probe(state.t, z, &jacobian, &mut x, &mut residual)
         })
+        .map(Box::new)
     }
 
     /// The stacked outputs of the step from `z = (q_k, p_k)` solved by one update of `x = 0` with
