@@ -62,10 +62,10 @@ fn the_attribute_declares_the_separable_lagrangians() {
         - 0.5 * k * (x * x + y * y),
 )]
 #[derive(Debug, Clone, Copy)]
-struct Charge {
-    m: f64,
-    b: f64,
-    k: f64,
+pub(crate) struct Charge {
+    pub(crate) m: f64,
+    pub(crate) b: f64,
+    pub(crate) k: f64,
 }
 
 /// `½ ẋ² + c |ẋ| − ½ x²`.
@@ -78,8 +78,8 @@ struct Kinked {
 /// `½ (ẋ + c)² − cos x`: a constant `b = c` in the momentum, `p = ẋ + c`.
 #[dirac_system(coordinates(x), lagrangian = 0.5 * (dot(x) + c).powi(2) + cos(x))]
 #[derive(Debug, Clone, Copy)]
-struct Shifted {
-    c: f64,
+pub(crate) struct Shifted {
+    pub(crate) c: f64,
 }
 
 #[test]
@@ -359,8 +359,8 @@ struct Damped;
     inputs(u),
 )]
 #[derive(Debug, Clone, Copy)]
-struct Duffing {
-    k: f64,
+pub(crate) struct Duffing {
+    pub(crate) k: f64,
 }
 
 #[test]
@@ -436,7 +436,7 @@ fn compositions_keep_their_order_under_a_time_dependent_force() {
 }
 
 /// A hand-written damper that claims its force does not read the velocity.
-struct FalseForce;
+pub(crate) struct FalseForce;
 
 impl DiracSystem<1> for FalseForce {
     const SEPARABLE: bool = true;

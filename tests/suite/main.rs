@@ -19,6 +19,7 @@ mod explicit;
 mod extremes;
 mod field;
 mod first_order;
+mod fixed_point;
 mod golden;
 mod group_derivatives;
 mod hamiltonian;

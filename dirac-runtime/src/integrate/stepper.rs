@@ -61,6 +61,9 @@ pub enum Solver {
     /// By the step map of equations linear with constant coefficients, read off the step
     /// ([`Stepper::with_step_map`]): a matrix–vector product a step.
     StepMap,
+    /// By fixed-point iteration without a Jacobian ([`Stepper::with_fixed_point`]), Newton's
+    /// method where it does not settle.
+    FixedPoint,
     /// By Newton's method, for the reason given (why there is no step map).
     Newton(String),
 }
@@ -135,6 +138,11 @@ pub struct Stepper<S, const N: usize, E: StepEquations<N> = EulerLagrange<S, N, 
     work: Option<StepWork<N>>,
     /// Steps are taken by the step map ([`with_step_map`](Self::with_step_map)).
     step_map: bool,
+    /// Steps are solved by fixed-point iteration ([`with_fixed_point`](Self::with_fixed_point)).
+    fixed_point: bool,
+    /// The steps of the run that the fixed-point iteration handed to Newton's method, and why
+    /// the last one was.
+    handed_over: (u64, Option<String>),
     system: PhantomData<fn() -> S>,
 }
 
@@ -743,6 +751,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             violation: Some(0.0),
             work: Some(StepWork::zero()),
             step_map: false,
+            fixed_point: false,
+            handed_over: (0, None),
             system: PhantomData,
         })
     }
@@ -833,6 +843,52 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             .map_err(|why| DiracError::Unsupported(format!("a step map: {why}")))?;
         self.step_map = true;
         Ok(self)
+    }
+
+    /// Solves each step by fixed-point iteration, without a Jacobian, where the model is
+    /// separable (`L = ½ vᵀ M v + bᵀ v − V(q)` with constant `M` and `b`,
+    /// [`DiracSystem::SEPARABLE`]) on `Rⁿ`, without constraints, its forces (if any) free of the
+    /// velocity: the positions at the rule's nodes are iterated from the extrapolation of the
+    /// last steps until the update vanishes or stops shrinking (see
+    /// [`fixed_point`](crate::step::fixed_point)), each iteration one gradient of `L` per
+    /// node. The solution is the same discrete Euler–Lagrange equations' root as Newton's, to
+    /// round-off, and is checked by its residual. A step where the iteration does not settle
+    /// (a growing update, 40 iterations, a model whose mass matrix is not constant or not
+    /// invertible) is solved by Newton's method instead: [`handed_over`](Self::handed_over)
+    /// counts those steps and says why the last one was. Fails with `Unsupported`, saying why,
+    /// for other models.
+    ///
+    /// ```
+    /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Solver, Stepper};
+    /// # use nalgebra::{SVector, vector};
+    /// struct Pendulum;
+    /// impl DiracSystem<1> for Pendulum {
+    ///     const SEPARABLE: bool = true;
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         v[0] * v[0] * 0.5 + q[0].cos()
+    ///     }
+    /// }
+    /// let mut stepper = Stepper::new(Pendulum, Quadrature::galerkin(6)?, 0.5)?.with_fixed_point()?;
+    /// assert_eq!(stepper.solver(), Solver::FixedPoint);
+    /// stepper.start_from_momentum(vector![1.0], vector![0.0])?;
+    /// stepper.run(10)?;
+    /// assert_eq!(stepper.handed_over(), (0, None));
+    /// assert_eq!(stepper.last_report().map(|r| r.jacobians), Some(0));
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn with_fixed_point(mut self) -> Result<Self, DiracError> {
+        self.equations
+            .fixed_point_refusal()
+            .map_err(|why| DiracError::Unsupported(format!("a fixed-point iteration: {why}")))?;
+        self.fixed_point = true;
+        Ok(self)
+    }
+
+    /// The steps since the start that a stepper [`with_fixed_point`](Self::with_fixed_point)
+    /// solved by Newton's method because the iteration did not settle, and why the last one
+    /// did not (`(0, None)` for every other stepper).
+    pub fn handed_over(&self) -> (u64, Option<&str>) {
+        (self.handed_over.0, self.handed_over.1.as_deref())
     }
 
     /// Starts from position `q0` and velocity `v0` at the [start time](Self::with_start_time), with `p0 = ∂L/∂v(q0, v0)`.
@@ -1291,6 +1347,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         self.predictor.clear(self.unknowns.len());
         self.report = None;
         self.work = Some(StepWork::zero());
+        self.handed_over = (0, None);
     }
 
     /// Advances one step. On error the state is unchanged.
@@ -1410,6 +1467,23 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         let predictor = self.predictor.predict();
         let equations = &mut self.equations;
         equations.predict(state, predictor, &mut self.unknowns);
+        if self.fixed_point {
+            let tolerance = self.newton.options().residual_tolerance;
+            match equations.fixed_point_step(state, &mut self.unknowns, tolerance) {
+                Some(Ok(report)) => {
+                    let mut next = equations.advance(state, &self.unknowns, self.steps)?;
+                    next.t = self.start + (self.steps + 1) as f64 * equations.h();
+                    let work = equations.work(state, &self.unknowns);
+                    return Ok(Proposal { next, report, work });
+                }
+                Some(Err(why)) => {
+                    // Newton's method from the predictor.
+                    self.handed_over = (self.handed_over.0 + 1, Some(why));
+                    equations.predict(state, predictor, &mut self.unknowns);
+                }
+                None => {}
+            }
+        }
         let report = if self.unknowns.is_empty() {
             // An explicit step: `advance` takes it.
             NewtonReport::default()
@@ -1476,6 +1550,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         }
         if self.step_map {
             return Solver::StepMap;
+        }
+        if self.fixed_point {
+            return Solver::FixedPoint;
         }
         Solver::Newton(match self.equations.step_map_refusal() {
             Ok(()) => "Newton's method is the default; with_step_map takes the step map".into(),

@@ -28,19 +28,21 @@ use crate::discrete::first_order;
 use crate::discrete::hidden_constraint::HiddenConstraints;
 use crate::discrete::initial_state;
 use crate::discrete::layout::Layout;
-use crate::model::derivatives::{Dual, Seed, seeded};
+use crate::model::derivatives::{self, Dual, Seed, seeded};
 use crate::model::legendre;
 use crate::model::system::DiracSystem;
 use crate::quadrature::MAX_DEGREE;
 use crate::solve::jacobian::{Dense, Jacobian};
 use crate::solve::newton::NewtonOptions;
-use crate::solve::newton::{Newton, NewtonFailure};
+use crate::solve::newton::{Newton, NewtonFailure, NewtonReport};
 use crate::space::configuration_space::{ConfigurationSpace, StepCovectors, compensated_add};
 use crate::space::manifold::Vectors;
 use crate::step::affine_step::{self, AffineStep};
 use crate::step::dense_output::{ChartPath, Sample, chart_path};
+use crate::step::fixed_point::{self, FixedPoint, Settled};
 use crate::step::step_derivatives::{StepDerivatives, StepHessians};
 use crate::step::step_equations::{State, StepEquations, StepWork};
+use crate::step::verlet::Kinetic;
 
 /// The discrete Euler–Lagrange equations of a [`DiracSystem`] under a quadrature, on the
 /// configuration space `C`, with the system's forces, inputs and constraints: the
@@ -116,6 +118,14 @@ pub struct EulerLagrange<S, const N: usize, C> {
     affine: Option<Box<AffineStep>>,
     /// Why a reading of the run's step map failed (every later step of the run fails so).
     affine_refused: Option<String>,
+    /// The run's fixed-point iteration (see [`fixed_point`](crate::step::fixed_point)), set up
+    /// at its first step; `None` before.
+    iteration: Option<FixedPoint<N>>,
+    /// Why the run's steps cannot be iterated (a mass matrix that is not constant or not
+    /// invertible): every step is then Newton's.
+    iteration_refused: Option<String>,
+    /// The residual of a solution found by iteration, checked before it is taken.
+    iterated_residual: DVector<f64>,
 }
 
 impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: usize>
@@ -175,6 +185,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             coupling: None,
             affine: None,
             affine_refused: None,
+            iteration: None,
+            iteration_refused: None,
+            iterated_residual: DVector::zeros(0),
             discrete,
         })
     }
@@ -218,10 +231,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         self.forget_step_map();
     }
 
-    /// Forgets the run's step map: the next step reads it off again.
+    /// Forgets the run's step map and fixed-point tables: the next step sets them up again.
     fn forget_step_map(&mut self) {
         self.affine = None;
         self.affine_refused = None;
+        self.iteration = None;
+        self.iteration_refused = None;
     }
 
     /// Whether the run's steps are projected onto `p = ϑ(q)` by the multipliers at the end of
@@ -747,6 +762,138 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         next.velocity = space.push_forward(&state.q, &xi, &(xi / self.discrete.h()));
         self.discrete.check_end(&next.q, &next.velocity, step)?;
         Ok(next)
+    }
+
+    /// Whether the model's kind allows the fixed-point iteration (the part of
+    /// [`refuse_fixed_point`](Self::refuse_fixed_point) known when it is compiled).
+    const MAY_ITERATE: bool = S::SEPARABLE
+        && C::TRANSLATION
+        && S::ONE_FORMS + S::HOLONOMIC == 0
+        && (!S::FORCES || S::FORCES_FREE_OF_VELOCITY);
+
+    fn refuse_fixed_point(&self) -> Result<(), String> {
+        let why = if !S::SEPARABLE {
+            "the Lagrangian is not known to be separable (L = ½ vᵀ M v + bᵀ v − V(q) with \
+             constant M and b: DiracSystem::SEPARABLE)"
+        } else if !C::TRANSLATION {
+            "the configuration space is not a vector space"
+        } else if S::ONE_FORMS + S::HOLONOMIC > 0 {
+            "the model has constraints (their multipliers are not iterated)"
+        } else if S::FORCES && !S::FORCES_FREE_OF_VELOCITY {
+            "the model's forces may read the velocity (DiracSystem::FORCES_FREE_OF_VELOCITY is \
+             not declared)"
+        } else if self.coupling.is_some() {
+            "the model is a component of an interconnection"
+        } else {
+            return Ok(());
+        };
+        Err(why.to_string())
+    }
+
+    /// The run's fixed-point tables, set up from `state` at its first step, or why there are
+    /// none (kept for the run).
+    fn iteration_tables(&mut self, state: &State<N>) -> Result<FixedPoint<N>, String> {
+        if let Some(why) = &self.iteration_refused {
+            return Err(why.clone());
+        }
+        if let Some(tables) = self.iteration.take() {
+            return Ok(tables);
+        }
+        let tables = Kinetic::of(self.discrete.system(), &state.q, &state.velocity)
+            .map_err(|e| format!("the run's kinetic terms: {e}"))
+            .and_then(|kinetic| {
+                FixedPoint::new(self.discrete.quadrature(), kinetic).ok_or_else(|| {
+                    format!(
+                        "{} has no fixed-point tables",
+                        self.discrete.quadrature().name()
+                    )
+                })
+            });
+        if let Err(why) = &tables {
+            self.iteration_refused = Some(why.clone());
+        }
+        tables
+    }
+
+    /// Solves the step from `state` by the fixed-point iteration from the predictor in `x`
+    /// (see [`fixed_point`](crate::step::fixed_point)), writes the solution into `x` and
+    /// assembles it, its residual checked against `tolerance` times the size of its terms.
+    fn iterate(
+        &mut self,
+        state: &State<N>,
+        x: &mut DVector<f64>,
+        tolerance: f64,
+    ) -> Result<NewtonReport, String> {
+        let mut tables = self.iteration_tables(state)?;
+        for (j, z) in self.increments.iter_mut().enumerate() {
+            z.copy_from(&x.fixed_rows::<N>(self.layout.point(j + 1)));
+        }
+        let (system, inputs) = (self.discrete.system(), &self.inputs);
+        let at_rest = SVector::zeros();
+        let pull = |y: &SVector<f64, N>, t: f64| {
+            let g = derivatives::directional_gradient(system, y, &at_rest, Seed::POSITION);
+            match S::FORCES {
+                true => g + system.force(y, &at_rest, t, inputs),
+                false => g,
+            }
+        };
+        let h = self.discrete.h();
+        let settled = tables.solve(&state.q, &state.p, state.t, h, &mut self.increments, pull);
+        let Settled {
+            iterations,
+            contraction,
+        } = match settled {
+            Ok(settled) => settled,
+            Err(why) => {
+                self.iteration = Some(tables);
+                return Err(why);
+            }
+        };
+        let mut residual = std::mem::take(&mut self.iterated_residual);
+        if residual.len() != x.len() {
+            residual = DVector::zeros(x.len());
+        }
+        // The tables' solution refined on the assembled rows (each correction taken, at
+        // round-off too: a correction left out biases every step alike, and the energy's
+        // round-off drifts faster), the rows assembled at the last point (for `advance`).
+        // `assemble` reads the increments from `x`.
+        let mut scale;
+        let mut refinements = 0;
+        loop {
+            for (j, z) in self.increments.iter().enumerate() {
+                x.fixed_rows_mut::<N>(self.layout.point(j + 1)).copy_from(z);
+            }
+            scale = self.assemble(state, x, &mut residual, None);
+            if refinements == fixed_point::REFINEMENTS {
+                break;
+            }
+            let layout = self.layout;
+            tables.correct(h, |j| {
+                residual.fixed_rows::<N>(layout.point(j + 1)).into_owned()
+            });
+            tables.apply(&mut self.increments);
+            refinements += 1;
+        }
+        // The rows' terms: the assembly's count, and at least `p_k` and `M ξ_s / h`.
+        let terms = scale
+            .max(state.p.amax())
+            .max(tables.momentum_size(h, &self.increments));
+        self.iteration = Some(tables);
+        let size = residual.amax();
+        self.iterated_residual = residual;
+        if !(size <= tolerance * terms) {
+            return Err(format!(
+                "the iteration's solution leaves a residual of {size:.1e} against a tolerance \
+                 of {:.1e}: the model may not be separable as it declares",
+                tolerance * terms
+            ));
+        }
+        Ok(NewtonReport {
+            iterations,
+            jacobians: 0,
+            residual: size,
+            contraction,
+        })
     }
 
     /// Second derivatives of the step from `state` solved by `x` with respect to `(q_k, p_k)`,
@@ -1609,6 +1756,23 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
 
     fn step_map_refusal(&self) -> Result<(), String> {
         self.refuse_step_map()
+    }
+
+    fn fixed_point_step(
+        &mut self,
+        state: &State<N>,
+        x: &mut DVector<f64>,
+        tolerance: f64,
+    ) -> Option<Result<NewtonReport, String>> {
+        // Known when the model is compiled: models that cannot be iterated compile no iteration.
+        if !Self::MAY_ITERATE || self.refuse_fixed_point().is_err() {
+            return None;
+        }
+        Some(self.iterate(state, x, tolerance))
+    }
+
+    fn fixed_point_refusal(&self) -> Result<(), String> {
+        self.refuse_fixed_point()
     }
 
     fn violation(&self, from: &State<N>, to: &State<N>, x: &DVector<f64>) -> f64 {

@@ -11,7 +11,7 @@
 use nalgebra::{DMatrix, DVector, SVector};
 
 use crate::base::error::DiracError;
-use crate::solve::newton::{Newton, NewtonFailure};
+use crate::solve::newton::{Newton, NewtonFailure, NewtonReport};
 use crate::space::manifold::Manifold;
 use crate::step::dense_output::Sample;
 use crate::step::step_derivatives::StepDerivatives;
@@ -237,6 +237,33 @@ pub trait StepEquations<const N: usize> {
     /// else why not. By default the equations give none.
     fn step_map_refusal(&self) -> Result<(), String> {
         Err(format!("{} give no step map", Self::NAME))
+    }
+
+    /// Solves the step from `state` by fixed-point iteration from the predictor in `x`, for a
+    /// stepper [`with_fixed_point`](crate::Stepper::with_fixed_point): writes the solution into
+    /// `x`, assembled as Newton's last evaluation would leave it (so that
+    /// [`advance`](Self::advance) takes it), its residual at most `tolerance` times the size of
+    /// its terms, and returns how the iteration went (no Jacobians). `Err` with why where it
+    /// does not settle: the stepper then solves the step by Newton's method. `None` (the
+    /// default) where the equations are not iterated (and so refuse it in
+    /// [`fixed_point_refusal`](Self::fixed_point_refusal)).
+    fn fixed_point_step(
+        &mut self,
+        state: &State<N, Self::Manifold>,
+        x: &mut DVector<f64>,
+        tolerance: f64,
+    ) -> Option<Result<NewtonReport, String>> {
+        let _ = (state, x, tolerance);
+        None
+    }
+
+    /// `Ok(())` where the steps can be solved by fixed-point iteration
+    /// ([`fixed_point_step`](Self::fixed_point_step)), else why not. By default they cannot.
+    fn fixed_point_refusal(&self) -> Result<(), String> {
+        Err(format!(
+            "{} are not solved by fixed-point iteration",
+            Self::NAME
+        ))
     }
 
     /// The constraint violation of the step from `from` to `to` that `x` solved (`to` as

@@ -246,6 +246,24 @@ impl<const N: usize> Kinetic<N> {
         (v, energy)
     }
 
+    /// `M x`.
+    #[inline]
+    pub(crate) fn momentum_times(&self, x: &SVector<f64, N>) -> SVector<f64, N> {
+        match self.unit {
+            true => *x,
+            false => self.mass * x,
+        }
+    }
+
+    /// `M⁻¹ x`.
+    #[inline]
+    pub(crate) fn inverse_mass_times(&self, x: &SVector<f64, N>) -> SVector<f64, N> {
+        match self.unit {
+            true => *x,
+            false => self.inverse_mass * x,
+        }
+    }
+
     /// `v = M⁻¹ (p − b)`.
     #[inline]
     pub(crate) fn velocity(&self, p: &SVector<f64, N>) -> SVector<f64, N> {
