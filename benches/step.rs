@@ -808,8 +808,13 @@ fn explicit(c: &mut Criterion) {
         let mut hand = HandComposition::start(composition.coefficients(), h);
         let explicit = Stepper::explicit(scene, composition, h).expect("separable scene");
         kepler_step(&mut group, &format!("kepler_{order}/explicit"), explicit);
-        let implicit = Stepper::new(scene, quadrature, h).expect("valid scene");
+        let implicit = Stepper::new(scene, quadrature.clone(), h).expect("valid scene");
         kepler_step(&mut group, &format!("kepler_{order}/implicit"), implicit);
+        // The implicit step solved by fixed-point iteration, without a Jacobian.
+        let iterated = Stepper::new(scene, quadrature, h)
+            .and_then(Stepper::with_fixed_point)
+            .expect("separable scene");
+        kepler_step(&mut group, &format!("kepler_{order}/fixed_point"), iterated);
         group.bench_function(format!("kepler_{order}/hand_written"), |b| {
             b.iter(|| {
                 if hand.steps >= 10_000 {

@@ -26,6 +26,8 @@ pub struct Scene<S, F, G, const Y: usize, const Z: usize, const N: usize> {
     pub system: S,
     pub ode: F,
     pub dae: Option<G>,
+    /// The quadratures and steps at a short horizon (T = 10).
+    pub quadratures: Vec<Quadrature>,
     pub steps: Vec<f64>,
     /// The quadratures and steps at a long horizon (T = 10⁴), where a step costs 10³ times more.
     pub long: (Vec<Quadrature>, Vec<f64>),
@@ -65,8 +67,11 @@ pub fn pendulum() -> Scene<pendulum::Pendulum, PendulumOde, PendulumOde, 2, 2, 1
             theta0: 1.0,
         },
         dae: None,
-        steps: vec![0.2, 0.1, 0.05, 0.025],
-        long: (every_quadrature(), vec![0.2, 0.1, 0.05, 0.025]),
+        // Separable: the Gauss steps by fixed-point iteration cost a gradient per node and
+        // iteration, so the grid reaches to degree 8 (order 16) and steps of 1.
+        quadratures: gauss_to_eight(),
+        steps: vec![1.0, 0.5, 0.2, 0.1, 0.05, 0.025],
+        long: (gauss_to_eight(), vec![1.0, 0.5, 0.2, 0.1, 0.05, 0.025]),
         fictive_steps: Vec::new(),
     }
 }
@@ -83,7 +88,10 @@ pub fn visit_all(visitor: &mut impl Visitor) -> Result<(), String> {
             theta0: [half_pi, half_pi],
         },
         dae: None,
-        steps: vec![0.02, 0.01, 0.005],
+        quadratures: (1..=6)
+            .filter_map(|s| Quadrature::galerkin(s).ok())
+            .collect(),
+        steps: vec![0.05, 0.02, 0.01, 0.005],
         long: (every_quadrature(), vec![0.02, 0.01, 0.005]),
         fictive_steps: Vec::new(),
     })?;
@@ -99,6 +107,7 @@ pub fn visit_all(visitor: &mut impl Visitor) -> Result<(), String> {
                 e,
             },
             dae: None,
+            quadratures: every_quadrature(),
             long: (every_quadrature(), steps.clone()),
             steps,
             // A revolution is 2π of the fictive time: 16 to 128 steps a revolution.
@@ -113,6 +122,7 @@ pub fn visit_all(visitor: &mut impl Visitor) -> Result<(), String> {
             theta0: chain::initial::<8>().into(),
         },
         dae: None,
+        quadratures: every_quadrature(),
         steps: vec![0.02, 0.01, 0.005],
         // 200 µs per galerkin(3) step: 10⁶ steps at T = 10⁴ take minutes.
         long: (
@@ -133,6 +143,7 @@ pub fn visit_all(visitor: &mut impl Visitor) -> Result<(), String> {
         system: circuit::LC,
         ode: lc,
         dae: Some(LcDae(lc)),
+        quadratures: every_quadrature(),
         // Linear: by their step maps the Gauss–Galerkin steps cost a product of a matrix and
         // the state whatever their degree, so the study reaches to degree 5 and long steps.
         steps: vec![0.4, 0.2, 0.1, 0.05],
@@ -153,10 +164,19 @@ pub fn visit_all(visitor: &mut impl Visitor) -> Result<(), String> {
         system: knife_edge::SCENE,
         ode: knife,
         dae: Some(KnifeEdgeDae(knife)),
+        quadratures: every_quadrature(),
         steps: vec![0.1, 0.05, 0.025, 0.0125],
         long: (every_quadrature(), vec![0.1, 0.05, 0.025, 0.0125]),
         fictive_steps: Vec::new(),
     })
+}
+
+/// `midpoint`, `galerkin(2)`, `galerkin(3)`, `galerkin(4)`, `galerkin(6)` and `galerkin(8)`.
+pub fn gauss_to_eight() -> Vec<Quadrature> {
+    [1, 2, 3, 4, 6, 8]
+        .into_iter()
+        .filter_map(|s| Quadrature::galerkin(s).ok())
+        .collect()
 }
 
 /// `midpoint`, `galerkin(2)` and `galerkin(3)`.
@@ -210,7 +230,7 @@ where
     let (quadratures, steps) = if long {
         scene.long.clone()
     } else {
-        (every_quadrature(), scene.steps.clone())
+        (scene.quadratures.clone(), scene.steps.clone())
     };
     let mut study = Study::new(scene.system.clone(), horizon, |s| {
         s.start_from_velocity(start.q, start.v)

@@ -23,20 +23,23 @@ fn oscillator_at(t: f64) -> Sample<1> {
 const STEPS: [f64; 4] = [0.2, 0.1, 0.05, 0.025];
 
 /// `|(q, p)(T) − exact|` by a stepper run here, not by the study, with the quadrature (by
-/// Newton's method or by its step map) or the explicit composition called `method`.
+/// Newton's method, by its step map or by fixed-point iteration) or the explicit composition
+/// called `method`.
 fn direct_error(method: &str, h: f64, horizon: f64) -> f64 {
     let exact = oscillator_at(horizon);
     let error =
         |q: SVector<f64, 1>, p: SVector<f64, 1>| (q - exact.q).amax().max((p - exact.p).amax());
-    let (name, mapped) = match method.strip_suffix(", step map") {
-        Some(name) => (name, true),
-        None => (method, false),
+    let (name, how) = match method.split_once(", ") {
+        Some((name, how)) => (name, how),
+        None => (method, "Newton"),
     };
     if let Some(quadrature) = scenes::quadratures().into_iter().find(|q| q.name() == name) {
         let mut stepper = Stepper::new(Oscillator, quadrature, h).unwrap();
-        if mapped {
-            stepper = stepper.with_step_map().unwrap();
-        }
+        stepper = match how {
+            "step map" => stepper.with_step_map().unwrap(),
+            "fixed point" => stepper.with_fixed_point().unwrap(),
+            _ => stepper,
+        };
         stepper
             .start_from_velocity(vector![1.0], vector![0.0])
             .unwrap();
@@ -69,8 +72,9 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
     .unwrap();
     assert!(study.failures.is_empty(), "{:?}", study.failures);
     // Three quadratures, by Newton's method and, the oscillator being quadratic, by their step
-    // maps; and the oscillator being separable, four explicit compositions.
-    assert_eq!(study.measurements.len(), 40);
+    // maps; and the oscillator being separable, by fixed-point iteration, and four explicit
+    // compositions.
+    assert_eq!(study.measurements.len(), 52);
     for m in &study.measurements {
         let direct = direct_error(&m.quadrature, m.h, horizon);
         assert!(
@@ -83,7 +87,8 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
             .iter()
             .any(|q| q.name() == m.quadrature);
         let mapped = m.quadrature.ends_with(", step map");
-        if implicit || mapped {
+        let iterated = m.quadrature.ends_with(", fixed point");
+        if implicit || mapped || iterated {
             if mapped {
                 assert_eq!(m.newton_iterations, 0.0, "{m:?}");
             } else {
@@ -136,7 +141,7 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
     let mut csv = Vec::new();
     study.write_csv(&mut csv).unwrap();
     let text = String::from_utf8(csv).unwrap();
-    assert_eq!(text.lines().count(), 41);
+    assert_eq!(text.lines().count(), 53);
     assert!(text.starts_with("quadrature,h,steps,error,energy_error,"));
 }
 
@@ -150,8 +155,9 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
 #[derive(Debug, Clone, Copy)]
 struct Pushed;
 
-/// The explicit runs hold the inputs the start function sets, as the implicit runs do:
-/// Störmer–Verlet and the trapezoidal rule are one map, so their errors agree.
+/// The explicit runs and those by fixed-point iteration hold the inputs the start function
+/// sets, as the implicit runs do: Störmer–Verlet and the trapezoidal rule are one map, so
+/// their errors agree.
 #[test]
 fn explicit_runs_hold_the_inputs_the_start_sets() {
     let horizon = 2.0;
@@ -176,13 +182,22 @@ fn explicit_runs_hold_the_inputs_the_start_sets() {
     .reference(exact)
     .run()
     .unwrap();
-    let [implicit, explicit] = [0, 1].map(|i| &study.measurements[i]);
-    assert_eq!(explicit.quadrature, "Störmer–Verlet");
-    assert!(
-        (implicit.error - explicit.error).abs() < 1e-12,
-        "{implicit:?} {explicit:?}"
-    );
-    assert!(explicit.error < 1e-2);
+    let run = |name: &str| {
+        study
+            .measurements
+            .iter()
+            .find(|m| m.quadrature == name)
+            .unwrap_or_else(|| panic!("no run {name}: {:?}", study.measurements))
+    };
+    let implicit = run("trapezoid");
+    // The input held by the fixed-point iteration's runs too.
+    for other in [run("Störmer–Verlet"), run("trapezoid, fixed point")] {
+        assert!(
+            (implicit.error - other.error).abs() < 1e-12,
+            "{implicit:?} {other:?}"
+        );
+    }
+    assert!(implicit.error < 1e-2);
 }
 
 /// Without a reference the study converges one, and it agrees with the pendulum's known q(5),
