@@ -69,7 +69,8 @@ const GROUPS: &[(&str, &str)] = &[
     (
         "explicit_step",
         "The explicit variational step of a separable Lagrangian (Störmer–Verlet and its \
-         compositions) against the implicit step of the same order, on Kepler's problem.",
+         compositions) against the implicit step of the same order, solved by Newton's method \
+         and by fixed-point iteration, on Kepler's problem (h = 0.01).",
     ),
     (
         "time_transformed_step",
@@ -104,6 +105,8 @@ const PAIRS: &[(&str, &str)] = &[
     ("run", "step_loop"),
     ("explicit", "implicit"),
     ("explicit", "hand_written"),
+    ("fixed_point", "implicit"),
+    ("fixed_point", "explicit"),
     ("time_transformed", "hand_written"),
     ("sequential", "hand_written"),
     ("parallel", "sequential"),
