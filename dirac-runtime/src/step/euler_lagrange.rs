@@ -881,7 +881,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         self.iteration = Some(tables);
         let size = residual.amax();
         self.iterated_residual = residual;
-        if !(size <= tolerance * terms) {
+        if exceeds(size, tolerance * terms) {
             return Err(format!(
                 "the iteration's solution leaves a residual of {size:.1e} against a tolerance \
                  of {:.1e}: the model may not be separable as it declares",
