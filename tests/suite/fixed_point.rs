@@ -138,7 +138,7 @@ fn forces_of_position_time_and_inputs_are_iterated_with_their_work() {
 /// `(x, p/ω)` at T = 240 for every degree (Gauss steps of a linear model err in phase alone,
 /// smoothly in `h`), the pendulum's `(q, p)(5)` against its golden values for degrees 4 and 5
 /// (above, the pendulum's errors reach the golden values' 14 digits before they settle into
-/// their slope). Newton's method gives the same orders: the steps are its roots.
+/// their slope). Newton's method gives the same errors: the steps are its roots.
 #[test]
 fn orders_up_to_sixteen() {
     let w = (oscillator::SCENE.k / oscillator::SCENE.m).sqrt();
@@ -150,32 +150,49 @@ fn orders_up_to_sixteen() {
         (7, [4.0, 3.0, 2.4, 2.0]),
         (8, [5.0, 4.0, 3.2, 3.0]),
     ] {
-        let errors: Vec<f64> = hs
+        // (error by the iteration, by Newton's method, steps handed over) at each step.
+        let runs: Vec<(f64, f64, u64)> = hs
             .iter()
             .map(|&h| {
-                let quadrature = Quadrature::galerkin(s).unwrap();
-                let mut stepper = Stepper::new(oscillator::SCENE, quadrature, h)
-                    .unwrap()
-                    .with_fixed_point()
-                    .unwrap();
-                stepper
-                    .start_from_momentum(vector![oscillator::Q0], vector![0.0])
-                    .unwrap();
-                stepper.run((t / h).round() as u64).unwrap();
-                let dq = stepper.q()[0] - oscillator::Q0 * (w * t).cos();
-                let dp = stepper.p()[0] + oscillator::Q0 * w * (w * t).sin();
-                (dq * dq + dp * dp / (w * w)).sqrt()
+                let error = |iterated: bool| {
+                    let quadrature = Quadrature::galerkin(s).unwrap();
+                    let mut stepper = Stepper::new(oscillator::SCENE, quadrature, h).unwrap();
+                    if iterated {
+                        stepper = stepper.with_fixed_point().unwrap();
+                    }
+                    stepper
+                        .start_from_momentum(vector![oscillator::Q0], vector![0.0])
+                        .unwrap();
+                    stepper.run((t / h).round() as u64).unwrap();
+                    let dq = stepper.q()[0] - oscillator::Q0 * (w * t).cos();
+                    let dp = stepper.p()[0] + oscillator::Q0 * w * (w * t).sin();
+                    (
+                        (dq * dq + dp * dp / (w * w)).sqrt(),
+                        stepper.handed_over().0,
+                    )
+                };
+                let ((iterated, handed), (newton, _)) = (error(true), error(false));
+                (iterated, newton, handed)
             })
             .collect();
+        let errors: Vec<f64> = runs.iter().map(|r| r.0).collect();
         let measured = slope(&hs, &errors);
+        let handed: Vec<u64> = runs.iter().map(|r| r.2).collect();
         println!(
-            "oscillator galerkin({s}): order {measured:.2}, errors {}",
+            "oscillator galerkin({s}): order {measured:.2}, errors {}, steps handed over {handed:?}",
             scientific(&errors)
         );
         assert!(
             (measured - 2.0 * s as f64).abs() < 0.3,
             "galerkin({s}): {measured}"
         );
+        // The iteration's errors are Newton's, to the round-off of a run (about 4e-14 here).
+        for &(iterated, newton, _) in &runs {
+            assert!(
+                (iterated - newton).abs() <= 1e-3 * newton + 1e-13,
+                "{iterated:e} {newton:e}"
+            );
+        }
     }
     for s in [4, 5] {
         let ns = [8, 10, 12, 16];
@@ -246,7 +263,7 @@ fn round_off_takes_over_below_these_steps() {
 }
 
 /// The energy's round-off over 2·10⁵ steps of `galerkin(6)` at h = 0.25 on the pendulum, where
-/// the method's own energy error is below round-off: within 3e-13 (measured 6e-14; over 10⁶
+/// the method's own energy error is below round-off: within 3e-13 (measured 8.4e-14; over 10⁶
 /// steps 3.0e-13, Newton's method 8.7e-14). Without the refinement on the assembled rows the
 /// tables' round-off drifts it to 2.6e-12 here.
 #[test]
@@ -271,10 +288,11 @@ fn the_energys_round_off_stays_small() {
 
 #[test]
 fn steps_the_iteration_cannot_settle_are_newtons() {
-    // A step far beyond the iteration's reach: every step is handed over, and they are Newton's.
-    let h = 4.0;
-    let mut newton = Stepper::new(oscillator::SCENE, Quadrature::galerkin(4).unwrap(), h).unwrap();
-    let mut iterated = Stepper::new(oscillator::SCENE, Quadrature::galerkin(4).unwrap(), h)
+    // A step beyond the iteration's reach (it contracts up to ω h = 3.46 for `galerkin(2)`):
+    // the steps are handed over, and they are Newton's.
+    let h = 6.0;
+    let mut newton = Stepper::new(oscillator::SCENE, Quadrature::galerkin(2).unwrap(), h).unwrap();
+    let mut iterated = Stepper::new(oscillator::SCENE, Quadrature::galerkin(2).unwrap(), h)
         .unwrap()
         .with_fixed_point()
         .unwrap();
@@ -308,17 +326,23 @@ fn steps_the_iteration_cannot_settle_are_newtons() {
     assert!(why.is_some_and(|w| w.contains("residual")), "{why:?}");
     assert!((newton.q() - iterated.q()).amax() < 1e-13);
     assert!((newton.p() - iterated.p()).amax() < 1e-13);
-    // A false claim to be separable: the run's kinetic terms refuse it at the first step.
+    // A false claim to be separable: the run's kinetic terms refuse it at the first step, and
+    // Newton's method takes the run from there.
+    let mut newton =
+        Stepper::new(FalselySeparable, Quadrature::galerkin(2).unwrap(), 0.05).unwrap();
     let mut iterated = Stepper::new(FalselySeparable, Quadrature::galerkin(2).unwrap(), 0.05)
         .unwrap()
         .with_fixed_point()
         .unwrap();
-    iterated
-        .start_from_velocity(vector![0.7], vector![0.2])
-        .unwrap();
-    iterated.run(10).unwrap();
+    for stepper in [&mut newton, &mut iterated] {
+        stepper
+            .start_from_velocity(vector![0.7], vector![0.2])
+            .unwrap();
+        stepper.run(10).unwrap();
+    }
+    assert_eq!((newton.q(), newton.p()), (iterated.q(), iterated.p()));
     let (count, why) = iterated.handed_over();
-    assert_eq!(count, 10);
+    assert_eq!(count, 1);
     assert!(why.is_some_and(|w| w.contains("SEPARABLE")), "{why:?}");
 }
 

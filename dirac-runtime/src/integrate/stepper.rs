@@ -143,6 +143,8 @@ pub struct Stepper<S, const N: usize, E: StepEquations<N> = EulerLagrange<S, N, 
     /// The steps of the run that the fixed-point iteration handed to Newton's method, and why
     /// the last one was.
     handed_over: (u64, Option<String>),
+    /// Why the step being solved was handed over (taken into `handed_over` when it is accepted).
+    handing_over: Option<String>,
     system: PhantomData<fn() -> S>,
 }
 
@@ -753,6 +755,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             step_map: false,
             fixed_point: false,
             handed_over: (0, None),
+            handing_over: None,
             system: PhantomData,
         })
     }
@@ -853,10 +856,11 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// [`fixed_point`](crate::step::fixed_point)), each iteration one gradient of `L` per
     /// node. The solution is the same discrete Euler–Lagrange equations' root as Newton's, to
     /// round-off, and is checked by its residual. A step where the iteration does not settle
-    /// (a growing update, 40 iterations, a model whose mass matrix is not constant or not
-    /// invertible) is solved by Newton's method instead: [`handed_over`](Self::handed_over)
-    /// counts those steps and says why the last one was. Fails with `Unsupported`, saying why,
-    /// for other models.
+    /// (an update that grows twice running, 40 iterations, a residual left) is solved by
+    /// Newton's method instead: [`handed_over`](Self::handed_over) counts those steps and says
+    /// why the last one was. A run whose mass matrix is not constant or not invertible is
+    /// handed over at its first step, and stepped by Newton's method from there. Fails with
+    /// `Unsupported`, saying why, for other models.
     ///
     /// ```
     /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Solver, Stepper};
@@ -886,7 +890,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
 
     /// The steps since the start that a stepper [`with_fixed_point`](Self::with_fixed_point)
     /// solved by Newton's method because the iteration did not settle, and why the last one
-    /// did not (`(0, None)` for every other stepper).
+    /// did not (`(0, None)` for every other stepper). A step that failed is not counted.
     pub fn handed_over(&self) -> (u64, Option<&str>) {
         (self.handed_over.0, self.handed_over.1.as_deref())
     }
@@ -1437,6 +1441,7 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
 
     /// Solves the next step without making it current: the state is unchanged whatever happens.
     fn solve_step(&mut self) -> Result<Proposal<N, E::Manifold>, DiracError> {
+        self.handing_over = None;
         let Some(state) = &self.state else {
             return Err(DiracError::NotStarted);
         };
@@ -1477,8 +1482,8 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
                     return Ok(Proposal { next, report, work });
                 }
                 Some(Err(why)) => {
-                    // Newton's method from the predictor.
-                    self.handed_over = (self.handed_over.0 + 1, Some(why));
+                    // Newton's method from the predictor; counted if the step is accepted.
+                    self.handing_over = Some(why);
                     equations.predict(state, predictor, &mut self.unknowns);
                 }
                 None => {}
@@ -1520,6 +1525,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
             .work
             .zip(proposal.work)
             .map(|(total, step)| total + step);
+        if let Some(why) = self.handing_over.take() {
+            self.handed_over = (self.handed_over.0 + 1, Some(why));
+        }
         self.steps += 1;
         self.before = self.state;
         self.state = Some(proposal.next);

@@ -122,7 +122,7 @@ pub struct EulerLagrange<S, const N: usize, C> {
     /// at its first step; `None` before.
     iteration: Option<FixedPoint<N>>,
     /// Why the run's steps cannot be iterated (a mass matrix that is not constant or not
-    /// invertible): every step is then Newton's.
+    /// invertible): its first step is handed over, and every step is then Newton's.
     iteration_refused: Option<String>,
     /// The residual of a solution found by iteration, checked before it is taken.
     iterated_residual: DVector<f64>,
@@ -880,8 +880,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             .max(tables.momentum_size(h, &self.increments));
         self.iteration = Some(tables);
         let size = residual.amax();
+        // `amax` skips a NaN that a later entry follows.
+        let finite = residual.iter().all(|x| x.is_finite());
         self.iterated_residual = residual;
-        if exceeds(size, tolerance * terms) {
+        if !finite || exceeds(size, tolerance * terms) {
             return Err(format!(
                 "the iteration's solution leaves a residual of {size:.1e} against a tolerance \
                  of {:.1e}: the model may not be separable as it declares",
@@ -1765,7 +1767,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         tolerance: f64,
     ) -> Option<Result<NewtonReport, String>> {
         // Known when the model is compiled: models that cannot be iterated compile no iteration.
-        if !Self::MAY_ITERATE || self.refuse_fixed_point().is_err() {
+        // A run whose kinetic terms refused it was handed over at its first step; its later
+        // steps are Newton's without a word.
+        if !Self::MAY_ITERATE
+            || self.refuse_fixed_point().is_err()
+            || self.iteration_refused.is_some()
+        {
             return None;
         }
         Some(self.iterate(state, x, tolerance))

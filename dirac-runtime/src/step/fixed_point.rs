@@ -23,10 +23,10 @@
 //! positions are iterated, `Y ← q_k + h α v_0 + h² W M⁻¹ G(Y)`: each iteration takes the
 //! gradient at the nodes and no Jacobian. It contracts by about `h² ‖W‖ ‖M⁻¹ ∇²V‖` per
 //! iteration, so it serves non-stiff models at moderate steps. Started from the stepper's
-//! extrapolation of the last steps, it runs until its update vanishes or stops shrinking below
-//! `√ε` of the increments (a solution to round-off, not to a tolerance), and gives up
-//! where an update grows or after [`MAX_ITERATIONS`]; the stepper then solves that step by
-//! Newton's method.
+//! extrapolation of the last steps, it runs until its update is at round-off (a solution to
+//! round-off, not to a tolerance), and gives up where its update grows twice running above
+//! round-off or after [`MAX_ITERATIONS`]; the stepper then solves that step by Newton's
+//! method.
 //!
 //! The tables carry the round-off of inverting `K` (up to `10⁻¹³` of the increments at degree
 //! 8, where the equispaced points make `K` ill-conditioned), which would bias every step alike.
@@ -83,8 +83,9 @@ pub(crate) struct Settled {
 
 impl<const N: usize> FixedPoint<N> {
     /// The tables of `quadrature` with the run's `kinetic` terms; `None` where `K` is singular
-    /// (no Galerkin step has such a `K`: it is the stiffness matrix of the path's polynomials
-    /// with `ξ_0 = 0`, positive definite on them).
+    /// (no Galerkin step has such a `K`: its rows combine, row 0 with the sum of the others,
+    /// into the stiffness matrix of the path's polynomials with `ξ_0 = 0`, which is positive
+    /// definite).
     pub(crate) fn new(quadrature: &Quadrature, kinetic: Kinetic<N>) -> Option<Self> {
         let (s, nodes, weights) = (
             quadrature.degree(),
@@ -199,35 +200,40 @@ impl<const N: usize> FixedPoint<N> {
         }
         let h2 = h * h;
         let mut previous: Option<f64> = None;
+        let mut grown = false;
         let mut contraction: f64 = 0.0;
         for iteration in 1..=MAX_ITERATIONS {
             for i in 0..r {
                 let g = pull(&(q + self.offsets[i]), t + self.nodes[i] * h);
                 self.pulls[i] = self.kinetic.inverse_mass_times(&g);
             }
-            let (mut update, mut size) = (0.0f64, 0.0f64);
+            let (mut update, mut size, mut finite) = (0.0f64, 0.0f64, true);
             for l in 0..r {
                 let mut next = v0 * (h * self.alpha[l]);
                 for i in 0..r {
                     next += self.pulls[i] * (h2 * self.w[l * r + i]);
                 }
+                // `max` drops a NaN: finiteness is tested apart.
+                finite &= next.iter().all(|x| x.is_finite());
                 update = update.max((next - self.offsets[l]).amax());
                 size = size.max(next.amax());
                 self.offsets[l] = next;
             }
-            if !(update.is_finite() && size.is_finite()) {
+            if !finite {
                 return Err(format!(
                     "the fixed-point iteration left the finite numbers at iteration {iteration}"
                 ));
             }
-            let loose = f64::EPSILON.sqrt() * (size + f64::EPSILON * q.amax());
             if let Some(before) = previous
                 && before > 0.0
             {
                 contraction = contraction.max(update / before);
             }
-            let stalled = previous.is_some_and(|before| update >= before);
-            if update == 0.0 || (update <= loose && stalled) {
+            // The update's round-off: that of the sums (`size`), and the gradients' at `q_k + η`,
+            // rounded to `q_k`'s ulps, carried by the iteration's contraction.
+            let floor = 4.0 * f64::EPSILON * (size + contraction.min(1.0) * q.amax());
+            let grew = previous.is_some_and(|before| update > before);
+            if update <= floor || (grew && update <= 64.0 * floor) {
                 // The solution: the increments from the pulls that gave the last offsets.
                 for (m, xi) in increments.iter_mut().enumerate() {
                     let mut value = v0 * (h * self.beta[m]);
@@ -241,13 +247,15 @@ impl<const N: usize> FixedPoint<N> {
                     contraction,
                 });
             }
-            if stalled {
+            // An update above round-off that grew twice running: the iteration does not contract
+            // (the ∞-norm of one update may grow on the way in).
+            if grew && grown {
                 return Err(format!(
-                    "the fixed-point iteration does not contract: its update grew from {:.1e} to \
-                     {update:.1e} at iteration {iteration}",
-                    previous.unwrap_or(0.0)
+                    "the fixed-point iteration does not contract: its update grew twice running, \
+                     to {update:.1e} at iteration {iteration}"
                 ));
             }
+            grown = grew;
             previous = Some(update);
         }
         Err(format!(
@@ -273,7 +281,8 @@ mod tests {
     }
 
     /// With `s` Gauss nodes the tables are the Gauss collocation method's: `α = c`, and
-    /// `Σ_i W_li = c_l²/2` (`W = A²` integrates a constant twice).
+    /// `Σ_i W_li = c_l²/2` from `s = 2` (`W = A²` integrates a constant twice, exactly where
+    /// the collocation polynomial's degree reaches 2); the midpoint rule's `W` is `A² = ¼`.
     #[test]
     fn gauss_tables_are_collocation() {
         let kinetic =
@@ -284,7 +293,8 @@ mod tests {
             for (l, &c) in quadrature.nodes().iter().enumerate() {
                 assert!((tables.alpha[l] - c).abs() < 1e-12, "s = {s}");
                 let row: f64 = (0..s).map(|i| tables.w[l * s + i]).sum();
-                assert!((row - c * c / 2.0).abs() < 1e-12, "s = {s}");
+                let twice = if s == 1 { 0.25 } else { c * c / 2.0 };
+                assert!((row - twice).abs() < 1e-12, "s = {s}: {row}");
             }
         }
     }
