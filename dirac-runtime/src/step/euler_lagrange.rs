@@ -864,7 +864,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 x.fixed_rows_mut::<N>(self.layout.point(j + 1)).copy_from(z);
             }
             scale = self.assemble(state, x, &mut residual, None);
-            if refinements == fixed_point::REFINEMENTS {
+            if refinements == fixed_point::refinements(contraction) {
                 break;
             }
             let layout = self.layout;
