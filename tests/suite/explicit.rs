@@ -436,6 +436,7 @@ fn compositions_keep_their_order_under_a_time_dependent_force() {
 }
 
 /// A hand-written damper that claims its force does not read the velocity.
+#[derive(Clone)]
 pub(crate) struct FalseForce;
 
 impl DiracSystem<1> for FalseForce {

@@ -24,6 +24,7 @@ impl DiracSystem<2> for Coupled {
 }
 
 /// A hand-written model that claims to be separable, its mass `1 + x²` moving with `x`.
+#[derive(Clone)]
 struct FalselySeparable;
 
 impl DiracSystem<1> for FalselySeparable {
@@ -286,22 +287,34 @@ fn the_energys_round_off_stays_small() {
     assert!(largest < 3e-13, "{largest:e}");
 }
 
-#[test]
-fn steps_the_iteration_cannot_settle_are_newtons() {
-    // A step beyond the iteration's reach (it contracts up to ω h = 3.46 for `galerkin(2)`):
-    // the steps are handed over, and they are Newton's.
-    let h = 6.0;
-    let mut newton = Stepper::new(oscillator::SCENE, Quadrature::galerkin(2).unwrap(), h).unwrap();
-    let mut iterated = Stepper::new(oscillator::SCENE, Quadrature::galerkin(2).unwrap(), h)
+/// `steps` steps of `model` from `(q0, v0)` by Newton's method and by the iteration.
+fn run_both<S: DiracSystem<N> + Clone, const N: usize>(
+    model: S,
+    quadrature: Quadrature,
+    h: f64,
+    (q0, v0): (SVector<f64, N>, SVector<f64, N>),
+    steps: u64,
+) -> (Stepper<S, N>, Stepper<S, N>) {
+    let mut newton = Stepper::new(model.clone(), quadrature.clone(), h).unwrap();
+    let mut iterated = Stepper::new(model, quadrature, h)
         .unwrap()
         .with_fixed_point()
         .unwrap();
     for stepper in [&mut newton, &mut iterated] {
-        stepper
-            .start_from_momentum(vector![0.5], vector![0.0])
-            .unwrap();
-        stepper.run(20).unwrap();
+        stepper.start_from_velocity(q0, v0).unwrap();
+        stepper.run(steps).unwrap();
     }
+    (newton, iterated)
+}
+
+#[test]
+fn steps_the_iteration_cannot_settle_are_newtons() {
+    let galerkin = |s| Quadrature::galerkin(s).unwrap();
+    // A step beyond the iteration's reach (it contracts up to ω h = 3.46 for `galerkin(2)`):
+    // the steps are handed over, and they are Newton's.
+    let h = 6.0;
+    let start = (vector![0.5], vector![0.0]);
+    let (newton, iterated) = run_both(oscillator::SCENE, galerkin(2), h, start, 20);
     let (count, why) = iterated.handed_over();
     println!(
         "ω h = {:.2}: {count} of 20 handed over: {why:?}",
@@ -310,17 +323,8 @@ fn steps_the_iteration_cannot_settle_are_newtons() {
     assert!(count > 0 && why.is_some_and(|w| w.contains("iteration")));
     assert!((newton.q() - iterated.q()).amax() < 1e-13);
     // A false claim about the forces: the rows' residual refuses each iterated solution.
-    let mut newton = Stepper::new(FalseForce, Quadrature::galerkin(2).unwrap(), 0.05).unwrap();
-    let mut iterated = Stepper::new(FalseForce, Quadrature::galerkin(2).unwrap(), 0.05)
-        .unwrap()
-        .with_fixed_point()
-        .unwrap();
-    for stepper in [&mut newton, &mut iterated] {
-        stepper
-            .start_from_velocity(vector![1.0], vector![0.5])
-            .unwrap();
-        stepper.run(50).unwrap();
-    }
+    let start = (vector![1.0], vector![0.5]);
+    let (newton, iterated) = run_both(FalseForce, galerkin(2), 0.05, start, 50);
     let (count, why) = iterated.handed_over();
     assert_eq!(count, 50);
     assert!(why.is_some_and(|w| w.contains("residual")), "{why:?}");
@@ -328,18 +332,8 @@ fn steps_the_iteration_cannot_settle_are_newtons() {
     assert!((newton.p() - iterated.p()).amax() < 1e-13);
     // A false claim to be separable: the run's kinetic terms refuse it at the first step, and
     // Newton's method takes the run from there.
-    let mut newton =
-        Stepper::new(FalselySeparable, Quadrature::galerkin(2).unwrap(), 0.05).unwrap();
-    let mut iterated = Stepper::new(FalselySeparable, Quadrature::galerkin(2).unwrap(), 0.05)
-        .unwrap()
-        .with_fixed_point()
-        .unwrap();
-    for stepper in [&mut newton, &mut iterated] {
-        stepper
-            .start_from_velocity(vector![0.7], vector![0.2])
-            .unwrap();
-        stepper.run(10).unwrap();
-    }
+    let start = (vector![0.7], vector![0.2]);
+    let (newton, iterated) = run_both(FalselySeparable, galerkin(2), 0.05, start, 10);
     assert_eq!((newton.q(), newton.p()), (iterated.q(), iterated.p()));
     let (count, why) = iterated.handed_over();
     assert_eq!(count, 1);

@@ -53,8 +53,10 @@ enum Problem {
     Velocity,
 }
 
-/// How a [`Stepper`]'s steps are solved ([`Stepper::solver`]).
+/// How a [`Stepper`]'s steps are solved ([`Stepper::solver`]). More ways may come: a `match`
+/// needs a wildcard arm.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Solver {
     /// In closed form: an explicit step has no equations to solve.
     Explicit,
