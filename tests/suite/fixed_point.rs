@@ -135,6 +135,24 @@ fn forces_of_position_time_and_inputs_are_iterated_with_their_work() {
     }
 }
 
+/// The pendulum's error in `(q, p)(5)` against its golden values after `n` steps of
+/// `galerkin(s)` by the iteration, and the steps it handed over.
+fn pendulum_at_5(s: usize, n: u64) -> (f64, u64) {
+    let quadrature = Quadrature::galerkin(s).unwrap();
+    let mut stepper = Stepper::new(pendulum::SCENE, quadrature, 5.0 / n as f64)
+        .unwrap()
+        .with_fixed_point()
+        .unwrap();
+    stepper
+        .start_from_momentum(vector![1.0], vector![0.0])
+        .unwrap();
+    stepper.run(n).unwrap();
+    let error = (stepper.q()[0] - pendulum::Q5)
+        .abs()
+        .max((stepper.p()[0] - pendulum::P5).abs());
+    (error, stepper.handed_over().0)
+}
+
 /// Orders `2s` up to 16, by least-squares slopes against closed forms: the oscillator's
 /// `(x, p/ω)` at T = 240 for every degree (Gauss steps of a linear model err in phase alone,
 /// smoothly in `h`), the pendulum's `(q, p)(5)` against its golden values for degrees 4 and 5
@@ -201,19 +219,9 @@ fn orders_up_to_sixteen() {
         let errors: Vec<f64> = ns
             .iter()
             .map(|&n| {
-                let quadrature = Quadrature::galerkin(s).unwrap();
-                let mut stepper = Stepper::new(pendulum::SCENE, quadrature, 5.0 / n as f64)
-                    .unwrap()
-                    .with_fixed_point()
-                    .unwrap();
-                stepper
-                    .start_from_momentum(vector![1.0], vector![0.0])
-                    .unwrap();
-                stepper.run(n).unwrap();
-                assert_eq!(stepper.handed_over().0, 0);
-                (stepper.q()[0] - pendulum::Q5)
-                    .abs()
-                    .max((stepper.p()[0] - pendulum::P5).abs())
+                let (error, handed) = pendulum_at_5(s, n);
+                assert_eq!(handed, 0);
+                error
             })
             .collect();
         let measured = slope(&hs, &errors);
@@ -234,20 +242,7 @@ fn orders_up_to_sixteen() {
 #[test]
 fn round_off_takes_over_below_these_steps() {
     for (s, n) in [(4, 50), (5, 20), (6, 12), (7, 8), (8, 5)] {
-        let error = |n: u64| {
-            let quadrature = Quadrature::galerkin(s).unwrap();
-            let mut stepper = Stepper::new(pendulum::SCENE, quadrature, 5.0 / n as f64)
-                .unwrap()
-                .with_fixed_point()
-                .unwrap();
-            stepper
-                .start_from_momentum(vector![1.0], vector![0.0])
-                .unwrap();
-            stepper.run(n).unwrap();
-            (stepper.q()[0] - pendulum::Q5)
-                .abs()
-                .max((stepper.p()[0] - pendulum::P5).abs())
-        };
+        let error = |n: u64| pendulum_at_5(s, n).0;
         let coarse = n * 2 / 3;
         let (at, coarser) = (error(n), error(coarse));
         let h = |n: u64| 5.0 / n as f64;

@@ -209,8 +209,9 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
     ///     .steps([0.1, 0.05])
     ///     .compositions([Composition::kahan_li_8()])
     ///     .run()?;
-    /// // midpoint, galerkin(2), galerkin(3) and Kahan–Li 8 at two steps.
-    /// assert_eq!(study.measurements.len(), 8);
+    /// // midpoint, galerkin(2), galerkin(3) (by Newton's method and by fixed-point iteration)
+    /// // and Kahan–Li 8, at two steps.
+    /// assert_eq!(study.measurements.len(), 14);
     /// let explicit = study.measurements.iter().find(|m| m.quadrature.starts_with("Kahan–Li 8"));
     /// assert_eq!(explicit.map(|m| m.newton_iterations), Some(0.0));
     /// # Ok::<(), dirac_runtime::DiracError>(())
