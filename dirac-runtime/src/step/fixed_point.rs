@@ -1,7 +1,7 @@
 //! The Galerkin step of a separable Lagrangian solved by fixed-point iteration, without a
 //! Jacobian.
 //!
-//! For `L = ½ vᵀ M v + bᵀ v − V(q)` with constant `M` and `b` ([`DiracSystem::SEPARABLE`]) and
+//! For `L = ½ vᵀ M v + bᵀ v − V(q)` with constant `M` and `b` ([`DiracSystem::SEPARABLE`](crate::DiracSystem::SEPARABLE)) and
 //! `g(q) = ∂L/∂q` (plus a force that does not read the velocity, `F(q, t, u)`), the rows
 //! `R_j = δ_j0 p_k + ∂L_d/∂Q_j + f_j = 0` (`j = 0..s−1`) of a degree-`s` Galerkin step are
 //!
@@ -27,12 +27,12 @@
 //! round-off, not to a tolerance: an estimate of the error left from the ratio of the last
 //! updates stopped it early, since that ratio misjudges the contraction on the way in), and
 //! gives up where its update grows twice running above round-off or after
-//! [`MAX_ITERATIONS`]; the stepper then solves that step by Newton's method.
+//! 40 iterations; the stepper then solves that step by Newton's method.
 //!
 //! The tables carry the round-off of inverting `K` (up to `10⁻¹³` of the increments at degree
 //! 8, where the equispaced points make `K` ill-conditioned), which would bias every step alike.
 //! So the solution is refined on the rows themselves, assembled as Newton's method assembles
-//! them: `ξ ← ξ − h (K⁻¹ ⊗ M⁻¹) R(ξ)`, once or twice ([`refinements`]), and the rows assembled
+//! them: `ξ ← ξ − h (K⁻¹ ⊗ M⁻¹) R(ξ)`, once where the iteration contracts below `10⁻³`, twice above, and the rows assembled
 //! at the last point must be a root to the solver's tolerance. The root is then Newton's to
 //! round-off.
 

@@ -11,7 +11,7 @@ pub mod composition;
 pub mod dense_output;
 pub mod euler_lagrange;
 pub mod field;
-pub(crate) mod fixed_point;
+pub mod fixed_point;
 pub mod group_euler_lagrange;
 pub(crate) mod group_linearisation;
 pub mod hamilton;
