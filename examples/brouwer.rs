@@ -16,18 +16,17 @@ use std::time::{Duration, Instant};
 
 use dirac::plot::{Series, line_chart};
 use dirac::prelude::*;
-use dirac::{StepEquations, Vectors};
-use scenes::kepler;
-use scenes::roundoff::{checkpoints, exponent, rms_energy_error};
+use scenes::roundoff::{Method, checkpoints, exponent, rms_energy_error};
 
-/// `rms_energy_error` of the steppers `stepper` builds, with the wall time it took.
-fn timed<E: StepEquations<2, Manifold = Vectors> + Send>(
-    stepper: impl Fn() -> Result<Stepper<E::System, 2, E>, DiracError> + Sync,
+/// `rms_energy_error` of `method` at step `h`, with the wall time it took.
+fn timed(
+    method: &Method,
+    h: f64,
     runs: usize,
     at: &[u64],
 ) -> Result<(Vec<(f64, f64)>, Duration), DiracError> {
     let start = Instant::now();
-    let points = rms_energy_error(stepper, runs, at)?;
+    let points = rms_energy_error(method, h, runs, at)?;
     Ok((points, start.elapsed()))
 }
 
@@ -79,21 +78,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         });
     };
     let spread = |steps: u64| checkpoints(100, steps, per_decade as u32);
-    let composition = Composition::kahan_li_8();
-    let (points, wall) = timed(
-        || Stepper::explicit(kepler::SCENE, composition.clone(), h),
-        runs,
-        &spread(steps),
-    )?;
-    record(format!("explicit {}", composition.name()), points, wall);
+    let explicit = Method::Explicit(Composition::kahan_li_8());
+    let (points, wall) = timed(&explicit, h, runs, &spread(steps))?;
+    record(explicit.name(), points, wall);
     if implicit_steps > 0 {
-        let gauss = Quadrature::galerkin(4)?;
-        let (points, wall) = timed(
-            || Stepper::new(kepler::SCENE, gauss.clone(), h),
-            runs,
-            &spread(implicit_steps),
-        )?;
-        record(format!("implicit Gauss {}", gauss.name()), points, wall);
+        let gauss = Method::Lagrangian(Quadrature::galerkin(4)?);
+        let (points, wall) = timed(&gauss, h, runs, &spread(implicit_steps))?;
+        record(gauss.name(), points, wall);
     }
     // Guides from the first point: slopes 1/2 (a walk) and 1 (a drift).
     let (t0, e0) = series[0].points[0];

@@ -13,7 +13,7 @@ use dirac::prelude::*;
 use dirac::{StepEquations, Vectors};
 use rayon::prelude::*;
 
-use super::kepler;
+use super::{hamiltonian, kepler};
 
 /// Kepler's start turned by `angle` about the origin: the same orbit, rotated.
 pub fn turned_start(angle: f64) -> (SVector<f64, 2>, SVector<f64, 2>) {
@@ -33,15 +33,63 @@ pub fn checkpoints(first: u64, last: u64, per_decade: u32) -> Vec<u64> {
     steps
 }
 
-/// The root mean square of `E(t_n) − E(0)` at the step counts `at` over `runs` runs from turned
-/// starts (angles spread over the circle), run in parallel: `(t_n, rms)` pairs. `stepper`
-/// builds a stepper for each run of a Kepler model (Lagrangian or Hamiltonian), which is
-/// started from its turned start.
-pub fn rms_energy_error<E, F>(
-    stepper: F,
+/// A method whose round-off the ensembles measure on Kepler's problem.
+#[derive(Clone, Debug)]
+pub enum Method {
+    /// An explicit composition of Störmer–Verlet steps.
+    Explicit(Composition),
+    /// The implicit step of a quadrature on the Lagrangian route.
+    Lagrangian(Quadrature),
+    /// The implicit step of a quadrature on the discrete Hamiltonian route (Kepler's `H(q, p)`).
+    Hamiltonian(Quadrature),
+}
+
+impl Method {
+    /// The method's name, as the ensembles report it.
+    pub fn name(&self) -> String {
+        match self {
+            Method::Explicit(composition) => format!("explicit {}", composition.name()),
+            Method::Lagrangian(quadrature) => format!("implicit Gauss {}", quadrature.name()),
+            Method::Hamiltonian(quadrature) => {
+                format!("implicit Gauss {}, Hamiltonian route", quadrature.name())
+            }
+        }
+    }
+}
+
+/// The root mean square of `E(t_n) − E(0)` at the step counts `at` over `runs` runs of
+/// `method` with step `h` from turned starts (angles spread over the circle), run in parallel:
+/// `(t_n, rms)` pairs.
+///
+/// The runs are long (10⁵ to 10⁸ steps), so they are compiled here, once, at the scenes'
+/// optimisation level: the tests that call this are built unoptimised.
+pub fn rms_energy_error(
+    method: &Method,
+    h: f64,
     runs: usize,
     at: &[u64],
-) -> Result<Vec<(f64, f64)>, DiracError>
+) -> Result<Vec<(f64, f64)>, DiracError> {
+    match method {
+        Method::Explicit(composition) => ensemble(
+            || Stepper::explicit(kepler::SCENE, composition.clone(), h),
+            runs,
+            at,
+        ),
+        Method::Lagrangian(quadrature) => ensemble(
+            || Stepper::new(kepler::SCENE, quadrature.clone(), h),
+            runs,
+            at,
+        ),
+        Method::Hamiltonian(quadrature) => ensemble(
+            || Stepper::hamiltonian(hamiltonian::Kepler { mu: 1.0 }, quadrature.clone(), h),
+            runs,
+            at,
+        ),
+    }
+}
+
+/// `rms_energy_error` of the steppers `stepper` builds, each started from its turned start.
+fn ensemble<E, F>(stepper: F, runs: usize, at: &[u64]) -> Result<Vec<(f64, f64)>, DiracError>
 where
     E: StepEquations<2, Manifold = Vectors> + Send,
     F: Fn() -> Result<Stepper<E::System, 2, E>, DiracError> + Sync,
