@@ -91,7 +91,8 @@ fn recording_allocates_nothing_per_sample() {
 }
 
 /// Steps of constrained models and Galerkin rules allocate nothing either: one-forms held at the
-/// midpoint and at the Gauss nodes, SHAKE, a Galerkin step with internal points, and the LC
+/// midpoint and at the Gauss nodes, SHAKE, a Galerkin step with internal points (solved by
+/// Newton's method and by fixed-point iteration), and the LC
 /// circuit's hidden constraint checked at each midpoint step's end. (A projection that moves
 /// `q`, as under Galerkin rules, which hold the hidden constraint at their nodes only, and
 /// hidden constraints not fixed along the motion still allocate.)
@@ -134,6 +135,19 @@ fn constrained_and_galerkin_steps_allocate_nothing() {
     kepler
         .start_from_momentum(scenes::kepler::q0(), scenes::kepler::p0())
         .unwrap();
+    // The same Galerkin step solved by fixed-point iteration (its tables set up at the first
+    // step).
+    let mut iterated = Stepper::new(
+        scenes::kepler::SCENE,
+        Quadrature::galerkin(4).unwrap(),
+        0.01,
+    )
+    .unwrap()
+    .with_fixed_point()
+    .unwrap();
+    iterated
+        .start_from_momentum(scenes::kepler::q0(), scenes::kepler::p0())
+        .unwrap();
     let mut lc = Stepper::new(scenes::circuit::LC, Quadrature::midpoint(), 0.01).unwrap();
     lc.start_from_velocity(scenes::circuit::q0(), SVector::zeros())
         .unwrap();
@@ -146,6 +160,7 @@ fn constrained_and_galerkin_steps_allocate_nothing() {
         ),
         after_a_step("Cartesian pendulum, SHAKE", pendulum),
         after_a_step("Kepler, galerkin(3)", kepler),
+        after_a_step("Kepler, galerkin(4), fixed point", iterated),
     ];
     for (name, count) in counts {
         assert_eq!(count, 0, "{name}: {count} allocations in 100 steps");

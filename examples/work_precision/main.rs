@@ -89,8 +89,13 @@ impl Runner {
         );
         let rows = self.of(scene, horizon);
         for r in &rows {
+            // A fixed-point run's steps that its iteration handed to Newton's method.
+            let handed = match r.handed_over {
+                0 => String::new(),
+                n => format!(" ({n} steps by Newton)"),
+            };
             println!(
-                "  {:<12} {:>12} {:>10} {:>10.2e} {:>10.2e} {:>10.1e} {:>14.2}",
+                "  {:<12} {:>12} {:>10} {:>10.2e} {:>10.2e} {:>10.1e} {:>14.2}{handed}",
                 r.method,
                 r.setting,
                 r.steps,
@@ -229,6 +234,7 @@ impl Runner {
             "error",
             "energy_error",
             "violation",
+            "handed_over",
             "seconds_per_unit_time",
         ])
         .map_err(io)?;
@@ -242,6 +248,7 @@ impl Runner {
                 r.error.to_string(),
                 r.energy_error.to_string(),
                 r.violation.to_string(),
+                r.handed_over.to_string(),
                 r.seconds_per_unit_time.to_string(),
             ])
             .map_err(io)?;

@@ -38,8 +38,10 @@ pub fn checkpoints(first: u64, last: u64, per_decade: u32) -> Vec<u64> {
 pub enum Method {
     /// An explicit composition of Störmer–Verlet steps.
     Explicit(Composition),
-    /// The implicit step of a quadrature on the Lagrangian route.
+    /// The implicit step of a quadrature on the Lagrangian route, solved by Newton's method.
     Lagrangian(Quadrature),
+    /// The same step solved by fixed-point iteration ([`Stepper::with_fixed_point`]).
+    FixedPoint(Quadrature),
     /// The implicit step of a quadrature on the discrete Hamiltonian route (Kepler's `H(q, p)`).
     Hamiltonian(Quadrature),
 }
@@ -50,6 +52,9 @@ impl Method {
         match self {
             Method::Explicit(composition) => format!("explicit {}", composition.name()),
             Method::Lagrangian(quadrature) => format!("implicit Gauss {}", quadrature.name()),
+            Method::FixedPoint(quadrature) => {
+                format!("implicit Gauss {}, fixed point", quadrature.name())
+            }
             Method::Hamiltonian(quadrature) => {
                 format!("implicit Gauss {}, Hamiltonian route", quadrature.name())
             }
@@ -77,6 +82,11 @@ pub fn rms_energy_error(
         ),
         Method::Lagrangian(quadrature) => ensemble(
             || Stepper::new(kepler::SCENE, quadrature.clone(), h),
+            runs,
+            at,
+        ),
+        Method::FixedPoint(quadrature) => ensemble(
+            || Stepper::new(kepler::SCENE, quadrature.clone(), h)?.with_fixed_point(),
             runs,
             at,
         ),

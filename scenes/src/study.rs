@@ -198,6 +198,8 @@ pub struct Row {
     pub error: f64,
     pub energy_error: f64,
     pub violation: f64,
+    /// dirac's steps by fixed-point iteration handed to Newton's method (0 for a peer).
+    pub handed_over: u64,
     pub seconds_per_unit_time: f64,
 }
 
@@ -260,6 +262,7 @@ where
             error: m.error,
             energy_error: m.energy_error,
             violation: m.constraint_violation,
+            handed_over: m.handed_over,
             seconds_per_unit_time: m.seconds_per_unit_time,
         })
         .collect();
@@ -307,6 +310,7 @@ where
                 error: run.error,
                 energy_error: run.energy_error,
                 violation: run.violation,
+                handed_over: 0,
                 seconds_per_unit_time: run.seconds_per_unit_time,
             }),
             Err(why) => failures.push(format!("tol = {tolerance:e}: {why}")),

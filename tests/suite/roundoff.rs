@@ -35,6 +35,13 @@ fn gauss_round_off_in_the_energy_after_1e5_steps_is_a_walks_not_a_drifts() {
     assert!(points[2].1 < 2.0e-15, "{points:?}");
 }
 
+/// The same Gauss step solved by fixed-point iteration.
+#[test]
+fn fixed_point_gauss_round_off_in_the_energy_after_1e5_steps_is_a_walks_not_a_drifts() {
+    let points = spread(Method::FixedPoint(Quadrature::galerkin(4).unwrap()));
+    assert!(points[2].1 < 2.0e-15, "{points:?}");
+}
+
 /// The same Gauss step on the discrete Hamiltonian route (Kepler's `H(q, p)`): 6.8e-16 after
 /// 10⁵ steps. Three biases of an ulp a step each let it drift like t^0.9: its rows weighed the
 /// nodes by the basis at point 0 (as the Lagrangian route's did), took the node's terms times

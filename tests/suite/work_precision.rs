@@ -83,6 +83,8 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
         );
         assert_eq!(m.steps, (horizon / m.h).round() as u64);
         assert!(m.seconds_per_unit_time > 0.0);
+        // ω h ≤ 0.2: every iteration settles.
+        assert_eq!(m.handed_over, 0, "{m:?}");
         let implicit = scenes::quadratures()
             .iter()
             .any(|q| q.name() == m.quadrature);
@@ -158,6 +160,42 @@ struct Pushed;
 /// The explicit runs and those by fixed-point iteration hold the inputs the start function
 /// sets, as the implicit runs do: Störmer–Verlet and the trapezoidal rule are one map, so
 /// their errors agree.
+/// A fixed-point run's steps that its iteration hands to Newton's method are counted: on the
+/// oscillator the midpoint rule's iteration contracts by `(ω h)²/4`, so at h = 2.5 it hands
+/// over every step and at h = 0.1 none (the run at the first step decides that the iteration
+/// is measured at all); the steps handed over are still the midpoint rule's.
+#[test]
+fn the_steps_a_fixed_point_run_hands_over_are_counted() {
+    let horizon = 10.0;
+    let study = Study::new(Oscillator, horizon, |s| {
+        s.start_from_velocity(vector![1.0], vector![0.0])
+    })
+    .quadratures([Quadrature::midpoint()])
+    .compositions([])
+    .steps([0.1, 2.5])
+    .repetitions(1)
+    .reference(oscillator_at(horizon))
+    .run()
+    .unwrap();
+    let find = |name: &str, h: f64| {
+        study
+            .measurements
+            .iter()
+            .find(|m| m.quadrature == name && m.h == h)
+            .unwrap_or_else(|| panic!("no {name} at h = {h}: {study:?}"))
+    };
+    for h in [0.1, 2.5] {
+        let (newton, iterated) = (find("midpoint", h), find("midpoint, fixed point", h));
+        assert_eq!(newton.handed_over, 0);
+        let expected = if h > 2.0 { iterated.steps } else { 0 };
+        assert_eq!(iterated.handed_over, expected, "{iterated:?}");
+        assert!(
+            (iterated.error - newton.error).abs() <= 1e-12 * newton.error.max(1.0),
+            "{iterated:?} against {newton:?}"
+        );
+    }
+}
+
 #[test]
 fn explicit_runs_hold_the_inputs_the_start_sets() {
     let horizon = 2.0;

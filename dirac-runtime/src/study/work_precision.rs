@@ -109,6 +109,9 @@ pub struct Measurement {
     pub constraint_violation: f64,
     /// Newton iterations per step, on average.
     pub newton_iterations: f64,
+    /// Steps of a run by fixed-point iteration that it handed to Newton's method, where the
+    /// iteration did not settle (see [`Stepper::handed_over`]); 0 for every other run.
+    pub handed_over: u64,
     /// Wall time per unit of simulated time, in seconds (the fastest repetition).
     pub seconds_per_unit_time: f64,
 }
@@ -560,6 +563,7 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
             energy_error: trajectory.max_energy_error(),
             constraint_violation: trajectory.max_constraint_violation(),
             newton_iterations: iterations as f64 / steps.max(1) as f64,
+            handed_over: stepper.handed_over().0,
             seconds_per_unit_time: fastest / self.horizon,
         })
     }
@@ -623,6 +627,7 @@ impl<S: DiracSystem<N> + Clone, const N: usize> Study<'_, S, N> {
             energy_error: trajectory.max_energy_error(),
             constraint_violation: 0.0,
             newton_iterations: 0.0,
+            handed_over: 0,
             seconds_per_unit_time: fastest / self.horizon,
         })
     }
@@ -712,6 +717,7 @@ impl<const N: usize> WorkPrecision<N> {
             "energy_error",
             "constraint_violation",
             "newton_iterations",
+            "handed_over",
             "seconds_per_unit_time",
         ])
         .map_err(io)?;
@@ -724,6 +730,7 @@ impl<const N: usize> WorkPrecision<N> {
                 m.energy_error.to_string(),
                 m.constraint_violation.to_string(),
                 m.newton_iterations.to_string(),
+                m.handed_over.to_string(),
                 m.seconds_per_unit_time.to_string(),
             ])
             .map_err(io)?;
