@@ -1,11 +1,12 @@
 //! Writes `docs/performance.md` from the last bench run: every criterion result under
 //! `target/criterion` (`cargo bench --bench step`), grouped as the bench groups them, with the
 //! ratios of paired steps (generated / hand-written, modular / monolithic, Hamiltonian /
-//! Lagrangian, run / step loop), and the work–precision study's summary where one is named
-//! (`output/work_precision/summary.md`). Run by `scripts/performance.sh`; the file is never
-//! edited by hand.
+//! Lagrangian, run / step loop), the work–precision study's summary where one is named
+//! (`output/work_precision/summary.md`) and the field's against the method of lines
+//! (`output/field_work_precision/summary.md`). Run by `scripts/performance.sh`; the file is
+//! never edited by hand.
 //!
-//! `cargo run --example performance [CRITERION_DIR] [OUT] [STUDY_SUMMARY]`
+//! `cargo run --example performance [CRITERION_DIR] [OUT] [STUDY_SUMMARY] [FIELD_SUMMARY]`
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -205,7 +206,11 @@ fn twin(id: &str, from: &str, to: &str) -> Option<String> {
     })
 }
 
-fn write(groups: &BTreeMap<String, Vec<Result>>, study: Option<String>) -> String {
+fn write(
+    groups: &BTreeMap<String, Vec<Result>>,
+    study: Option<String>,
+    field: Option<String>,
+) -> String {
     let mut out = String::new();
     let machine = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -301,6 +306,13 @@ fn write(groups: &BTreeMap<String, Vec<Result>>, study: Option<String>) -> Strin
             study.trim()
         );
     }
+    if let Some(field) = field {
+        let _ = writeln!(
+            out,
+            "\n## A field against the method of lines\n\n{}",
+            field.trim()
+        );
+    }
     let _ = writeln!(
         out,
         "\n## Reproduce\n\n```text\nscripts/performance.sh             # every bench, then the \
@@ -337,13 +349,14 @@ fn main() -> std::result::Result<(), Box<dyn std::error::Error>> {
     if groups.is_empty() {
         return Err(format!("no criterion results under {}", criterion.display()).into());
     }
-    let study = match args.next() {
-        Some(path) => {
-            Some(std::fs::read_to_string(&path).map_err(|e| format!("reading {path}: {e}"))?)
-        }
-        None => None,
+    let mut summary = || match args.next() {
+        Some(path) => std::fs::read_to_string(&path)
+            .map(Some)
+            .map_err(|e| format!("reading {path}: {e}")),
+        None => Ok(None),
     };
-    std::fs::write(&target, write(&groups, study))?;
+    let (study, field) = (summary()?, summary()?);
+    std::fs::write(&target, write(&groups, study, field))?;
     let count: usize = groups.values().map(Vec::len).sum();
     println!(
         "wrote {} ({count} results in {} groups)",

@@ -10,6 +10,7 @@ pub mod components;
 pub mod double_pendulum;
 pub mod ensemble;
 pub mod field;
+pub mod field_lines;
 pub mod figures;
 pub mod first_order;
 pub mod furuta;
