@@ -68,7 +68,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             last.0,
         );
         for &(t, e) in &points {
-            csv += &format!("{name},{t},{e}\n");
+            // Quoted: a name may hold a comma.
+            csv += &format!("\"{name}\",{t},{e}\n");
         }
         series.push(Series {
             label: name,

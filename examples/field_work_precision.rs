@@ -23,12 +23,15 @@ struct Row {
     error: f64,
 }
 
+/// What a target bounds: a run's error or its energy error.
+type Measure = fn(&Row) -> f64;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let cells: usize = args.next().map_or(Ok(800), |a| a.parse())?;
     let horizon: f64 = args.next().map_or(Ok(100.0), |a| a.parse())?;
     let omega = 0.5;
-    let lines = SineGordonLines::new((-20.0, 20.0), cells);
+    let lines = SineGordonLines::new((-20.0, 20.0), cells)?;
     let y0 = lines.breather(omega, 0.0);
     let fine = integrate(&lines, Peer::Dop853, &y0, horizon, 1e-13)?;
     let coarse = integrate(&lines, Peer::Dop853, &y0, horizon, 1e-12)?;
@@ -64,16 +67,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     for peer in [Peer::Dopri5, Peer::Dop853] {
         for tolerance in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12] {
-            let run = integrate(&lines, peer, &y0, horizon, tolerance)?;
-            rows.push(Row {
-                method: peer.name().to_string(),
-                setting: format!("tol = {tolerance:e}"),
-                dirac: false,
-                error: distance(&run.end, &fine.end),
-                run,
-            });
+            match integrate(&lines, peer, &y0, horizon, tolerance) {
+                Ok(run) => rows.push(Row {
+                    method: peer.name().to_string(),
+                    setting: format!("tol = {tolerance:e}"),
+                    dirac: false,
+                    error: distance(&run.end, &fine.end),
+                    run,
+                }),
+                Err(why) => println!("  {} tol = {tolerance:e}: {why}", peer.name()),
+            }
         }
     }
+    // The reference checked apart from Dop853: the order-8 composition at its smallest step.
+    let independent = rows
+        .iter()
+        .filter(|r| r.dirac && r.method.starts_with("Kahan–Li 8"))
+        .max_by_key(|r| r.run.steps)
+        .map_or(f64::NAN, |r| r.error);
     println!(
         "  {:<26} {:>14} {:>8} {:>10} {:>10} {:>14}",
         "method", "setting", "steps", "error", "|ΔE|", "ms per unit t"
@@ -95,7 +106,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "The sine-Gordon breather (ω = {omega}) on [−20, 20], {cells} cells, free ends, to T = \
          {horizon}: dirac's `Field` against the method of lines on the same grid \
          (`cargo run --release --example field_work_precision`). Errors are against Dop853 at \
-         1e-13 on that grid (estimated error {reference_error:.1e}); the energy is read at every \
+         1e-13 on that grid (estimated error {reference_error:.1e} from its distance to 1e-12; \
+         Kahan–Li 8 at Δt = Δx/10 ends {independent:.1e} from it); the energy is read at every \
          step of every run (the peers' accepted steps, stored as they go). Cost is wall time \
          per unit of simulated time; ratio = the peers' cost / dirac's.\n"
     )?;
@@ -103,7 +115,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         summary,
         "| target | dirac's cheapest | peers' cheapest | ratio |\n|---|---|---|---|"
     )?;
-    let targets: [(&str, f64, fn(&Row) -> f64); 5] = [
+    let targets: [(&str, f64, Measure); 5] = [
         ("error ≤ 1e-4", 1e-4, |r| r.error),
         ("error ≤ 1e-6", 1e-6, |r| r.error),
         ("error ≤ 1e-8", 1e-8, |r| r.error),

@@ -9,11 +9,10 @@ use std::time::Instant;
 
 use dirac::nalgebra::SVector;
 use dirac::{Boundary, Composition, DiracError, Field};
-use ode_solvers::dop_shared::OutputType;
-use ode_solvers::{DVector, Dop853, Dopri5, System};
+use ode_solvers::{DVector, System};
 
 use super::field::{SineGordon, breather, kink};
-use super::peers::Peer;
+use super::peers::{Peer, adaptive};
 
 /// The sine-Gordon field `u_tt = u_xx − sin u` on `[a, b]` with free ends, cut into `cells`
 /// cells of width `Δx`: the semi-discrete equations of dirac's `Field`. Its nodes carry masses
@@ -27,8 +26,8 @@ use super::peers::Peer;
 /// (and `ü_N` likewise), as a first-order system in `y = (u_0, …, u_N, u̇_0, …, u̇_N)`.
 #[derive(Debug, Clone, Copy)]
 pub struct SineGordonLines {
-    /// The left end `a`.
-    pub start: f64,
+    /// `[a, b]`.
+    pub interval: (f64, f64),
     /// The cells' width `Δx`.
     pub dx: f64,
     /// The number of cells `N` (`N + 1` nodes).
@@ -36,13 +35,18 @@ pub struct SineGordonLines {
 }
 
 impl SineGordonLines {
-    /// The field on `[a, b]` in `cells` cells.
-    pub fn new((a, b): (f64, f64), cells: usize) -> Self {
-        Self {
-            start: a,
+    /// The field on `[a, b]` in `cells` cells; `Err` for no cells or an empty interval.
+    pub fn new((a, b): (f64, f64), cells: usize) -> Result<Self, String> {
+        if cells == 0 || a.partial_cmp(&b) != Some(std::cmp::Ordering::Less) {
+            return Err(format!(
+                "{cells} cells on [{a}, {b}]: a field needs cells and a < b"
+            ));
+        }
+        Ok(Self {
+            interval: (a, b),
             dx: (b - a) / cells as f64,
             cells,
-        }
+        })
     }
 
     /// `N + 1`.
@@ -53,7 +57,7 @@ impl SineGordonLines {
     /// The node positions `x_j = a + j Δx`.
     pub fn positions(&self) -> Vec<f64> {
         (0..self.nodes())
-            .map(|j| self.start + j as f64 * self.dx)
+            .map(|j| self.interval.0 + j as f64 * self.dx)
             .collect()
     }
 
@@ -132,17 +136,19 @@ impl System<f64, DVector<f64>> for Watched<'_> {
 /// steps, and the wall time of a run that does not read the energy.
 #[derive(Debug, Clone)]
 pub struct LinesRun {
+    /// `y = (u, u̇)` at the end.
     pub end: DVector<f64>,
+    /// Steps taken (accepted steps for a peer).
     pub steps: u64,
+    /// `max |E − E_0|` over the steps.
     pub energy_error: f64,
+    /// Wall time of the run that does not read the energy.
     pub seconds: f64,
 }
 
-/// Integrates `lines` from `y0` to `t_end` by `peer` (Dop853 or Dopri5) at relative and absolute
-/// `tolerance`, with the crate's default controllers and no step limit: once with the energy
-/// read at every accepted step, then timed without. Output is sparse (every accepted step is
-/// stored, as the study's peers do): the crate's dense output at a few points off the steps
-/// ended 1e-3 away from the solution on this grid.
+/// Integrates `lines` from `y0` to `t_end` by `peer` (Dop853 or Dopri5; BDF is refused) at
+/// relative and absolute `tolerance`, as the study runs them (every accepted step stored): once
+/// with the energy read at every accepted step, then timed without.
 pub fn integrate(
     lines: &SineGordonLines,
     peer: Peer,
@@ -150,47 +156,14 @@ pub fn integrate(
     t_end: f64,
     tolerance: f64,
 ) -> Result<LinesRun, String> {
-    let failed = |e: ode_solvers::dop_shared::IntegrationError| format!("{}: {e}", peer.name());
     let energy = RefCell::new((lines.energy(y0), 0.0));
-    macro_rules! run {
-        ($solver:ident, $beta:expr, $fac_min:expr, $fac_max:expr, $system:expr) => {{
-            let mut solver = $solver::from_param(
-                $system,
-                0.0,
-                t_end,
-                0.0,
-                y0.clone(),
-                tolerance,
-                tolerance,
-                0.9,
-                $beta,
-                $fac_min,
-                $fac_max,
-                t_end,
-                0.0,
-                u32::MAX,
-                1000,
-                OutputType::Sparse,
-            );
-            let stats = solver.integrate().map_err(failed)?;
-            let end = solver.y_out().last().cloned().ok_or("no output")?;
-            (end, stats.accepted_steps as u64)
-        }};
-    }
-    let watched = || Watched {
+    let watched = Watched {
         lines,
         energy: &energy,
     };
-    let (end, steps) = match peer {
-        Peer::Dop853 => run!(Dop853, 0.0, 0.333, 6.0, watched()),
-        Peer::Dopri5 => run!(Dopri5, 0.04, 0.2, 10.0, watched()),
-        Peer::Bdf => return Err("the method of lines here is explicit: BDF is not run".into()),
-    };
+    let (end, steps) = adaptive!(peer, watched, y0.clone(), t_end, tolerance)?;
     let clock = Instant::now();
-    match peer {
-        Peer::Dop853 => run!(Dop853, 0.0, 0.333, 6.0, *lines),
-        _ => run!(Dopri5, 0.04, 0.2, 10.0, *lines),
-    };
+    adaptive!(peer, *lines, y0.clone(), t_end, tolerance)?;
     let seconds = clock.elapsed().as_secs_f64();
     Ok(LinesRun {
         end,
@@ -200,7 +173,35 @@ pub fn integrate(
     })
 }
 
-/// A run of dirac's `Field` on the lines' grid: as [`LinesRun`], the energy read at every step.
+impl SineGordonLines {
+    /// dirac's `Field` on this grid (free ends), stepped by `composition` with step `dt`, started
+    /// from `y`.
+    pub fn field(
+        &self,
+        composition: &Composition,
+        dt: f64,
+        y: &DVector<f64>,
+    ) -> Result<Field<SineGordon, 1>, DiracError> {
+        let n = self.nodes();
+        if y.len() != 2 * n {
+            return Err(DiracError::Dimension(format!(
+                "y has {} entries, the grid's (u, u_t) {}",
+                y.len(),
+                2 * n
+            )));
+        }
+        let mut field = Field::new(SineGordon, self.interval, self.cells, Boundary::Free, dt)?
+            .with_composition(composition.clone());
+        let pick = |offset: usize| -> Vec<SVector<f64, 1>> {
+            (0..n).map(|j| SVector::from([y[offset + j]])).collect()
+        };
+        field.start(&pick(0), &pick(n))?;
+        Ok(field)
+    }
+}
+
+/// A run of dirac's `Field` on the lines' grid from `y0` to `t_end` (a whole number of steps
+/// `dt`, else `InvalidRun`): as [`LinesRun`], the energy read at every step.
 pub fn field_run(
     lines: &SineGordonLines,
     composition: &Composition,
@@ -208,25 +209,14 @@ pub fn field_run(
     y0: &DVector<f64>,
     t_end: f64,
 ) -> Result<LinesRun, DiracError> {
-    let n = lines.nodes();
-    let end = lines.start + lines.cells as f64 * lines.dx;
     let steps = (t_end / dt).round() as u64;
-    let started = || -> Result<Field<SineGordon, 1>, DiracError> {
-        let mut field = Field::new(
-            SineGordon,
-            (lines.start, end),
-            lines.cells,
-            Boundary::Free,
-            dt,
-        )?
-        .with_composition(composition.clone());
-        let pick = |offset: usize| -> Vec<SVector<f64, 1>> {
-            (0..n).map(|j| SVector::from([y0[offset + j]])).collect()
-        };
-        field.start(&pick(0), &pick(n))?;
-        Ok(field)
-    };
-    let mut field = started()?;
+    if steps == 0 || (steps as f64 * dt - t_end).abs() > 1e-9 * t_end {
+        return Err(DiracError::InvalidRun(format!(
+            "steps of {dt} do not reach {t_end} in a whole number"
+        )));
+    }
+    let n = lines.nodes();
+    let mut field = lines.field(composition, dt, y0)?;
     let e0 = field.energy()?;
     let mut energy_error: f64 = 0.0;
     for _ in 0..steps {
@@ -234,13 +224,13 @@ pub fn field_run(
         energy_error = energy_error.max((field.energy()? - e0).abs());
     }
     let (u, ut) = (field.u()?, field.velocities()?);
-    let end_state = DVector::from_fn(2 * n, |i, _| if i < n { u[i][0] } else { ut[i - n][0] });
-    let mut timed = started()?;
+    let end = DVector::from_fn(2 * n, |i, _| if i < n { u[i][0] } else { ut[i - n][0] });
+    let mut timed = lines.field(composition, dt, y0)?;
     let clock = Instant::now();
     timed.run(steps)?;
     let seconds = clock.elapsed().as_secs_f64();
     Ok(LinesRun {
-        end: end_state,
+        end,
         steps,
         energy_error,
         seconds,

@@ -20,7 +20,7 @@ use std::cell::RefCell;
 use std::time::Instant;
 
 use dirac::Sample;
-use ode_solvers::{Dop853, Dopri5, OutputType, System};
+use ode_solvers::System;
 
 use super::first_order::FirstOrder;
 
@@ -117,7 +117,62 @@ impl<F: FirstOrder<Y, N>, const Y: usize, const N: usize> System<f64, ode_solver
 }
 
 /// No step limit: a long horizon at a tight tolerance takes millions of steps.
-const MAX_STEPS: u32 = u32::MAX;
+pub(crate) const MAX_STEPS: u32 = u32::MAX;
+
+/// ode_solvers' `Dop853` or `Dopri5` (`peer`) on `system` from `y0` over `[0, horizon]` at
+/// relative and absolute `tolerance`: `Ok((end state, accepted steps))`, or `Err` with why. Each
+/// with the crate's default controller (safety, beta, fac_min, fac_max), no step limit, `h_max`
+/// the whole span, and sparse output: every accepted step is stored, and `solout` sees it (with
+/// dense output it would see the last interpolated point instead; and its interpolant at a few
+/// points off the steps ended 1e-3 away from the solution of a field's stiff semi-discrete
+/// equations). A macro because the solvers are generic over the state's dimension with bounds
+/// of ode_solvers' own nalgebra.
+macro_rules! adaptive {
+    (@run $solver:ident, $beta:expr, $fac_min:expr, $fac_max:expr,
+     $system:expr, $y0:expr, $horizon:expr, $tolerance:expr) => {{
+        let mut solver = ode_solvers::$solver::from_param(
+            $system,
+            0.0,
+            $horizon,
+            0.0,
+            $y0,
+            $tolerance,
+            $tolerance,
+            0.9,
+            $beta,
+            $fac_min,
+            $fac_max,
+            $horizon,
+            0.0,
+            $crate::peers::MAX_STEPS,
+            1000,
+            ode_solvers::OutputType::Sparse,
+        );
+        match solver.integrate() {
+            Ok(stats) => solver
+                .y_out()
+                .last()
+                .cloned()
+                .map(|end| (end, stats.accepted_steps as u64))
+                .ok_or_else(|| format!("{}: no output", stringify!($solver))),
+            Err(e) => Err(format!("{}: {e}", stringify!($solver))),
+        }
+    }};
+    ($peer:expr, $system:expr, $y0:expr, $horizon:expr, $tolerance:expr) => {
+        match $peer {
+            $crate::peers::Peer::Dop853 => {
+                adaptive!(@run Dop853, 0.0, 0.333, 6.0, $system, $y0, $horizon, $tolerance)
+            }
+            $crate::peers::Peer::Dopri5 => {
+                adaptive!(@run Dopri5, 0.04, 0.2, 10.0, $system, $y0, $horizon, $tolerance)
+            }
+            $crate::peers::Peer::Bdf => Err::<_, String>(
+                "BDF is not an explicit Runge–Kutta method: it is run apart".to_string(),
+            ),
+        }
+    };
+}
+pub(crate) use adaptive;
 
 /// Runs `peer` on `ode` from its initial state to `horizon`: the end state and the accepted
 /// steps.
@@ -133,42 +188,11 @@ fn integrate<F: FirstOrder<Y, N>, const Y: usize, const N: usize>(
     }
     let y0 = ode_solvers::SVector::<f64, Y>::from(ode.initial());
     let system = Explicit { ode, monitor };
-    let failed = |e: ode_solvers::dop_shared::IntegrationError| format!("{}: {e}", peer.name());
-    // Sparse output: every accepted step is stored, and `solout` sees it (with dense output it
-    // would see the last interpolated point instead).
-    // The crate's default controller for each method (safety, beta, fac_min, fac_max), with no
-    // step limit and h_max the whole span.
-    macro_rules! explicit {
-        ($solver:ident, $beta:expr, $fac_min:expr, $fac_max:expr) => {{
-            let mut solver = $solver::from_param(
-                system,
-                0.0,
-                horizon,
-                0.0,
-                y0,
-                tolerance,
-                tolerance,
-                0.9,
-                $beta,
-                $fac_min,
-                $fac_max,
-                horizon,
-                0.0,
-                MAX_STEPS,
-                1000,
-                OutputType::Sparse,
-            );
-            let stats = solver.integrate().map_err(failed)?;
-            let end = *solver.y_out().last().ok_or("no output")?;
-            (end, stats.accepted_steps)
-        }};
-    }
     let (y_out, steps) = match peer {
-        Peer::Dop853 => explicit!(Dop853, 0.0, 0.333, 6.0),
-        Peer::Dopri5 => explicit!(Dopri5, 0.04, 0.2, 10.0),
         Peer::Bdf => return bdf(ode, horizon, tolerance, monitor),
+        peer => adaptive!(peer, system, y0, horizon, tolerance)?,
     };
-    Ok((array(&y_out), steps as u64))
+    Ok((array(&y_out), steps))
 }
 
 /// The end state of Dop853 on `system` from `y0` over `[0, t_end]` at relative and absolute
@@ -180,30 +204,7 @@ pub fn dop853_end<S: System<f64, ode_solvers::SVector<f64, Y>>, const Y: usize>(
     t_end: f64,
     tolerance: f64,
 ) -> Result<ode_solvers::SVector<f64, Y>, String> {
-    let mut solver = Dop853::from_param(
-        system,
-        0.0,
-        t_end,
-        0.0,
-        y0,
-        tolerance,
-        tolerance,
-        0.9,
-        0.0,
-        0.333,
-        6.0,
-        t_end,
-        0.0,
-        MAX_STEPS,
-        1000,
-        OutputType::Sparse,
-    );
-    solver.integrate().map_err(|e| format!("Dop853: {e}"))?;
-    solver
-        .y_out()
-        .last()
-        .copied()
-        .ok_or_else(|| "no output".into())
+    adaptive!(Peer::Dop853, system, y0, t_end, tolerance).map(|(end, _)| end)
 }
 
 /// Without the `bdf` feature: a refusal that names it.

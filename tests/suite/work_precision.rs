@@ -157,9 +157,6 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
 #[derive(Debug, Clone, Copy)]
 struct Pushed;
 
-/// The explicit runs and those by fixed-point iteration hold the inputs the start function
-/// sets, as the implicit runs do: Störmer–Verlet and the trapezoidal rule are one map, so
-/// their errors agree.
 /// A fixed-point run's steps that its iteration hands to Newton's method are counted: on the
 /// oscillator the midpoint rule's iteration contracts by `(ω h)²/4`, so at h = 2.5 it hands
 /// over every step and at h = 0.1 none (the run at the first step decides that the iteration
@@ -186,7 +183,6 @@ fn the_steps_a_fixed_point_run_hands_over_are_counted() {
     };
     for h in [0.1, 2.5] {
         let (newton, iterated) = (find("midpoint", h), find("midpoint, fixed point", h));
-        assert_eq!(newton.handed_over, 0);
         let expected = if h > 2.0 { iterated.steps } else { 0 };
         assert_eq!(iterated.handed_over, expected, "{iterated:?}");
         assert!(
@@ -196,6 +192,9 @@ fn the_steps_a_fixed_point_run_hands_over_are_counted() {
     }
 }
 
+/// The explicit runs and those by fixed-point iteration hold the inputs the start function
+/// sets, as the implicit runs do: Störmer–Verlet and the trapezoidal rule are one map, so
+/// their errors agree.
 #[test]
 fn explicit_runs_hold_the_inputs_the_start_sets() {
     let horizon = 2.0;
