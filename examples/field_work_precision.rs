@@ -42,6 +42,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         lines.dx, fine.steps
     );
     let mut rows = Vec::new();
+    // A run kept as a row, or reported where it failed.
+    let mut record =
+        |method: &str, setting: String, dirac: bool, run: Result<LinesRun, String>| match run {
+            Ok(run) => rows.push(Row {
+                method: method.to_string(),
+                error: distance(&run.end, &fine.end),
+                setting,
+                dirac,
+                run,
+            }),
+            Err(why) => println!("  {method} {setting}: {why}"),
+        };
     let compositions = [
         Composition::verlet(),
         Composition::suzuki(),
@@ -53,30 +65,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // beyond: a composition's own limit differs, and a run that fails is reported.
         for dt in [1.6, 1.2, 0.8, 0.6, 0.4, 0.2, 0.1].map(|k| k * lines.dx) {
             let dt = horizon / (horizon / dt).ceil();
-            match field_run(&lines, composition, dt, &y0, horizon) {
-                Ok(run) => rows.push(Row {
-                    method: composition.name().to_string(),
-                    setting: format!("Δt = {dt:.4}"),
-                    dirac: true,
-                    error: distance(&run.end, &fine.end),
-                    run,
-                }),
-                Err(why) => println!("  {} Δt = {dt:.4}: {why}", composition.name()),
-            }
+            let run = field_run(&lines, composition, dt, &y0, horizon).map_err(|e| e.to_string());
+            record(composition.name(), format!("Δt = {dt:.4}"), true, run);
         }
     }
     for peer in [Peer::Dopri5, Peer::Dop853] {
         for tolerance in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12] {
-            match integrate(&lines, peer, &y0, horizon, tolerance) {
-                Ok(run) => rows.push(Row {
-                    method: peer.name().to_string(),
-                    setting: format!("tol = {tolerance:e}"),
-                    dirac: false,
-                    error: distance(&run.end, &fine.end),
-                    run,
-                }),
-                Err(why) => println!("  {} tol = {tolerance:e}: {why}", peer.name()),
-            }
+            let run = integrate(&lines, peer, &y0, horizon, tolerance);
+            record(peer.name(), format!("tol = {tolerance:e}"), false, run);
         }
     }
     // The reference checked apart from Dop853: the order-8 composition at its smallest step.

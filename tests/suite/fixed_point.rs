@@ -130,17 +130,24 @@ fn forces_of_position_time_and_inputs_are_iterated_with_their_work() {
     }
 }
 
-/// The pendulum's error in `(q, p)(5)` against its golden values after `n` steps of
-/// `galerkin(s)` by the iteration, and the steps it handed over.
-fn pendulum_at_5(s: usize, n: u64) -> (f64, u64) {
+/// The pendulum by `galerkin(s)` at step `h`, solved by the iteration, started from `q = 1` at
+/// rest.
+fn iterated_pendulum(s: usize, h: f64) -> Stepper<pendulum::Pendulum, 1> {
     let quadrature = Quadrature::galerkin(s).unwrap();
-    let mut stepper = Stepper::new(pendulum::SCENE, quadrature, 5.0 / n as f64)
+    let mut stepper = Stepper::new(pendulum::SCENE, quadrature, h)
         .unwrap()
         .with_fixed_point()
         .unwrap();
     stepper
         .start_from_momentum(vector![1.0], vector![0.0])
         .unwrap();
+    stepper
+}
+
+/// The pendulum's error in `(q, p)(5)` against its golden values after `n` steps of
+/// `galerkin(s)` by the iteration, and the steps it handed over.
+fn pendulum_at_5(s: usize, n: u64) -> (f64, u64) {
+    let mut stepper = iterated_pendulum(s, 5.0 / n as f64);
     stepper.run(n).unwrap();
     let error = (stepper.q()[0] - pendulum::Q5)
         .abs()
@@ -249,13 +256,7 @@ fn round_off_takes_over_below_these_steps() {
 /// tables' round-off drifts it to 2.6e-12 here.
 #[test]
 fn the_energys_round_off_stays_small() {
-    let mut stepper = Stepper::new(pendulum::SCENE, Quadrature::galerkin(6).unwrap(), 0.25)
-        .unwrap()
-        .with_fixed_point()
-        .unwrap();
-    stepper
-        .start_from_momentum(vector![1.0], vector![0.0])
-        .unwrap();
+    let mut stepper = iterated_pendulum(6, 0.25);
     let e0 = stepper.energy().unwrap();
     let mut largest: f64 = 0.0;
     for _ in 0..200_000 {
