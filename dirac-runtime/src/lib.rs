@@ -34,7 +34,8 @@ pub use base::{error, scalar};
 pub use discrete::{constraint, discrete_lagrangian};
 pub use integrate::{event, run, snapshots, stepper, time_transformation, trajectory};
 pub use model::{
-    body_frame, closed_form, hamiltonian_system, interconnection, legendre, repeated, slot, system,
+    body_frame, closed_form, hamiltonian_system, interconnection, joint, legendre, repeated, slot,
+    system,
 };
 pub use solve::{jacobian, newton};
 pub use space::{configuration_space, manifold, product, rotation, sphere};
@@ -62,6 +63,7 @@ pub use model::closed_form::{HessianZeros, LagrangianGradient, LagrangianHessian
 pub use model::density::SeparableDensity;
 pub use model::hamiltonian_system::HamiltonianSystem;
 pub use model::interconnection::{Interconnected, Interconnection, Junction, Junctions, Ports};
+pub use model::joint::{Anchor, Joint};
 pub use model::repeated::Repeated;
 pub use model::system::DiracSystem;
 pub use quadrature::{Quadrature, Rule};

@@ -22,6 +22,7 @@ pub mod knife_edge;
 pub mod ladder;
 pub mod lotka_volterra;
 pub mod lqr;
+pub mod mechanism;
 pub mod motor;
 pub mod oscillator;
 pub mod peers;

@@ -24,6 +24,7 @@ mod golden;
 mod group_derivatives;
 mod hamiltonian;
 mod interconnection;
+mod joints;
 mod invariants;
 mod layers;
 mod lie_group;

@@ -21,8 +21,12 @@ const VECTOR_GRAIN: usize = 1 << 14;
 ///     ⎡ J_1            E_1 ⎤        J_c   a block's own unknowns (filled per evaluation)
 /// J = ⎢      ⋱          ⋮  ⎥        E_c   how the couplings μ enter block c's rows
 ///     ⎢          J_K   E_K ⎥        G_c   how block c's unknowns enter the coupling rows
-///     ⎣ G_1  …   G_K    0  ⎦        (E_c and G_c constant, on the couplings touching c)
+///     ⎣ G_1  …   G_K    0  ⎦        (E_c and G_c on the couplings touching c)
 /// ```
+///
+/// The borders are set when the Jacobian is built; the residual's closure fills each `J_c` and
+/// may rewrite the borders of couplings whose coefficients change with the unknowns (a joint's
+/// rows, see [`BlockMatrix`]).
 ///
 /// `J (x, μ) = (r, s)` is solved by `z_c = J_c⁻¹ r_c`, `Y_c = J_c⁻¹ E_c`, the Schur complement
 /// `S = Σ_c G_c Y_c`, `S μ = Σ_c G_c z_c − s`, and `x_c = z_c − Y_c μ`. Each block is factorised
@@ -39,8 +43,8 @@ const VECTOR_GRAIN: usize = 1 << 14;
 ///     vec![(0, 0, 1.0)],
 ///     vec![(0, 0, -1.0)],
 /// ])?;
-/// j.matrix()[0][(0, 0)] = 2.0;
-/// j.matrix()[1][(0, 0)] = 4.0;
+/// j.matrix()[0].own[(0, 0)] = 2.0;
+/// j.matrix()[1].own[(0, 0)] = 4.0;
 /// j.factorise(1e-13).unwrap();
 /// // [[2, 0, 1], [0, 4, −1], [1, −1, 0]] (x₀, x₁, μ) = (3, 3, 0)
 /// let mut b = [3.0, 3.0, 0.0];
@@ -50,8 +54,8 @@ const VECTOR_GRAIN: usize = 1 << 14;
 /// ```
 #[derive(Debug, Clone)]
 pub struct Bordered {
-    /// The diagonal blocks `J_c`, filled by the residual's closure.
-    diagonal: Vec<DMatrix<f64>>,
+    /// The diagonal blocks `J_c` and their borders, filled by the residual's closure.
+    diagonal: Vec<BlockMatrix>,
     blocks: Vec<Block>,
     /// The number of couplings (the last unknowns and rows).
     couplings: usize,
@@ -65,6 +69,18 @@ pub struct Bordered {
     starts: Vec<usize>,
 }
 
+/// Block `c` of a [`Bordered`] Jacobian as its residual's closure fills it: `J_c` and its
+/// borders on the couplings that touch it (ascending).
+#[derive(Debug, Clone)]
+pub struct BlockMatrix {
+    /// `J_c`: the block's rows × its unknowns (zeroed before each evaluation).
+    pub own: DMatrix<f64>,
+    /// `E_c`: the block's rows × the couplings touching it (kept between evaluations).
+    pub e: DMatrix<f64>,
+    /// `G_c`: the couplings touching it × the block's unknowns (kept between evaluations).
+    pub g: DMatrix<f64>,
+}
+
 /// What a diagonal block keeps beside its matrix.
 #[derive(Debug, Clone)]
 struct Block {
@@ -72,9 +88,8 @@ struct Block {
     offset: usize,
     /// The couplings that touch the block, ascending.
     touching: Vec<usize>,
-    /// `E_c`: rows of the block × `touching`.
+    /// The borders `E_c`, `G_c` as built (restored with the block's shape).
     e: DMatrix<f64>,
-    /// `G_c`: `touching` × columns of the block.
     g: DMatrix<f64>,
     /// `J_c⁻¹ E_c` after factorising.
     y: DMatrix<f64>,
@@ -185,7 +200,7 @@ impl Bordered {
             }
         }
         Ok(Self {
-            diagonal: sizes.iter().map(|&n| DMatrix::zeros(n, n)).collect(),
+            diagonal: blocks.iter().map(Block::matrix).collect(),
             blocks,
             touched,
             starts,
@@ -228,21 +243,39 @@ impl Bordered {
     fn first_coupling(&self) -> usize {
         self.size - self.couplings
     }
+
+    /// The couplings touching block `c`, ascending: the columns of its `E_c` and rows of its
+    /// `G_c`.
+    pub fn touching(&self, c: usize) -> &[usize] {
+        &self.blocks[c].touching
+    }
+}
+
+impl Block {
+    /// A zero `J_c` with the borders as built.
+    fn matrix(&self) -> BlockMatrix {
+        let n = self.pivots.len();
+        BlockMatrix {
+            own: DMatrix::zeros(n, n),
+            e: self.e.clone(),
+            g: self.g.clone(),
+        }
+    }
 }
 
 impl Jacobian for Bordered {
-    type Matrix = Vec<DMatrix<f64>>;
+    type Matrix = Vec<BlockMatrix>;
 
     fn size(&self) -> usize {
         self.size
     }
 
-    fn matrix(&mut self) -> &mut Vec<DMatrix<f64>> {
+    fn matrix(&mut self) -> &mut Vec<BlockMatrix> {
         &mut self.diagonal
     }
 
     fn clear(&mut self) {
-        let zero = |j: &mut DMatrix<f64>| j.fill(0.0);
+        let zero = |j: &mut BlockMatrix| j.own.fill(0.0);
         if self.in_parallel() {
             let blocks = self.diagonal.par_iter_mut().with_min_len(self.grain);
             blocks.for_each(zero);
@@ -258,23 +291,23 @@ impl Jacobian for Bordered {
                 .diagonal
                 .iter()
                 .zip(&self.blocks)
-                .all(|(j, b)| j.shape() == (b.pivots.len(), b.pivots.len()))
+                .all(|(j, b)| {
+                    j.own.shape() == (b.pivots.len(), b.pivots.len())
+                        && j.e.shape() == b.e.shape()
+                        && j.g.shape() == b.g.shape()
+                })
     }
 
     fn restore(&mut self, _n: usize) {
-        self.diagonal = self
-            .blocks
-            .iter()
-            .map(|b| DMatrix::zeros(b.pivots.len(), b.pivots.len()))
-            .collect();
+        self.diagonal = self.blocks.iter().map(Block::matrix).collect();
     }
 
     fn norm(&mut self) -> f64 {
         // The largest row sum, NaN where a sum is (a NaN entry), as `row_sum_norm`.
         let most = |a: f64, b: f64| largest([a, b]);
-        let block_rows = |(j, block): (&DMatrix<f64>, &Block)| {
-            let n = j.nrows();
-            let (a, e) = (j.as_slice(), block.e.as_slice());
+        let block_rows = |(j, block): (&BlockMatrix, &Block)| {
+            let n = j.own.nrows();
+            let (a, e) = (j.own.as_slice(), j.e.as_slice());
             let rows = (0..n).map(|i| {
                 let own: f64 = (0..n).map(|k| a[i + k * n].abs()).sum();
                 own + (0..block.touching.len())
@@ -287,7 +320,7 @@ impl Jacobian for Bordered {
         let coupling_row = |j: usize| {
             let touched = &self.touched[self.starts[j]..self.starts[j + 1]];
             let entries = touched.iter().map(|&(c, a)| {
-                let g = &self.blocks[c].g;
+                let g = &self.diagonal[c].g;
                 (0..g.ncols()).map(|k| g[(a, k)].abs()).sum::<f64>()
             });
             entries.sum::<f64>()
@@ -309,7 +342,10 @@ impl Jacobian for Bordered {
     }
 
     fn is_finite(&self) -> bool {
-        let finite = |j: &DMatrix<f64>| j.iter().all(|v| v.is_finite());
+        let finite = |j: &BlockMatrix| {
+            let entries = j.own.iter().chain(j.e.iter()).chain(j.g.iter());
+            entries.copied().all(f64::is_finite)
+        };
         if self.in_parallel() {
             let blocks = self.diagonal.par_iter().with_min_len(self.grain);
             blocks.all(finite)
@@ -327,14 +363,15 @@ impl Jacobian for Bordered {
     }
 
     fn factorise(&mut self, tolerance: f64) -> Result<(), SingularPivot> {
-        let factorise = |(j, block): (&mut DMatrix<f64>, &mut Block)| {
+        let factorise = |(matrix, block): (&mut BlockMatrix, &mut Block)| {
+            let j = &mut matrix.own;
             lu::factorise(j, &mut block.pivots, &mut block.scales, tolerance).map_err(|p| {
                 SingularPivot {
                     column: block.offset + p.column,
                     involved: p.involved.iter().map(|i| block.offset + i).collect(),
                 }
             })?;
-            block.y.copy_from(&block.e);
+            block.y.copy_from(&matrix.e);
             let n = j.nrows();
             for column in block.y.as_mut_slice().chunks_exact_mut(n.max(1)) {
                 lu::solve(j, &block.pivots, column);
@@ -345,7 +382,7 @@ impl Jacobian for Bordered {
                 for b in 0..t {
                     let mut entry = 0.0;
                     for i in 0..n {
-                        entry += block.g[(a, i)] * block.y[(i, b)];
+                        entry += matrix.g[(a, i)] * block.y[(i, b)];
                     }
                     block.gy[(a, b)] = entry;
                 }
@@ -394,7 +431,7 @@ impl Jacobian for Bordered {
         };
         let nothing = |(), ()| ();
         let solve = |piece: BlockRuns<'_>, run: &mut [f64]| {
-            piece.each(run, |j, block, z| lu::solve(j, &block.pivots, z));
+            piece.each(run, |j, block, z| lu::solve(&j.own, &block.pivots, z));
         };
         in_runs(runs, own, self.grain, &solve, &nothing);
         // s − Σ G_c z_c, negated: coupling by coupling, over the blocks it touches in order.
@@ -403,7 +440,7 @@ impl Jacobian for Bordered {
             for &(c, a) in &self.touched[self.starts[j]..self.starts[j + 1]] {
                 let block = &self.blocks[c];
                 let z = &z[block.offset..block.offset + block.y.nrows()];
-                let g = block.g.row(a);
+                let g = self.diagonal[c].g.row(a);
                 *value -= g.iter().zip(z).map(|(g, z)| g * z).sum::<f64>();
             }
             *value = -*value;
@@ -433,7 +470,7 @@ impl Jacobian for Bordered {
 /// Blocks with their matrices, each owning its rows of a vector.
 #[derive(Clone, Copy)]
 struct BlockRuns<'a> {
-    diagonal: &'a [DMatrix<f64>],
+    diagonal: &'a [BlockMatrix],
     blocks: &'a [Block],
 }
 
@@ -463,13 +500,13 @@ impl Runs for BlockRuns<'_> {
 
 impl BlockRuns<'_> {
     /// `f(J_c, block, its rows of run)` for each block, `run` beginning at the first one's rows.
-    fn each(self, run: &mut [f64], f: impl Fn(&DMatrix<f64>, &Block, &mut [f64])) {
+    fn each(self, run: &mut [f64], f: impl Fn(&BlockMatrix, &Block, &mut [f64])) {
         let Some(start) = self.blocks.first().map(|b| b.offset) else {
             return;
         };
         for (j, block) in self.diagonal.iter().zip(self.blocks) {
             let at = block.offset - start;
-            f(j, block, &mut run[at..at + j.nrows()]);
+            f(j, block, &mut run[at..at + j.own.nrows()]);
         }
     }
 }
@@ -495,6 +532,7 @@ mod tests {
         let size = bordered.size();
         let mut dense = Dense::new(size);
         for (c, j) in bordered.matrix().iter_mut().enumerate() {
+            let j = &mut j.own;
             for r in 0..n {
                 for s in 0..n {
                     let v = ((3 * c + 5 * r + 7 * s) % 11) as f64 - 5.0
@@ -563,7 +601,7 @@ mod tests {
     #[test]
     fn a_block_singular_alone_names_its_column() {
         let (mut bordered, _) = chain(3, 2);
-        bordered.matrix()[1].fill(0.0);
+        bordered.matrix()[1].own.fill(0.0);
         assert_eq!(bordered.factorise(1e-13).unwrap_err().column, 2);
     }
 }

@@ -8,7 +8,7 @@ use nalgebra::DMatrix;
 use crate::base::float::row_sum_norm;
 use crate::solve::lu::{self, SingularPivot};
 
-pub use crate::solve::bordered::Bordered;
+pub use crate::solve::bordered::{BlockMatrix, Bordered};
 
 /// A Jacobian [`Newton`](crate::Newton)'s method fills, factorises in place and solves with.
 ///

@@ -64,7 +64,13 @@ pub trait Manifold<const N: usize>:
 
     /// The numbers that represent `point` (for trajectories), in the order of
     /// [`point_names`](Self::point_names).
-    fn point_components(point: &Self::Point<f64>) -> Vec<f64>;
+    fn point_components(point: &Self::Point<f64>) -> Vec<f64> {
+        Self::point_entries(point)
+    }
+
+    /// [`point_components`](Self::point_components) over any scalar (a point's numbers and
+    /// their derivatives).
+    fn point_entries<D: Scalar>(point: &Self::Point<D>) -> Vec<D>;
 
     /// The numbers that represent a tangent vector or covector, in the order of
     /// [`tangent_names`](Self::tangent_names).
@@ -130,7 +136,7 @@ impl<const N: usize> Manifold<N> for Vectors {
         covector.dot(vector)
     }
 
-    fn point_components(point: &SVector<f64, N>) -> Vec<f64> {
+    fn point_entries<D: Scalar>(point: &SVector<D, N>) -> Vec<D> {
         point.iter().copied().collect()
     }
 

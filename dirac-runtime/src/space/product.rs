@@ -324,8 +324,8 @@ impl<const N: usize, const K: usize, const A: usize, const B: usize> Manifold<N>
         sum
     }
 
-    fn point_components(point: &Configuration<f64, K, A, B>) -> Vec<f64> {
-        let mut out: Vec<f64> = point.vector.iter().copied().collect();
+    fn point_entries<D: Scalar>(point: &Configuration<D, K, A, B>) -> Vec<D> {
+        let mut out: Vec<D> = point.vector.iter().copied().collect();
         for r in &point.rotation {
             // Row by row: R_11, R_12, ..., R_33.
             out.extend(r.transpose().iter());

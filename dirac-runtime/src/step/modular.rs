@@ -62,10 +62,11 @@ use crate::base::float::{exceeds, largest};
 use crate::base::runs::{Runs, in_runs};
 use crate::discrete::discrete_lagrangian::DiscreteLagrangian;
 use crate::model::interconnection::Junction;
+use crate::model::joint::Joint;
 use crate::model::system::DiracSystem;
 use crate::quadrature::Quadrature;
 use crate::solve::banded::Banded;
-use crate::solve::bordered::Bordered;
+use crate::solve::bordered::{BlockMatrix, Bordered};
 use crate::solve::jacobian::Jacobian;
 use crate::solve::newton::{Newton, NewtonFailure, NewtonOptions, NewtonReport};
 use crate::solve::predictor::Predictor;
@@ -104,7 +105,9 @@ pub struct Modular {
     instances: HashMap<String, usize>,
     /// The names of included interconnections (their components are `name.instance`).
     nested: HashSet<String>,
-    /// The junctions' names.
+    /// The joints, their rows among `junctions`.
+    joints: Vec<JointRows>,
+    /// The junctions' and joints' names.
     junction_names: HashSet<String>,
     /// The first component with one-forms: the others' must be held at its constraint point.
     constrained: Option<usize>,
@@ -131,6 +134,8 @@ struct Component {
     offset: usize,
     /// The junction terms on it: `(junction, coordinate, coefficient)`.
     couplings: Vec<(usize, usize, f64)>,
+    /// The junctions touching it, ascending by rank (its borders' order in the Jacobian).
+    touching: Vec<usize>,
     /// The junctions' impulse on its coordinates (scratch of an evaluation).
     impulse: Vec<f64>,
     /// The size of its residual's terms at the last evaluation.
@@ -141,10 +146,32 @@ struct Component {
 #[derive(Debug, Clone)]
 struct Coupling {
     name: String,
-    /// `(component, coordinate, coefficient)`.
+    /// `(component, coordinate, coefficient)`: a joint's row's at the current state.
     terms: Vec<(usize, usize, f64)>,
     /// Where its multiplier sits among the junctions' unknowns of a step (set at a start).
     rank: usize,
+    /// `(joint, row)` where it is a joint's row.
+    joint: Option<(usize, usize)>,
+}
+
+/// A joint resolved to its components' positions.
+#[derive(Debug, Clone)]
+struct JointRows {
+    joint: Joint,
+    /// Each end's component (`None`: fixed in space).
+    ends: [Option<usize>; 2],
+    /// The indices, among its component's positions, of what each end's anchor reads.
+    at: [Vec<usize>; 2],
+    /// Its first row among the junctions (its rows follow).
+    first: usize,
+}
+
+/// A joint's rows at a point of its components: values, the size of their terms and each end's
+/// derivatives in its chart (rows × the component's coordinates).
+struct JointValue {
+    values: Vec<f64>,
+    size: f64,
+    chart: [DMatrix<f64>; 2],
 }
 
 /// A run: the solver sized for its unknowns and what the steps carry.
@@ -161,6 +188,8 @@ struct Running {
     /// step's end point, row `k`'s at `row_starts[k]..row_starts[k + 1]`.
     row_terms: Vec<(usize, f64)>,
     row_starts: Vec<usize>,
+    /// Whether the row of each multiplier is a joint's (its value not the linear row's).
+    jointed: Vec<bool>,
     /// Each component's proposed step in its chart, laid out as its unknowns (scratch).
     moved: Vec<f64>,
     violation: f64,
@@ -237,6 +266,7 @@ impl Modular {
             lookup: HashMap::new(),
             instances: HashMap::new(),
             nested: HashSet::new(),
+            joints: Vec::new(),
             junction_names: HashSet::new(),
             constrained: None,
             total: 0,
@@ -433,6 +463,7 @@ impl Modular {
             position: self.total_positions,
             offset: 0,
             couplings: Vec::new(),
+            touching: Vec::new(),
             impulse: vec![0.0; m],
             scale: 0.0,
         });
@@ -527,12 +558,24 @@ impl Modular {
             component.part.stop();
             self.components.push(component);
         }
+        let (first_junction, first_joint) = (self.junctions.len(), self.joints.len());
         for mut junction in other.junctions {
             junction.name = format!("{prefix}{}", junction.name);
             junction.rank = self.junctions.len();
             junction.terms.iter_mut().for_each(|t| t.0 += base);
-            self.junction_names.insert(junction.name.clone());
+            if let Some((joint, _)) = &mut junction.joint {
+                *joint += first_joint;
+            } else {
+                self.junction_names.insert(junction.name.clone());
+            }
             self.junctions.push(junction);
+        }
+        for mut rows in other.joints {
+            rows.joint.rename(format!("{prefix}{}", rows.joint.name()));
+            rows.ends.iter_mut().flatten().for_each(|c| *c += base);
+            rows.first += first_junction;
+            self.junction_names.insert(rows.joint.name().to_string());
+            self.joints.push(rows);
         }
         self.end_run();
         Ok(())
@@ -589,9 +632,174 @@ impl Modular {
             rank: self.junctions.len(),
             name: junction.name().to_string(),
             terms,
+            joint: None,
         });
         self.end_run();
         Ok(())
+    }
+
+    /// Adds the joint `joint`, a holonomic constraint between points its components carry (see
+    /// [`joint`](crate::joint)): its rows are junctions named `joint[k]`, held as SHAKE holds a
+    /// holonomic constraint, `g(q_{k+1}) = 0` with the impulse `G(q_k)ᵀ μ` on the row of `p_k`.
+    /// With a joint, every junction's impulse is taken on that row (a constant form gives the
+    /// same positions either way). An `Err(InvalidInterconnection)` names an anchor's unknown
+    /// instance or position (listing those there are), a joint of one component with itself, a
+    /// name taken, and the joint's own faults ([`Joint`]); at the start, the positions must
+    /// satisfy it and the velocities its differential.
+    ///
+    /// ```
+    /// use dirac_runtime::joint::{Anchor, Joint};
+    /// use dirac_runtime::modular::Modular;
+    /// use dirac_runtime::{DiracSystem, Quadrature, Scalar};
+    /// use nalgebra::SVector;
+    ///
+    /// /// A unit point mass in the plane under gravity 1.
+    /// struct Bob;
+    /// impl DiracSystem<2> for Bob {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 2>, v: &SVector<D, 2>) -> D {
+    ///         (v[0] * v[0] + v[1] * v[1]) * 0.5 - q[1]
+    ///     }
+    ///     fn coordinate_name(&self, i: usize) -> String {
+    ///         ["x", "y"][i].into()
+    ///     }
+    /// }
+    /// // A pendulum of length 1, released at rest from 0.1 rad: about the period 2π.
+    /// let mut pendulum = Modular::new(Quadrature::midpoint(), 0.001)?;
+    /// pendulum.add("bob", Bob)?;
+    /// let origin = Anchor::fixed([0.0, 0.0]);
+    /// pendulum.connect(Joint::rod("rod", origin, Anchor::point("bob", ["x", "y"]), 1.0))?;
+    /// let (s, c) = 0.1_f64.sin_cos();
+    /// pendulum.start_from_velocity(&[s, -c], &[0.0, 0.0])?;
+    /// pendulum.run(6283)?;
+    /// let q = pendulum.q();
+    /// assert!((q[0] * q[0] + q[1] * q[1] - 1.0).abs() < 1e-12);
+    /// assert!((q[0] - s).abs() < 1e-3);
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn connect(&mut self, joint: Joint) -> Result<(), DiracError> {
+        let invalid = |why: String| Err(DiracError::InvalidInterconnection(why));
+        joint.check()?;
+        let name = joint.name().to_string();
+        if self.junction_names.contains(&name) {
+            return invalid(format!("two junctions or joints are named {name:?}"));
+        }
+        let mut ends = [None, None];
+        let mut at = [Vec::new(), Vec::new()];
+        for (e, anchor) in joint.ends().iter().enumerate() {
+            let Some(instance) = anchor.instance() else {
+                continue;
+            };
+            let Some(&c) = self.instances.get(instance) else {
+                let names: Vec<&str> = self.components.iter().map(|c| c.name.as_str()).collect();
+                return invalid(format!(
+                    "joint {name}: no instance {instance:?} (the instances are {})",
+                    names.join(", ")
+                ));
+            };
+            let part = &self.components[c].part;
+            let theirs: Vec<String> = (0..part.positions()).map(|i| part.position_name(i)).collect();
+            for wanted in anchor.position_names() {
+                let Some(i) = theirs.iter().position(|p| *p == wanted) else {
+                    return invalid(format!(
+                        "joint {name}: {instance} has no position {wanted:?} (its positions are \
+                         {})",
+                        theirs.join(", ")
+                    ));
+                };
+                at[e].push(i);
+            }
+            ends[e] = Some(c);
+        }
+        if ends[0].is_some() && ends[0] == ends[1] {
+            return invalid(format!("joint {name} joins a component with itself"));
+        }
+        let first = self.junctions.len();
+        let index = self.joints.len();
+        for row in 0..joint.rows() {
+            let terms = ends
+                .iter()
+                .flatten()
+                .flat_map(|&c| (0..self.components[c].part.coordinates()).map(move |i| (c, i, 0.0)))
+                .collect();
+            self.junctions.push(Coupling {
+                name: joint.row_name(row),
+                terms,
+                rank: first + row,
+                joint: Some((index, row)),
+            });
+        }
+        self.junction_names.insert(name);
+        self.joints.push(JointRows {
+            joint,
+            ends,
+            at,
+            first,
+        });
+        self.end_run();
+        Ok(())
+    }
+
+    /// The junctions with the joints' rows read at the positions `q` (every component's, in the
+    /// order of [`position_names`](Self::position_names); the current ones where `None`): their
+    /// coefficients the rows' differentials in the charts there. `Err(InconsistentInitialState)`
+    /// where given positions violate a joint.
+    fn joined_at(&self, q: Option<&[f64]>, tolerance: f64) -> Result<Vec<Coupling>, DiracError> {
+        let mut junctions = self.junctions.clone();
+        let coordinates = self.components.iter().map(|c| c.part.coordinates());
+        let zeros = vec![0.0; coordinates.max().unwrap_or(0)];
+        let components = &self.components;
+        for rows in &self.joints {
+            let own = |c: usize| {
+                let at = components[c].position;
+                q.map(|q| &q[at..at + components[c].part.positions()])
+            };
+            let origin = |c: usize| &zeros[..components[c].part.coordinates()];
+            let value = joint_value(components, rows, own, origin);
+            if q.is_some() {
+                for (row, g) in value.values.iter().enumerate() {
+                    if exceeds(g.abs(), tolerance * value.size) {
+                        return Err(DiracError::InconsistentInitialState(format!(
+                            "the initial positions violate joint {}: g = {g:.3e}",
+                            rows.joint.row_name(row)
+                        )));
+                    }
+                }
+            }
+            for row in 0..rows.joint.rows() {
+                for term in &mut junctions[rows.first + row].terms {
+                    let e = usize::from(rows.ends[0] != Some(term.0));
+                    term.2 = value.chart[e][(row, term.1)];
+                }
+            }
+        }
+        Ok(junctions)
+    }
+
+    /// Reads the joints' rows at the current state (after a start and after every step), and
+    /// each component's terms from the junctions.
+    fn refresh_joints(&mut self) {
+        if !self.joints.is_empty() {
+            self.junctions = self.joined_at(None, 0.0).expect("no check without positions");
+            self.couple();
+        }
+    }
+
+    /// Each component's junction terms and the junctions touching it, from the junctions.
+    fn couple(&mut self) {
+        for component in &mut self.components {
+            component.couplings.clear();
+            component.touching.clear();
+        }
+        for junction in &self.junctions {
+            for &(c, i, a) in &junction.terms {
+                self.components[c].couplings.push((junction.rank, i, a));
+                self.components[c].touching.push(junction.rank);
+            }
+        }
+        for component in &mut self.components {
+            component.touching.sort_unstable();
+            component.touching.dedup();
+        }
     }
 
     /// The number of coordinates of all components.
@@ -832,8 +1040,10 @@ impl Modular {
                 .map_err(|e| in_component(&component.name, e))?;
             started.push(state);
         }
-        self.check_junctions(v, tolerance)?;
-        let hidden = Hidden::find(&self.components, &self.junctions, (q, v), tolerance)?;
+        let junctions = self.joined_at(Some(q), tolerance)?;
+        Self::check_junctions(&self.components, &junctions, v, tolerance)?;
+        let hidden = Hidden::find(&self.components, &junctions, (q, v), tolerance)?;
+        self.junctions = junctions;
         // From here a failure leaves no run (the components begin afresh).
         self.run = None;
         self.begun = true;
@@ -850,7 +1060,6 @@ impl Modular {
         for component in &mut self.components {
             component.offset = offset;
             offset += component.part.unknowns();
-            component.couplings.clear();
         }
         // The junctions' multipliers in the order of the components they join (the first, then
         // the last, then the name), whatever order they were joined in: along a chain or a
@@ -865,11 +1074,7 @@ impl Modular {
         for (rank, &j) in order.iter().enumerate() {
             self.junctions[j].rank = rank;
         }
-        for junction in &self.junctions {
-            for &(c, i, a) in &junction.terms {
-                self.components[c].couplings.push((junction.rank, i, a));
-            }
-        }
+        self.couple();
         // The step's end point is a component's first unknowns (degree 1).
         let (mut row_terms, mut row_starts) = (Vec::new(), vec![0]);
         for &j in &order {
@@ -893,6 +1098,7 @@ impl Modular {
             multipliers: vec![0.0; self.junctions.len()],
             row_terms,
             row_starts,
+            jointed: order.iter().map(|&j| self.junctions[j].joint.is_some()).collect(),
             moved: vec![0.0; unknowns - self.junctions.len()],
             violation: 0.0,
             report: None,
@@ -900,7 +1106,7 @@ impl Modular {
             initial,
         });
         let multipliers = unknowns - self.junctions.len()..unknowns;
-        let share = self.junction_point().share();
+        let share = self.junction_share();
         run.predictor.share_impulses(Some((multipliers, share)));
         // A model the step does not determine (dependent junctions, a component singular on
         // its own) is refused here, before the first step, naming the unknowns.
@@ -944,19 +1150,23 @@ impl Modular {
         self.components.len().div_ceil(tasks).max(MIN_GRAIN)
     }
 
-    /// Where the junctions' impulses are held: the constrained components' constraint point
-    /// (they agree), or the midpoint; one share `σ` for every junction, as in the monolithic
-    /// interconnection.
-    fn junction_point(&self) -> ConstraintPoint {
-        self.constrained.map_or(ConstraintPoint::Midpoint, |c| {
+    /// The share `σ` of every junction's impulse on the row of `p_k`: with joints 1 (SHAKE),
+    /// else that of the constrained components' constraint point (they agree), or the
+    /// midpoint's, as in the monolithic interconnection.
+    fn junction_share(&self) -> f64 {
+        if !self.joints.is_empty() {
+            return 1.0;
+        }
+        let point = self.constrained.map_or(ConstraintPoint::Midpoint, |c| {
             self.components[c].part.point()
-        })
+        });
+        point.share()
     }
 
     /// The block-bordered Jacobian of a step: a block per component, the junctions' rows and
     /// columns.
     fn bordered(&self) -> Result<Bordered, DiracError> {
-        let share = self.junction_point().share();
+        let share = self.junction_share();
         let sizes: Vec<usize> = self.components.iter().map(|c| c.part.unknowns()).collect();
         let borders = |component: &Component| {
             let rows = component
@@ -973,12 +1183,17 @@ impl Modular {
     }
 
     /// `a_j · v = 0` for every junction, to the start's tolerance.
-    fn check_junctions(&self, v: &[f64], tolerance: f64) -> Result<(), DiracError> {
-        for junction in &self.junctions {
+    fn check_junctions(
+        components: &[Component],
+        junctions: &[Coupling],
+        v: &[f64],
+        tolerance: f64,
+    ) -> Result<(), DiracError> {
+        for junction in junctions {
             let terms = junction
                 .terms
                 .iter()
-                .map(|&(c, i, a)| a * v[self.components[c].first + i]);
+                .map(|&(c, i, a)| a * v[components[c].first + i]);
             let (rate, size) = sum_and_size(terms);
             if exceeds(rate.abs(), tolerance * size) {
                 return Err(DiracError::InconsistentInitialState(format!(
@@ -1017,12 +1232,13 @@ impl Modular {
             Some(p) => multipliers.copy_from_slice(&p.as_slice()[first..]),
             None => multipliers.fill(0.0),
         }
-        let share = self.junction_point().share();
+        let share = self.junction_share();
         let components = &mut self.components;
+        let (joints, junctions) = (&self.joints, &self.junctions);
         let (row_terms, row_starts) = (&run.row_terms, &run.row_starts);
         let evaluate = |x: &DVector<f64>,
                         r: &mut DVector<f64>,
-                        blocks: Option<&mut Vec<DMatrix<f64>>>| {
+                        mut blocks: Option<&mut Vec<BlockMatrix>>| {
             let x = x.as_slice();
             let mu = &x[first..];
             let (own, rows) = r.as_mut_slice().split_at_mut(first);
@@ -1043,7 +1259,7 @@ impl Modular {
             };
             let parts = Parts {
                 components: &mut components[..],
-                blocks: blocks.map(|b| &mut b[..]),
+                blocks: blocks.as_deref_mut().map(|b| &mut b[..]),
             };
             let scale = in_runs(parts, own, grain, &assemble, &f64::max);
             // The junctions' rows, in the order of their multipliers.
@@ -1062,7 +1278,33 @@ impl Modular {
                     .map(junction)
                     .fold(0.0, f64::max)
             };
-            scale.max(size)
+            // The joints' rows in place of those their coefficients at `q_k` give, and their
+            // borders: `G` at the step's end, `E = σ G(q_k)ᵀ`.
+            let components = &components[..];
+            let step = |c: usize| {
+                let at = components[c].offset;
+                &x[at..at + components[c].part.coordinates()]
+            };
+            let mut joined: f64 = 0.0;
+            for joint in joints {
+                let value = joint_value(components, joint, |_| None, step);
+                for (row, &g) in value.values.iter().enumerate() {
+                    let coupling = &junctions[joint.first + row];
+                    rows[coupling.rank] = g;
+                    let Some(blocks) = blocks.as_deref_mut() else {
+                        continue;
+                    };
+                    for &(c, i, a) in &coupling.terms {
+                        let touching = &components[c].touching;
+                        let t = touching.binary_search(&coupling.rank).expect("it touches c");
+                        let e = usize::from(joint.ends[0] != Some(c));
+                        blocks[c].g[(t, i)] = value.chart[e][(row, i)];
+                        blocks[c].e[(i, t)] = share * a;
+                    }
+                }
+                joined = joined.max(value.size);
+            }
+            scale.max(size).max(joined)
         };
         let report = run.newton.solve(&mut run.unknowns, evaluate);
         let names = |column: usize| self.unknown_name(column, first);
@@ -1133,9 +1375,11 @@ impl Modular {
         };
         in_runs(parts, &mut run.moved, grain, &steps, &|(), ()| ());
         let (moved, row_terms, row_starts) = (&run.moved, &run.row_terms, &run.row_starts);
+        let jointed = &run.jointed;
         let junction = |k: usize| {
             let terms = &row_terms[row_starts[k]..row_starts[k + 1]];
-            terms.iter().map(|&(u, a)| a * moved[u]).sum::<f64>().abs()
+            let value = terms.iter().map(|&(u, a)| a * moved[u]).sum::<f64>().abs();
+            if jointed[k] { 0.0 } else { value }
         };
         let junctions = self.junctions.len();
         let violations = if grain < junctions {
@@ -1144,13 +1388,26 @@ impl Modular {
         } else {
             largest((0..junctions).map(junction))
         };
-        Ok((report, largest([violation, violations])))
+        // The joints' `|g(q_{k+1})|`.
+        let components = &self.components;
+        let step = |c: usize| {
+            let at = components[c].offset;
+            &moved[at..at + components[c].part.coordinates()]
+        };
+        let joints = self.joints.iter().flat_map(|joint| {
+            joint_value(components, joint, |_| None, step)
+                .values
+                .into_iter()
+                .map(f64::abs)
+        });
+        Ok((report, largest([violation, violations, largest(joints)])))
     }
 
     /// The name of unknown `column` of a step (`first`: the junctions' first).
     fn unknown_name(&self, column: usize, first: usize) -> String {
         if let Some(junction) = self.junctions.iter().find(|j| first + j.rank == column) {
-            return format!("the multiplier of junction {}", junction.name);
+            let kind = if junction.joint.is_some() { "joint" } else { "junction" };
+            return format!("the multiplier of {kind} {}", junction.name);
         }
         let component = self
             .components
@@ -1218,6 +1475,7 @@ impl Modular {
         run.violation = violation;
         run.report = Some(report);
         self.run = Some(run);
+        self.refresh_joints();
         Ok(())
     }
 
@@ -1423,6 +1681,13 @@ impl Modular {
     /// [`PortWork`]); `NotStarted` before a start and zeros before the first step.
     pub fn ports(&self) -> Result<PortWork, DiracError> {
         let run = self.running()?;
+        if !self.joints.is_empty() {
+            return Err(DiracError::Unsupported(
+                "the port work of an interconnection with joints (their rows' coefficients \
+                 change over a step; the ledger gives each component's balance)"
+                    .into(),
+            ));
+        }
         let efforts: Vec<f64> = run.multipliers.iter().map(|mu| mu / self.h).collect();
         let mut work = vec![0.0; self.components.len()];
         let mut scale: f64 = 0.0;
@@ -1438,6 +1703,46 @@ impl Modular {
             work,
             scale,
         })
+    }
+}
+
+/// A joint's rows at the point each end's chart reaches with `xi(c)` from the positions `q(c)`
+/// (the current ones where `None`).
+fn joint_value<'q>(
+    components: &[Component],
+    rows: &JointRows,
+    q: impl Fn(usize) -> Option<&'q [f64]>,
+    xi: impl Fn(usize) -> &'q [f64],
+) -> JointValue {
+    let k = rows.joint.rows();
+    let mut positions: [Vec<f64>; 2] = Default::default();
+    let mut derivatives: [DMatrix<f64>; 2] = Default::default();
+    for (e, end) in rows.ends.iter().enumerate() {
+        if let Some(c) = *end {
+            let part = &components[c].part;
+            positions[e] = vec![0.0; part.positions()];
+            derivatives[e] = DMatrix::zeros(part.positions(), part.coordinates());
+            part.chart_positions(q(c), xi(c), &mut positions[e], &mut derivatives[e]);
+        }
+    }
+    let (mut values, mut terms) = (vec![0.0; k], Vec::new());
+    let size = rows.joint.evaluate(
+        (&positions[0], &positions[1]),
+        &rows.at,
+        &mut values,
+        &mut terms,
+    );
+    let mut chart = derivatives.each_ref().map(|d| DMatrix::zeros(k, d.ncols()));
+    for (row, end, position, a) in terms {
+        let d = &derivatives[end];
+        for i in 0..d.ncols() {
+            chart[end][(row, i)] += a * d[(position, i)];
+        }
+    }
+    JointValue {
+        values,
+        size,
+        chart,
     }
 }
 
@@ -1478,7 +1783,7 @@ fn in_component(name: &str, error: DiracError) -> DiracError {
 /// run of a step's vectors.
 struct Parts<'a> {
     components: &'a mut [Component],
-    blocks: Option<&'a mut [DMatrix<f64>]>,
+    blocks: Option<&'a mut [BlockMatrix]>,
 }
 
 impl Runs for Parts<'_> {
@@ -1527,7 +1832,7 @@ impl Parts<'_> {
             let at = component.offset - start;
             let own = &mut run[at..at + component.part.unknowns()];
             let block = blocks.as_mut().and_then(|b| b.next());
-            f(component, block, own);
+            f(component, block.map(|b| &mut b.own), own);
         }
     }
 }

@@ -10,6 +10,7 @@
 //! axes. Its positions are the numbers of its point (a rotation's nine entries, row by row).
 
 use nalgebra::{DMatrix, DVector, SVector};
+use num_dual::Dual64;
 
 use crate::base::constraint_point::ConstraintPoint;
 use crate::base::error::DiracError;
@@ -105,6 +106,16 @@ pub(super) trait Part: Send + std::fmt::Debug {
     fn work(&self) -> Option<(f64, Option<f64>)>;
     /// Its positions (its point's numbers; the origin before a start).
     fn q(&self) -> Vec<f64>;
+    /// The position numbers of the point its chart at `q` (at its current position where
+    /// `None`) reaches with `xi` into `positions`, and their derivatives in `xi` (positions ×
+    /// coordinates) into `jacobian`: what a joint reads of it.
+    fn chart_positions(
+        &self,
+        q: Option<&[f64]>,
+        xi: &[f64],
+        positions: &mut [f64],
+        jacobian: &mut DMatrix<f64>,
+    );
     /// Its momenta, read in the chart.
     fn p(&self) -> Vec<f64>;
     /// The number of its own constraints (one-forms and holonomic).
@@ -668,6 +679,30 @@ impl<E: ComponentEquations<N> + 'static, const N: usize> Part for Model<E, N> {
         let origin = <E::Manifold as Manifold<N>>::origin();
         let q = self.state.as_ref().map_or(&origin, |s| &s.q);
         <E::Manifold as Manifold<N>>::point_components(q)
+    }
+
+    fn chart_positions(
+        &self,
+        q: Option<&[f64]>,
+        xi: &[f64],
+        positions: &mut [f64],
+        jacobian: &mut DMatrix<f64>,
+    ) {
+        let given = q.map(|q| {
+            <E::Manifold as Manifold<N>>::point_from_components(q)
+                .expect("a component's own position numbers")
+        });
+        let point = given.as_ref().unwrap_or_else(|| &self.state().q);
+        for i in 0..N {
+            let seeded: SVector<Dual64, N> =
+                SVector::from_fn(|k, _| Dual64::new(xi[k], if k == i { 1.0 } else { 0.0 }));
+            let moved = self.space().retract(point, &seeded);
+            let entries = <E::Manifold as Manifold<N>>::point_entries(&moved);
+            for (r, entry) in entries.iter().enumerate() {
+                positions[r] = entry.re;
+                jacobian[(r, i)] = entry.eps;
+            }
+        }
     }
 
     fn p(&self) -> Vec<f64> {

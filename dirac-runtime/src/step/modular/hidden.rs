@@ -435,6 +435,7 @@ impl Hidden {
                 name: format!("the hidden constraint {k} across {}", self.names),
                 terms,
                 rank: ranked + k,
+                joint: None,
             })
             .collect())
     }

@@ -1,0 +1,537 @@
+//! Joints: holonomic junctions between points carried by components, the links of a mechanism
+//! in maximal coordinates.
+//!
+//! A [`Junction`](crate::Junction) is a constant one-form. A joint is a constraint on the
+//! positions of the components it joins, `g(q^A, q^B) = 0`, with rows that are not linear in
+//! them: two points held together (a ball joint in space, a pin in the plane), two points held
+//! at a distance (a massless rod), an axis of one body held along an axis of the other (a
+//! hinge). Each end is an [`Anchor`]: a point fixed in space, a point whose coordinates are a
+//! component's own (a point mass), or a point fixed in a body: `x + R a` for a body at `x`
+//! turned by the rotation `R`, `(x, y) + Rot(θ) a` in the plane.
+//!
+//! The modular step ([`Modular::connect`](crate::modular::Modular::connect)) holds a joint as
+//! SHAKE holds a holonomic constraint: its impulse `G(q_k)ᵀ μ` on the row of `p_k`, with
+//! `G = ∂g/∂q` read in each component's chart, and `g(q_{k+1}) = 0` at the step's end.
+//!
+//! ```
+//! use dirac_runtime::joint::{Anchor, Joint};
+//! // A rod of length 1 from the origin to a point mass at (x, y).
+//! let rod = Joint::rod("rod", Anchor::fixed([0.0, 0.0]), Anchor::point("bob", ["x", "y"]), 1.0);
+//! assert_eq!(rod.rows(), 1);
+//! // A hinge about the body's x axis at the origin.
+//! let hinge = Joint::revolute(
+//!     "hinge",
+//!     Anchor::fixed([0.0, 0.0, 0.0]),
+//!     Anchor::body("link", ["x", "y", "z"], "R", [0.0, 0.0, 0.5]),
+//!     [1.0, 0.0, 0.0],
+//!     [1.0, 0.0, 0.0],
+//! );
+//! assert_eq!(hinge.rows(), 5);
+//! ```
+
+use crate::base::error::DiracError;
+
+/// One end of a [`Joint`]: where it sits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Anchor {
+    pub(crate) place: Place,
+}
+
+/// The kinds of anchor.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Place {
+    /// A point fixed in space (2 or 3 numbers).
+    Fixed(Vec<f64>),
+    /// The point whose coordinates are the instance's positions `origin`.
+    Point {
+        instance: String,
+        origin: Vec<String>,
+    },
+    /// `x + R a`: the body's origin, the rotation's name and `a` in the body's axes.
+    Body {
+        instance: String,
+        origin: [String; 3],
+        rotation: String,
+        offset: [f64; 3],
+    },
+    /// `(x, y) + Rot(θ) a` in the plane.
+    Planar {
+        instance: String,
+        origin: [String; 2],
+        angle: String,
+        offset: [f64; 2],
+    },
+}
+
+impl Anchor {
+    /// A point fixed in space (in the plane with two numbers).
+    pub fn fixed<const D: usize>(point: [f64; D]) -> Self {
+        Self {
+            place: Place::Fixed(point.to_vec()),
+        }
+    }
+
+    /// The point whose coordinates are the positions `origin` of the instance (a point mass).
+    pub fn point<const D: usize>(instance: &str, origin: [&str; D]) -> Self {
+        Self {
+            place: Place::Point {
+                instance: instance.into(),
+                origin: origin.map(String::from).to_vec(),
+            },
+        }
+    }
+
+    /// The point `x + R a` of a rigid body: `x` the positions `origin`, `R` the rotation named
+    /// `rotation` (its entries `rotation_11` … `rotation_33`), `a` the point in the body's axes.
+    pub fn body(instance: &str, origin: [&str; 3], rotation: &str, offset: [f64; 3]) -> Self {
+        Self {
+            place: Place::Body {
+                instance: instance.into(),
+                origin: origin.map(String::from),
+                rotation: rotation.into(),
+                offset,
+            },
+        }
+    }
+
+    /// The point `(x, y) + Rot(θ) a` of a body in the plane: `(x, y)` the positions `origin`,
+    /// `θ` the coordinate `angle`, `a` the point in the body's axes.
+    pub fn planar(instance: &str, origin: [&str; 2], angle: &str, offset: [f64; 2]) -> Self {
+        Self {
+            place: Place::Planar {
+                instance: instance.into(),
+                origin: origin.map(String::from),
+                angle: angle.into(),
+                offset,
+            },
+        }
+    }
+
+    /// The instance the anchor is on (`None`: fixed in space).
+    pub fn instance(&self) -> Option<&str> {
+        match &self.place {
+            Place::Fixed(_) => None,
+            Place::Point { instance, .. }
+            | Place::Body { instance, .. }
+            | Place::Planar { instance, .. } => Some(instance),
+        }
+    }
+
+    /// The dimension of the space the point lies in.
+    pub(crate) fn dimension(&self) -> usize {
+        match &self.place {
+            Place::Fixed(p) => p.len(),
+            Place::Point { origin, .. } => origin.len(),
+            Place::Body { .. } => 3,
+            Place::Planar { .. } => 2,
+        }
+    }
+
+    /// The names of the positions the anchor reads, in the order [`Anchor::evaluate`] takes
+    /// their indices: the origin, then the rotation's nine entries (row by row) or the angle.
+    pub(crate) fn position_names(&self) -> Vec<String> {
+        match &self.place {
+            Place::Fixed(_) => Vec::new(),
+            Place::Point { origin, .. } => origin.clone(),
+            Place::Body {
+                origin, rotation, ..
+            } => {
+                let entries = (1..=3).flat_map(|i| (1..=3).map(move |j| (i, j)));
+                let mut names = origin.to_vec();
+                names.extend(entries.map(|(i, j)| format!("{rotation}_{i}{j}")));
+                names
+            }
+            Place::Planar { origin, angle, .. } => {
+                let mut names = origin.to_vec();
+                names.push(angle.clone());
+                names
+            }
+        }
+    }
+
+    /// Whether the anchor turns with a frame an axis can be fixed in (a body in space, or
+    /// space itself).
+    fn has_axes(&self) -> bool {
+        match &self.place {
+            Place::Fixed(p) => p.len() == 3,
+            Place::Body { .. } => true,
+            Place::Point { .. } | Place::Planar { .. } => false,
+        }
+    }
+
+    /// The point at the positions `q` of its component (`at`: the indices of
+    /// [`position_names`](Self::position_names) in `q`), with its derivatives.
+    pub(crate) fn evaluate(&self, q: &[f64], at: &[usize]) -> Carried {
+        let mut point = Carried::default();
+        match &self.place {
+            Place::Fixed(p) => point.value[..p.len()].copy_from_slice(p),
+            Place::Point { origin, .. } => {
+                for i in 0..origin.len() {
+                    point.value[i] = q[at[i]];
+                    point.terms[i].push((at[i], 1.0));
+                }
+            }
+            Place::Body { offset, .. } => {
+                for i in 0..3 {
+                    point.value[i] = q[at[i]];
+                    point.terms[i].push((at[i], 1.0));
+                    for l in 0..3 {
+                        let entry = at[3 + 3 * i + l];
+                        point.value[i] += q[entry] * offset[l];
+                        point.terms[i].push((entry, offset[l]));
+                    }
+                }
+            }
+            Place::Planar { offset, .. } => {
+                let (s, c) = q[at[2]].sin_cos();
+                let [a, b] = *offset;
+                point.value[0] = q[at[0]] + c * a - s * b;
+                point.value[1] = q[at[1]] + s * a + c * b;
+                point.terms[0].extend([(at[0], 1.0), (at[2], -s * a - c * b)]);
+                point.terms[1].extend([(at[1], 1.0), (at[2], c * a - s * b)]);
+            }
+        }
+        point
+    }
+
+    /// The axis `axis` (in the anchor's frame) at the positions `q`, with its derivatives.
+    fn axis(&self, q: &[f64], at: &[usize], axis: &[f64; 3]) -> Carried {
+        let mut turned = Carried::default();
+        match &self.place {
+            Place::Body { .. } => {
+                for i in 0..3 {
+                    for l in 0..3 {
+                        let entry = at[3 + 3 * i + l];
+                        turned.value[i] += q[entry] * axis[l];
+                        turned.terms[i].push((entry, axis[l]));
+                    }
+                }
+            }
+            _ => turned.value = *axis,
+        }
+        turned
+    }
+}
+
+/// A vector of up to 3 numbers and its derivatives in its component's positions:
+/// `terms[i]` lists `(position, ∂value_i/∂position)`.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Carried {
+    pub value: [f64; 3],
+    pub terms: [Vec<(usize, f64)>; 3],
+}
+
+/// What a joint holds.
+#[derive(Debug, Clone, PartialEq)]
+enum Kind {
+    /// The two points coincide.
+    Spherical,
+    /// The two points lie at this distance.
+    Rod(f64),
+    /// The points coincide and the axes (each in its end's frame) stay parallel.
+    Revolute([f64; 3], [f64; 3]),
+}
+
+/// A holonomic junction between two [`Anchor`]s (see the [module](self)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    name: String,
+    kind: Kind,
+    ends: [Anchor; 2],
+}
+
+impl Joint {
+    /// Holds the two points together: a ball joint in space, a pin (a revolute joint) in the
+    /// plane; as many rows as the points have coordinates.
+    pub fn spherical(name: &str, a: Anchor, b: Anchor) -> Self {
+        Self::new(name, Kind::Spherical, a, b)
+    }
+
+    /// Holds the two points at the distance `length` (a massless rod between them); one row,
+    /// `(|r_a − r_b|² − length²) / (2 length)`.
+    pub fn rod(name: &str, a: Anchor, b: Anchor, length: f64) -> Self {
+        Self::new(name, Kind::Rod(length), a, b)
+    }
+
+    /// A hinge in space: the points coincide and the axis `axis_a` of `a`'s frame stays along
+    /// the axis `axis_b` of `b`'s (each end a body, or fixed in space): five rows, the last two
+    /// `u_a · w_1 = u_a · w_2 = 0` with `w_1, w_2` perpendicular to `axis_b` in `b`'s frame.
+    pub fn revolute(name: &str, a: Anchor, b: Anchor, axis_a: [f64; 3], axis_b: [f64; 3]) -> Self {
+        Self::new(name, Kind::Revolute(axis_a, axis_b), a, b)
+    }
+
+    fn new(name: &str, kind: Kind, a: Anchor, b: Anchor) -> Self {
+        Self {
+            name: name.into(),
+            kind,
+            ends: [a, b],
+        }
+    }
+
+    /// The joint's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Gives it the name `name` (a joint of an included interconnection).
+    pub(crate) fn rename(&mut self, name: String) {
+        self.name = name;
+    }
+
+    /// Its two ends.
+    pub fn ends(&self) -> &[Anchor; 2] {
+        &self.ends
+    }
+
+    /// The number of its rows (of multipliers).
+    pub fn rows(&self) -> usize {
+        match self.kind {
+            Kind::Spherical => self.ends[0].dimension(),
+            Kind::Rod(_) => 1,
+            Kind::Revolute(..) => 5,
+        }
+    }
+
+    /// The name of row `k`.
+    pub fn row_name(&self, k: usize) -> String {
+        format!("{}[{k}]", self.name)
+    }
+
+    /// `Err(InvalidInterconnection)` where the joint cannot be held: both ends fixed, ends in
+    /// spaces of different dimensions or of a dimension other than 2 and 3, a length that is
+    /// not positive and finite, an axis that is not finite and non-zero, or a hinge on an end
+    /// without axes (a point mass, a body in the plane: there a pin is `spherical`).
+    pub(crate) fn check(&self) -> Result<(), DiracError> {
+        let invalid = |why: String| {
+            Err(DiracError::InvalidInterconnection(format!(
+                "joint {}: {why}",
+                self.name
+            )))
+        };
+        let [a, b] = &self.ends;
+        if a.instance().is_none() && b.instance().is_none() {
+            return invalid("both ends are fixed in space".into());
+        }
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        for end in &self.ends {
+            let bad = match &end.place {
+                Place::Fixed(p) => !finite(p),
+                Place::Body { offset, .. } => !finite(offset),
+                Place::Planar { offset, .. } => !finite(offset),
+                Place::Point { .. } => false,
+            };
+            if bad {
+                return invalid("a point that is not finite".into());
+            }
+        }
+        let (da, db) = (a.dimension(), b.dimension());
+        if da != db || !(2..=3).contains(&da) {
+            return invalid(format!(
+                "its ends lie in spaces of dimension {da} and {db}: both must be 2 or both 3"
+            ));
+        }
+        match &self.kind {
+            Kind::Rod(length) if !(length.is_finite() && *length > 0.0) => {
+                invalid(format!("the length {length} is not positive and finite"))
+            }
+            Kind::Revolute(u, w) => {
+                if !(a.has_axes() && b.has_axes()) {
+                    return invalid(
+                        "a hinge needs both ends turning with a frame in space (a body, or \
+                         fixed); in the plane a pin is a spherical joint"
+                            .into(),
+                    );
+                }
+                let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+                if !(norm(u).is_finite() && norm(u) > 0.0 && norm(w).is_finite() && norm(w) > 0.0)
+                {
+                    return invalid("an axis that is zero or not finite".into());
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Its rows at the positions `qa`, `qb` of its ends' components (`at`: the indices of each
+    /// anchor's [`position_names`](Anchor::position_names)): the values into `value`, the
+    /// derivatives as `(row, end, position, ∂)` into `terms` (cleared first); the size of the
+    /// terms the rows sum.
+    pub(crate) fn evaluate(
+        &self,
+        (qa, qb): (&[f64], &[f64]),
+        at: &[Vec<usize>; 2],
+        value: &mut [f64],
+        terms: &mut Vec<(usize, usize, usize, f64)>,
+    ) -> f64 {
+        terms.clear();
+        let ra = self.ends[0].evaluate(qa, &at[0]);
+        let rb = self.ends[1].evaluate(qb, &at[1]);
+        let d = self.ends[0].dimension();
+        let mut size: f64 = 0.0;
+        // Row `row` += s · (vector i of `carried` at end `end`)'s derivatives.
+        let add = |terms: &mut Vec<_>, row: usize, end: usize, carried: &Carried, i: usize, s| {
+            terms.extend(carried.terms[i].iter().map(|&(p, a)| (row, end, p, s * a)));
+        };
+        match &self.kind {
+            Kind::Spherical | Kind::Revolute(..) => {
+                for i in 0..d {
+                    value[i] = ra.value[i] - rb.value[i];
+                    size = size.max(ra.value[i].abs()).max(rb.value[i].abs());
+                    add(terms, i, 0, &ra, i, 1.0);
+                    add(terms, i, 1, &rb, i, -1.0);
+                }
+            }
+            Kind::Rod(length) => {
+                let r: Vec<f64> = (0..d).map(|i| ra.value[i] - rb.value[i]).collect();
+                let squared: f64 = r.iter().map(|x| x * x).sum();
+                value[0] = (squared - length * length) / (2.0 * length);
+                size = (squared + length * length) / (2.0 * length);
+                for (i, ri) in r.iter().enumerate() {
+                    add(terms, 0, 0, &ra, i, ri / length);
+                    add(terms, 0, 1, &rb, i, -ri / length);
+                }
+            }
+        }
+        if let Kind::Revolute(axis_a, axis_b) = &self.kind {
+            let u = self.ends[0].axis(qa, &at[0], axis_a);
+            for (k, w) in perpendiculars(axis_b).iter().enumerate() {
+                let w = self.ends[1].axis(qb, &at[1], w);
+                let row = 3 + k;
+                value[row] = (0..3).map(|i| u.value[i] * w.value[i]).sum();
+                for i in 0..3 {
+                    add(terms, row, 0, &u, i, w.value[i]);
+                    add(terms, row, 1, &w, i, u.value[i]);
+                }
+                size = size.max(1.0);
+            }
+        }
+        size
+    }
+}
+
+/// Two unit vectors perpendicular to `axis` and to each other.
+fn perpendiculars(axis: &[f64; 3]) -> [[f64; 3]; 2] {
+    let norm = axis.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let n = axis.map(|x| x / norm);
+    // The coordinate axis least along `n`, made perpendicular.
+    let k = (0..3)
+        .min_by(|&i, &j| n[i].abs().total_cmp(&n[j].abs()))
+        .unwrap_or(0);
+    let mut e = [0.0; 3];
+    e[k] = 1.0;
+    let cross = |a: &[f64; 3], b: &[f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let w1 = cross(&n, &e);
+    let norm1 = w1.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let w1 = w1.map(|x| x / norm1);
+    let w2 = cross(&n, &w1);
+    [w1, w2]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rows' derivatives against central differences in every position.
+    #[test]
+    fn the_rows_derivatives_are_their_values_differences() {
+        // A body turned about an oblique axis, a planar body, point masses.
+        let (s, c) = 0.7_f64.sin_cos();
+        let body = [0.3, -0.2, 0.9, c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0];
+        let cases = [
+            (
+                Joint::revolute(
+                    "hinge",
+                    Anchor::body("a", ["x", "y", "z"], "R", [0.1, 0.2, 0.5]),
+                    Anchor::body("b", ["x", "y", "z"], "R", [0.0, -0.3, 0.2]),
+                    [1.0, 0.0, 0.0],
+                    [0.0, 1.0, 1.0],
+                ),
+                body.to_vec(),
+                body.iter().rev().copied().collect::<Vec<f64>>(),
+            ),
+            (
+                Joint::spherical(
+                    "pin",
+                    Anchor::planar("a", ["x", "y"], "t", [0.4, -0.1]),
+                    Anchor::point("b", ["x", "y"]),
+                ),
+                vec![0.2, 0.5, 1.1],
+                vec![-0.3, 0.8],
+            ),
+            (
+                Joint::rod(
+                    "rod",
+                    Anchor::point("a", ["x", "y", "z"]),
+                    Anchor::fixed([0.1, 0.0, 0.0]),
+                    1.3,
+                ),
+                vec![0.2, 0.5, 1.1],
+                vec![],
+            ),
+        ];
+        for (joint, qa, qb) in cases {
+            joint.check().unwrap();
+            let at = [
+                (0..joint.ends[0].position_names().len()).collect(),
+                (0..joint.ends[1].position_names().len()).collect(),
+            ];
+            let rows = joint.rows();
+            let (mut value, mut terms) = (vec![0.0; rows], Vec::new());
+            joint.evaluate((&qa, &qb), &at, &mut value, &mut terms);
+            for end in 0..2 {
+                let n = [qa.len(), qb.len()][end];
+                for p in 0..n {
+                    let h = 1e-6;
+                    let moved = |sign: f64| {
+                        let (mut a, mut b) = (qa.clone(), qb.clone());
+                        [&mut a, &mut b][end][p] += sign * h;
+                        let mut v = vec![0.0; rows];
+                        joint.evaluate((&a, &b), &at, &mut v, &mut Vec::new());
+                        v
+                    };
+                    let (up, down) = (moved(1.0), moved(-1.0));
+                    for row in 0..rows {
+                        let exact: f64 = terms
+                            .iter()
+                            .filter(|t| t.0 == row && t.1 == end && t.2 == p)
+                            .map(|t| t.3)
+                            .sum();
+                        let difference = (up[row] - down[row]) / (2.0 * h);
+                        assert!(
+                            (exact - difference).abs() < 1e-8,
+                            "{} row {row} end {end} position {p}: {exact} vs {difference}",
+                            joint.name
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn joints_that_cannot_be_held_are_refused() {
+        let fixed = || Anchor::fixed([0.0, 0.0, 0.0]);
+        let mass = || Anchor::point("m", ["x", "y", "z"]);
+        let planar = || Anchor::planar("p", ["x", "y"], "t", [1.0, 0.0]);
+        let refused = [
+            Joint::spherical("both fixed", fixed(), fixed()),
+            Joint::spherical("dimensions", planar(), mass()),
+            Joint::rod("length", fixed(), mass(), 0.0),
+            Joint::revolute("no axes", fixed(), mass(), [1.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+            Joint::revolute("zero axis", fixed(), fixed(), [0.0; 3], [1.0, 0.0, 0.0]),
+            Joint::spherical("not finite", Anchor::fixed([f64::NAN, 0.0, 0.0]), mass()),
+        ];
+        for joint in refused {
+            let error = joint.check().unwrap_err().to_string();
+            assert!(error.contains(&format!("joint {}", joint.name())), "{error}");
+        }
+        assert!(Joint::rod("fine", fixed(), mass(), 1.0).check().is_ok());
+    }
+}

@@ -1,0 +1,305 @@
+//! Mechanisms in maximal coordinates: point masses and rigid bodies, each a component of a
+//! modular interconnection, held together by joints.
+//!
+//! - trep's n-link chain: `n` unit point masses on massless unit rods from a pivot, in the
+//!   vertical plane (`point_chain`); the same model as `chain::Chain` in reduced coordinates
+//!   (absolute angles), and as `PointChain2`, one model with its rods as holonomic constraints.
+//! - A chain of rigid rods in space hanging from ball joints (`body_chain`).
+//! - A four-bar linkage in the plane, a closed loop of three bars pinned to each other and to
+//!   the ground (`four_bar`).
+
+use dirac::prelude::*;
+
+/// A point mass `m` in the vertical plane under gravity `g` along `−y`.
+#[dirac_system(
+    coordinates(x, y),
+    lagrangian = 0.5 * m * (dot(x).powi(2) + dot(y).powi(2)) - m * g * y,
+)]
+#[derive(Debug, Clone, Copy)]
+pub struct PlanarMass {
+    pub m: f64,
+    pub g: f64,
+}
+
+/// Two point masses on rods of length `l` from the origin, one model with its rods as
+/// holonomic constraints (the monolithic step's equations of `point_chain(2, …)`).
+#[dirac_system(
+    coordinates(x1, y1, x2, y2),
+    lagrangian = 0.5 * m * (dot(x1).powi(2) + dot(y1).powi(2) + dot(x2).powi(2) + dot(y2).powi(2))
+        - m * g * (y1 + y2),
+    holonomic(x1 * x1 + y1 * y1 - l * l, (x2 - x1).powi(2) + (y2 - y1).powi(2) - l * l),
+)]
+#[derive(Debug, Clone, Copy)]
+pub struct PointChain2 {
+    pub m: f64,
+    pub l: f64,
+    pub g: f64,
+}
+
+/// A rigid bar in the vertical plane: centre `(x, y)`, angle `theta`, mass `m`, moment of
+/// inertia `i` about its centre, gravity `g` along `−y`.
+#[dirac_system(
+    coordinates(x, y, theta),
+    lagrangian = 0.5 * m * (dot(x).powi(2) + dot(y).powi(2)) + 0.5 * i * dot(theta).powi(2)
+        - m * g * y,
+)]
+#[derive(Debug, Clone, Copy)]
+pub struct PlanarBar {
+    pub m: f64,
+    pub i: f64,
+    pub g: f64,
+}
+
+/// A rigid body in space: centre of mass `(x, y, z)`, attitude `R`, mass `m`, inertia `j` about
+/// its centre in its axes, gravity `g` along `−z`.
+#[dirac_system(
+    coordinates(x, y, z, R: SO3),
+    lagrangian = 0.5 * m * (dot(x).powi(2) + dot(y).powi(2) + dot(z).powi(2))
+        + 0.5 * dot(omega(R), j * omega(R))
+        - m * g * z,
+)]
+#[derive(Debug, Clone, Copy)]
+pub struct Body {
+    pub m: f64,
+    pub j: [[f64; 3]; 3],
+    pub g: f64,
+}
+
+/// The name of mass or body `k`.
+pub fn link(k: usize) -> String {
+    format!("link{k}")
+}
+
+/// trep's n-link chain in maximal coordinates: `n` masses `m` (`link0`, `link1`, …) on rods of
+/// length `l`, the first from a pivot at the origin, gravity `g`, stepped by the midpoint rule
+/// with step `h`.
+pub fn point_chain(n: usize, m: f64, l: f64, g: f64, h: f64) -> Result<Modular, DiracError> {
+    let mut chain = Modular::new(Quadrature::midpoint(), h)?;
+    for k in 0..n {
+        chain.add(&link(k), PlanarMass { m, g })?;
+    }
+    let mut above = Anchor::fixed([0.0, 0.0]);
+    for k in 0..n {
+        let name = link(k);
+        let here = Anchor::point(&name, ["x", "y"]);
+        chain.connect(Joint::rod(&format!("rod{k}"), above, here.clone(), l))?;
+        above = here;
+    }
+    Ok(chain)
+}
+
+/// The positions and velocities (in the order of `point_chain`'s) of the chain at absolute
+/// angles `theta` from the downward vertical with rates `omega` (`chain::Chain`'s coordinates).
+pub fn point_chain_state(theta: &[f64], omega: &[f64], l: f64) -> (Vec<f64>, Vec<f64>) {
+    let (mut q, mut v) = (Vec::new(), Vec::new());
+    let (mut x, mut y, mut vx, mut vy) = (0.0, 0.0, 0.0, 0.0);
+    for (t, w) in theta.iter().zip(omega) {
+        let (s, c) = t.sin_cos();
+        x += l * s;
+        y -= l * c;
+        vx += l * c * w;
+        vy += l * s * w;
+        q.extend([x, y]);
+        v.extend([vx, vy]);
+    }
+    (q, v)
+}
+
+/// The absolute angles from the downward vertical of the chain at positions `q`.
+pub fn point_chain_angles(q: &[f64]) -> Vec<f64> {
+    let (mut x, mut y) = (0.0, 0.0);
+    q.chunks(2)
+        .map(|p| {
+            let angle = (p[0] - x).atan2(y - p[1]);
+            (x, y) = (p[0], p[1]);
+            angle
+        })
+        .collect()
+}
+
+/// A uniform thin rod of mass `m` and length `l` along its third axis, its axial moment a tenth
+/// of the others (a rod of finite thickness).
+pub fn rod_body(m: f64, l: f64, g: f64) -> Body {
+    let across = m * l * l / 12.0;
+    Body {
+        m,
+        j: [[across, 0.0, 0.0], [0.0, across, 0.0], [0.0, 0.0, across / 10.0]],
+        g,
+    }
+}
+
+/// `n` rods (`rod_body(m, l, g)`, `link0`, …) in space, each hanging by a ball joint at its top
+/// end (`(0, 0, l/2)` in its axes) from the bottom end of the one before, the first from the
+/// origin; stepped by the midpoint rule (Cayley chart) with step `h`.
+pub fn body_chain(n: usize, m: f64, l: f64, g: f64, h: f64) -> Result<Modular, DiracError> {
+    let mut chain = Modular::new(Quadrature::midpoint(), h)?;
+    for k in 0..n {
+        chain.add_on_space(&link(k), rod_body(m, l, g), Product::cayley())?;
+    }
+    let (top, bottom) = ([0.0, 0.0, l / 2.0], [0.0, 0.0, -l / 2.0]);
+    let mut above = Anchor::fixed([0.0, 0.0, 0.0]);
+    for k in 0..n {
+        let name = link(k);
+        let end = |offset| Anchor::body(&name, ["x", "y", "z"], "R", offset);
+        chain.connect(Joint::spherical(&format!("ball{k}"), above, end(top)))?;
+        above = end(bottom);
+    }
+    Ok(chain)
+}
+
+/// The positions and velocities (in the order of `body_chain`'s) of rods of length `l` with
+/// attitudes `attitudes` turning at the body angular velocities `omegas`, hanging from the
+/// origin.
+pub fn body_chain_state(
+    attitudes: &[Matrix3<f64>],
+    omegas: &[Vector3<f64>],
+    l: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let (mut q, mut v) = (Vec::new(), Vec::new());
+    let (mut pivot, mut moving) = (Vector3::zeros(), Vector3::zeros());
+    let half = Vector3::new(0.0, 0.0, -l / 2.0);
+    for (r, w) in attitudes.iter().zip(omegas) {
+        let centre = pivot + r * half;
+        let velocity = moving + r * w.cross(&half);
+        q.extend(centre.iter());
+        q.extend(r.transpose().iter());
+        v.extend(velocity.iter());
+        v.extend(w.iter());
+        pivot += r * (half * 2.0);
+        moving += r * w.cross(&(half * 2.0));
+    }
+    (q, v)
+}
+
+/// The spatial angular momentum about the origin of a `body_chain` with positions `q` and
+/// momenta `p` (each body's `x × p_x + R π`, `π` its body angular momentum).
+pub fn body_chain_momentum(q: &[f64], p: &[f64]) -> Vector3<f64> {
+    let mut total = Vector3::zeros();
+    for (q, p) in q.chunks(12).zip(p.chunks(6)) {
+        let x = Vector3::new(q[0], q[1], q[2]);
+        let r = Matrix3::from_row_slice(&q[3..12]);
+        total += x.cross(&Vector3::new(p[0], p[1], p[2])) + r * Vector3::new(p[3], p[4], p[5]);
+    }
+    total
+}
+
+/// A four-bar linkage's bar lengths: crank, coupler, rocker, and the ground between the pivots.
+pub const FOUR_BAR: [f64; 4] = [1.0, 2.5, 2.0, 2.2];
+
+/// The four-bar linkage in the vertical plane: the crank (`crank`) pinned to the ground at the
+/// origin, the rocker (`rocker`) at `(d, 0)`, the coupler (`coupler`) pinned to both; bars of
+/// `FOUR_BAR`'s lengths, unit mass per length, their joints at their ends (`(±len/2, 0)` in
+/// their axes); gravity `g`; the midpoint rule with step `h`.
+pub fn four_bar(g: f64, h: f64) -> Result<Modular, DiracError> {
+    let [a, b, c, d] = FOUR_BAR;
+    let mut linkage = Modular::new(Quadrature::midpoint(), h)?;
+    for (name, len) in [("crank", a), ("coupler", b), ("rocker", c)] {
+        let bar = PlanarBar {
+            m: len,
+            i: len * len * len / 12.0,
+            g,
+        };
+        linkage.add(name, bar)?;
+    }
+    let end = |name: &str, len: f64, sign: f64| {
+        Anchor::planar(name, ["x", "y"], "theta", [sign * len / 2.0, 0.0])
+    };
+    let pins = [
+        ("ground_crank", Anchor::fixed([0.0, 0.0]), end("crank", a, -1.0)),
+        ("crank_coupler", end("crank", a, 1.0), end("coupler", b, -1.0)),
+        ("coupler_rocker", end("coupler", b, 1.0), end("rocker", c, 1.0)),
+        ("rocker_ground", end("rocker", c, -1.0), Anchor::fixed([d, 0.0])),
+    ];
+    for (name, first, second) in pins {
+        linkage.connect(Joint::spherical(name, first, second))?;
+    }
+    Ok(linkage)
+}
+
+/// The four-bar's positions and velocities (in `four_bar`'s order) with the crank at angle
+/// `phi` turning at `omega`: the coupler and rocker placed by closing the loop (the rocker's
+/// tip above the ground line), their rates solved from the loop's velocity equations.
+pub fn four_bar_state(phi: f64, omega: f64) -> (Vec<f64>, Vec<f64>) {
+    let [a, b, c, d] = FOUR_BAR;
+    // The crank's tip, and the rocker's tip at distance b from it and c from (d, 0).
+    let tip = Vector2::new(a * phi.cos(), a * phi.sin());
+    let pivot = Vector2::new(d, 0.0);
+    let between = pivot - tip;
+    let e = between.norm();
+    let along = (b * b - c * c + e * e) / (2.0 * e);
+    let across = (b * b - along * along).sqrt();
+    let unit = between / e;
+    let normal = Vector2::new(-unit[1], unit[0]);
+    let joint = tip + unit * along + normal * across;
+    let coupler = (joint - tip).y.atan2((joint - tip).x);
+    // The rocker points from its tip (its +end) to the ground pivot (its −end).
+    let rocker = (joint - pivot).y.atan2((joint - pivot).x);
+    // Loop closure's rates: a ω e(φ)⊥ + b β̇ e(β)⊥ = c γ̇ e(γ)⊥.
+    let perp = |t: f64| Vector2::new(-t.sin(), t.cos());
+    let m = Matrix2::from_columns(&[perp(coupler) * b, -perp(rocker) * c]);
+    let rates = m
+        .try_inverse()
+        .expect("a four-bar away from its dead points")
+        * (-perp(phi) * (a * omega));
+    let (beta, gamma) = (rates[0], rates[1]);
+    let centre = |from: Vector2<f64>, t: f64, len: f64| from + Vector2::new(t.cos(), t.sin()) * (len / 2.0);
+    let moving = |from: Vector2<f64>, t: f64, w: f64, len: f64| from + perp(t) * (w * len / 2.0);
+    let crank_velocity = perp(phi) * (a * omega);
+    let q = [
+        (centre(Vector2::zeros(), phi, a), phi),
+        (centre(tip, coupler, b), coupler),
+        (centre(pivot, rocker, c), rocker),
+    ];
+    let v = [
+        (moving(Vector2::zeros(), phi, omega, a), omega),
+        (moving(crank_velocity, coupler, beta, b), beta),
+        (moving(Vector2::zeros(), rocker, gamma, c), gamma),
+    ];
+    let flat = |s: [(Vector2<f64>, f64); 3]| s.iter().flat_map(|(p, t)| [p[0], p[1], *t]).collect();
+    (flat(q), flat(v))
+}
+
+/// The four-bar as one model on `R⁹` with its four pins as eight holonomic constraints (the
+/// monolithic step's equations of `four_bar`): bars `a`, `b`, `c` of unit mass per length,
+/// ground pivots `d` apart.
+#[dirac_system(
+    coordinates(x1, y1, t1, x2, y2, t2, x3, y3, t3),
+    lagrangian = 0.5 * a * (dot(x1).powi(2) + dot(y1).powi(2)) + a.powi(3) / 24.0 * dot(t1).powi(2)
+        + 0.5 * b * (dot(x2).powi(2) + dot(y2).powi(2)) + b.powi(3) / 24.0 * dot(t2).powi(2)
+        + 0.5 * c * (dot(x3).powi(2) + dot(y3).powi(2)) + c.powi(3) / 24.0 * dot(t3).powi(2)
+        - g * (a * y1 + b * y2 + c * y3),
+    holonomic(
+        x1 - 0.5 * a * cos(t1),
+        y1 - 0.5 * a * sin(t1),
+        x1 + 0.5 * a * cos(t1) - x2 + 0.5 * b * cos(t2),
+        y1 + 0.5 * a * sin(t1) - y2 + 0.5 * b * sin(t2),
+        x2 + 0.5 * b * cos(t2) - x3 - 0.5 * c * cos(t3),
+        y2 + 0.5 * b * sin(t2) - y3 - 0.5 * c * sin(t3),
+        x3 - 0.5 * c * cos(t3) - d,
+        y3 - 0.5 * c * sin(t3),
+    ),
+)]
+#[derive(Debug, Clone, Copy)]
+pub struct FourBarMonolithic {
+    pub a: f64,
+    pub b: f64,
+    pub c: f64,
+    pub d: f64,
+    pub g: f64,
+}
+
+/// The four-bar's energy at positions `q` and velocities `v` (`four_bar(g, …)`'s order).
+pub fn four_bar_energy(q: &[f64], v: &[f64], g: f64) -> f64 {
+    let lengths = [FOUR_BAR[0], FOUR_BAR[1], FOUR_BAR[2]];
+    lengths
+        .iter()
+        .enumerate()
+        .map(|(k, len)| {
+            let (m, i) = (*len, len * len * len / 12.0);
+            let (q, v) = (&q[3 * k..3 * k + 3], &v[3 * k..3 * k + 3]);
+            0.5 * m * (v[0] * v[0] + v[1] * v[1]) + 0.5 * i * v[2] * v[2] + m * g * q[1]
+        })
+        .sum()
+}
+
+use dirac::nalgebra::{Matrix2, Vector2};

@@ -1,0 +1,245 @@
+//! Joints: mechanisms in maximal coordinates, stepped by the modular step.
+//!
+//! A joint is held as SHAKE holds a model's own holonomic constraint, so a mechanism of joined
+//! components steps exactly the equations of one model with its joints as holonomic
+//! constraints: checked to round-off on the pendulum, trep's two-link chain and a four-bar
+//! linkage. trep's n-link chain in maximal coordinates converges at second order to the chain
+//! in reduced coordinates; a chain of rigid bodies in space keeps its vertical angular momentum
+//! to round-off (the discrete Noether theorem); the loops close at every step.
+
+use dirac::nalgebra::Rotation3;
+use dirac::prelude::*;
+use scenes::cartesian_pendulum::CartesianPendulum;
+use scenes::chain::Chain;
+use scenes::mechanism::{self, FourBarMonolithic, PlanarMass, PointChain2};
+
+/// The largest entry of `a − b`.
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+}
+
+#[test]
+fn a_rod_joint_steps_the_equations_of_the_holonomic_pendulum() {
+    let (g, h) = (1.0, 0.05);
+    let mut joined = Modular::new(Quadrature::midpoint(), h).unwrap();
+    joined.add("bob", PlanarMass { m: 1.0, g }).unwrap();
+    let rod = Joint::rod(
+        "rod",
+        Anchor::fixed([0.0, 0.0]),
+        Anchor::point("bob", ["x", "y"]),
+        1.0,
+    );
+    joined.connect(rod).unwrap();
+    let pendulum = CartesianPendulum { m: 1.0, l: 1.0, g };
+    let mut one = Stepper::new(pendulum, Quadrature::midpoint(), h).unwrap();
+    let (s, c) = 1.2_f64.sin_cos();
+    joined.start_from_velocity(&[s, -c], &[0.0, 0.0]).unwrap();
+    one.start_from_velocity(vector![s, -c], vector![0.0, 0.0])
+        .unwrap();
+    let mut worst: f64 = 0.0;
+    for _ in 0..1000 {
+        joined.step().unwrap();
+        one.step().unwrap();
+        worst = worst.max(distance(joined.q().as_slice(), one.q().as_slice()));
+        let q = joined.q();
+        assert!((q[0].hypot(q[1]) - 1.0).abs() < 1e-13);
+        assert!(joined.constraint_violation().unwrap() < 1e-13);
+    }
+    assert!(worst < 1e-13, "joined and one model differ by {worst:.2e}");
+    let v = joined.velocities().unwrap();
+    let w = one.v().unwrap();
+    assert!(distance(v.as_slice(), w.as_slice()) < 1e-11);
+}
+
+#[test]
+fn trep_s_two_link_chain_joined_steps_as_one_model_with_holonomic_rods() {
+    let (m, l, g, h) = (1.0, 1.0, 9.81, 0.01);
+    let mut joined = mechanism::point_chain(2, m, l, g, h).unwrap();
+    let mut one = Stepper::new(PointChain2 { m, l, g }, Quadrature::midpoint(), h).unwrap();
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    let (q0, v0) = mechanism::point_chain_state(&[half_pi, half_pi], &[0.0, 0.0], l);
+    joined.start_from_velocity(&q0, &v0).unwrap();
+    one.start_from_velocity(SVector::from_column_slice(&q0), SVector::zeros())
+        .unwrap();
+    let mut worst: f64 = 0.0;
+    for _ in 0..1000 {
+        joined.step().unwrap();
+        one.step().unwrap();
+        worst = worst.max(distance(joined.q().as_slice(), one.q().as_slice()));
+        assert!(joined.constraint_violation().unwrap() < 1e-12);
+    }
+    assert!(worst < 1e-12, "joined and one model differ by {worst:.2e}");
+}
+
+#[test]
+fn the_four_bar_closes_its_loop_at_every_step_as_one_model_does() {
+    let [a, b, c, d] = mechanism::FOUR_BAR;
+    let (g, h) = (9.81, 0.002);
+    let mut joined = mechanism::four_bar(g, h).unwrap();
+    let model = FourBarMonolithic { a, b, c, d, g };
+    let mut one = Stepper::new(model, Quadrature::midpoint(), h).unwrap();
+    let (q0, v0) = mechanism::four_bar_state(1.0, 2.0);
+    joined.start_from_velocity(&q0, &v0).unwrap();
+    one.start_from_velocity(
+        SVector::from_column_slice(&q0),
+        SVector::from_column_slice(&v0),
+    )
+    .unwrap();
+    let energy = |joined: &Modular| {
+        let (q, v) = (joined.q(), joined.velocities().unwrap());
+        mechanism::four_bar_energy(q.as_slice(), v.as_slice(), g)
+    };
+    let e0 = energy(&joined);
+    let (mut worst, mut drift): (f64, f64) = (0.0, 0.0);
+    for k in 0..2000 {
+        joined.step().unwrap();
+        one.step().unwrap();
+        worst = worst.max(distance(joined.q().as_slice(), one.q().as_slice()));
+        assert!(joined.constraint_violation().unwrap() < 1e-12, "step {k}");
+        if k % 100 == 99 {
+            drift = drift.max((energy(&joined) - e0).abs() / e0.abs());
+        }
+    }
+    // The crank has turned past a full revolution.
+    assert!(joined.q()[2] > 1.0 + std::f64::consts::TAU, "crank at {}", joined.q()[2]);
+    assert!(worst < 1e-11, "joined and one model differ by {worst:.2e}");
+    assert!(drift < 1e-4, "the energy's relative error reached {drift:.2e}");
+}
+
+/// The n-link chain of trep's scene, straight and level at rest, over `t` at step `h` in
+/// maximal coordinates: its absolute angles at the end.
+fn maximal_chain_angles<const L: usize>(h: f64, t: f64) -> Vec<f64> {
+    let mut chain = mechanism::point_chain(L, 1.0, 1.0, 9.81, h).unwrap();
+    let theta = [std::f64::consts::FRAC_PI_2; L];
+    let (q0, v0) = mechanism::point_chain_state(&theta, &[0.0; L], 1.0);
+    chain.start_from_velocity(&q0, &v0).unwrap();
+    let steps = (t / h).round() as u64;
+    for _ in 0..steps {
+        chain.step().unwrap();
+        let q = chain.q();
+        let angles = mechanism::point_chain_angles(q.as_slice());
+        let (back, _) = mechanism::point_chain_state(&angles, &[0.0; L], 1.0);
+        // Every rod keeps its length: the positions are those of their own angles.
+        assert!(distance(&back, q.as_slice()) < 1e-12);
+    }
+    mechanism::point_chain_angles(chain.q().as_slice())
+}
+
+#[test]
+fn trep_s_chain_in_maximal_coordinates_converges_to_the_reduced_chain_at_second_order() {
+    const L: usize = 4;
+    let t = 1.0;
+    let system = Chain::<L> {
+        m: 1.0,
+        l: 1.0,
+        g: 9.81,
+    };
+    let mut reference = Stepper::new(system, Quadrature::galerkin(3).unwrap(), 0.001).unwrap();
+    let theta = SVector::<f64, L>::repeat(std::f64::consts::FRAC_PI_2);
+    reference
+        .start_from_velocity(theta, SVector::zeros())
+        .unwrap();
+    reference.run(1000).unwrap();
+    let exact = reference.q();
+    let errors: Vec<f64> = [0.01, 0.005, 0.0025]
+        .iter()
+        .map(|&h| distance(&maximal_chain_angles::<L>(h, t), exact.as_slice()))
+        .collect();
+    for pair in errors.windows(2) {
+        let order = (pair[0] / pair[1]).log2();
+        assert!((order - 2.0).abs() < 0.15, "order {order:.3} ({errors:?})");
+    }
+    // The reduced chain's midpoint rule has an error of the same size: both are second order.
+    let mut reduced = Stepper::new(system, Quadrature::midpoint(), 0.01).unwrap();
+    reduced.start_from_velocity(theta, SVector::zeros()).unwrap();
+    reduced.run(100).unwrap();
+    let theirs = distance(reduced.q().as_slice(), exact.as_slice());
+    assert!(errors[0] < 10.0 * theirs && theirs < 10.0 * errors[0], "{errors:?} vs {theirs}");
+}
+
+#[test]
+fn a_chain_of_bodies_keeps_its_vertical_angular_momentum_to_round_off() {
+    let (n, l, g, h) = (3, 1.0, 9.81, 0.01);
+    let mut chain = mechanism::body_chain(n, 1.0, l, g, h).unwrap();
+    let tilt = |a: f64, b: f64| {
+        Rotation3::from_axis_angle(&Vector3::x_axis(), a)
+            * Rotation3::from_axis_angle(&Vector3::y_axis(), b)
+    };
+    let attitudes: Vec<Matrix3<f64>> = (0..n)
+        .map(|k| tilt(0.4 + 0.2 * k as f64, -0.3 * k as f64).into_inner())
+        .collect();
+    let omegas: Vec<Vector3<f64>> = (0..n)
+        .map(|k| Vector3::new(0.5, -0.2 * k as f64, 1.0 + k as f64))
+        .collect();
+    let (q0, v0) = mechanism::body_chain_state(&attitudes, &omegas, l);
+    chain.start_from_velocity(&q0, &v0).unwrap();
+    let momentum = |chain: &Modular| {
+        mechanism::body_chain_momentum(chain.q().as_slice(), chain.p().as_slice())
+    };
+    let j0 = momentum(&chain);
+    let energy = |chain: &Modular| chain.energies().unwrap().iter().sum::<f64>();
+    let e0 = energy(&chain);
+    let (mut worst, mut drift): (f64, f64) = (0.0, 0.0);
+    for k in 0..1000 {
+        chain.step().unwrap();
+        assert!(chain.constraint_violation().unwrap() < 1e-12, "step {k}");
+        worst = worst.max((momentum(&chain)[2] - j0[2]).abs());
+        if k % 100 == 99 {
+            drift = drift.max((energy(&chain) - e0).abs());
+        }
+    }
+    assert!(j0[2].abs() > 0.1, "a chain turning about the vertical: {j0}");
+    assert!(worst < 1e-13, "the vertical angular momentum moved by {worst:.2e}");
+    // The horizontal components are not conserved (gravity's torque).
+    assert!((momentum(&chain)[0] - j0[0]).abs() > 1e-3);
+    assert!(drift < 0.05 * e0.abs().max(1.0), "energy error {drift:.2e} of {e0}");
+}
+
+#[test]
+fn joints_that_cannot_be_made_are_refused_with_the_reason() {
+    let mut chain = mechanism::point_chain(2, 1.0, 1.0, 9.81, 0.01).unwrap();
+    let bob = |name: &str| Anchor::point(name, ["x", "y"]);
+    let error = |result: Result<(), DiracError>| result.unwrap_err().to_string();
+    let unknown = error(chain.connect(Joint::rod("r", bob("nobody"), bob("link0"), 1.0)));
+    assert!(unknown.contains("no instance \"nobody\"") && unknown.contains("link0, link1"));
+    let position = error(chain.connect(Joint::rod(
+        "r",
+        Anchor::point("link0", ["x", "z"]),
+        bob("link1"),
+        1.0,
+    )));
+    assert!(position.contains("no position \"z\"") && position.contains("x, y"));
+    let itself = error(chain.connect(Joint::rod("r", bob("link0"), bob("link0"), 1.0)));
+    assert!(itself.contains("with itself"));
+    let taken = error(chain.connect(Joint::rod("rod1", bob("link0"), bob("link1"), 1.0)));
+    assert!(taken.contains("named \"rod1\""));
+    // Positions off the rods, and velocities along them.
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    let (mut q, v) = mechanism::point_chain_state(&[half_pi, 0.0], &[1.0, 0.0], 1.0);
+    let saved = chain.q();
+    q[3] += 1e-3;
+    let off = chain.start_from_velocity(&q, &v).unwrap_err();
+    assert!(matches!(off, DiracError::InconsistentInitialState(_)), "{off}");
+    assert!(off.to_string().contains("rod1[0]"), "{off}");
+    assert_eq!(chain.q(), saved);
+    let (q, mut v) = mechanism::point_chain_state(&[half_pi, 0.0], &[1.0, 0.0], 1.0);
+    v[0] += 0.5;
+    let along = chain.start_from_velocity(&q, &v).unwrap_err();
+    assert!(along.to_string().contains("rod0[0]"), "{along}");
+    // A rod restating another's constraint: the step does not determine the impulses.
+    let (q, v) = mechanism::point_chain_state(&[half_pi, 0.0], &[1.0, 0.0], 1.0);
+    chain
+        .connect(Joint::rod("again", bob("link0"), bob("link1"), 1.0))
+        .unwrap();
+    let twice = chain.start_from_velocity(&q, &v).unwrap_err();
+    assert!(
+        matches!(&twice, DiracError::SingularJacobian { unknowns, .. }
+            if unknowns.contains("joint again[0]") && unknowns.contains("joint rod1[0]")),
+        "{twice}"
+    );
+    // The port work through joints is not reported.
+    let mut chain = mechanism::point_chain(2, 1.0, 1.0, 9.81, 0.01).unwrap();
+    chain.start_from_velocity(&q, &v).unwrap();
+    chain.step().unwrap();
+    assert!(matches!(chain.ports(), Err(DiracError::Unsupported(_))));
+}
