@@ -161,24 +161,24 @@ impl Anchor {
 
     /// The point at the positions `q` of its component (`at`: the indices of
     /// [`position_names`](Self::position_names) in `q`), with its derivatives.
-    pub(crate) fn evaluate(&self, q: &[f64], at: &[usize]) -> Carried {
-        let mut point = Carried::default();
+    pub(crate) fn evaluate(&self, q: &[f64], at: &[usize], point: &mut Carried) {
+        *point = Carried::default();
         match &self.place {
             Place::Fixed(p) => point.value[..p.len()].copy_from_slice(p),
             Place::Point { origin, .. } => {
                 for i in 0..origin.len() {
                     point.value[i] = q[at[i]];
-                    point.terms[i].push((at[i], 1.0));
+                    point.push(i, (at[i], 1.0));
                 }
             }
             Place::Body { offset, .. } => {
                 for i in 0..3 {
                     point.value[i] = q[at[i]];
-                    point.terms[i].push((at[i], 1.0));
+                    point.push(i, (at[i], 1.0));
                     for l in 0..3 {
                         let entry = at[3 + 3 * i + l];
                         point.value[i] += q[entry] * offset[l];
-                        point.terms[i].push((entry, offset[l]));
+                        point.push(i, (entry, offset[l]));
                     }
                 }
             }
@@ -187,38 +187,52 @@ impl Anchor {
                 let [a, b] = *offset;
                 point.value[0] = q[at[0]] + c * a - s * b;
                 point.value[1] = q[at[1]] + s * a + c * b;
-                point.terms[0].extend([(at[0], 1.0), (at[2], -s * a - c * b)]);
-                point.terms[1].extend([(at[1], 1.0), (at[2], c * a - s * b)]);
+                point.push(0, (at[0], 1.0));
+                point.push(0, (at[2], -s * a - c * b));
+                point.push(1, (at[1], 1.0));
+                point.push(1, (at[2], c * a - s * b));
             }
         }
-        point
     }
 
     /// The axis `axis` (in the anchor's frame) at the positions `q`, with its derivatives.
-    fn axis(&self, q: &[f64], at: &[usize], axis: &[f64; 3]) -> Carried {
-        let mut turned = Carried::default();
+    fn axis(&self, q: &[f64], at: &[usize], axis: &[f64; 3], turned: &mut Carried) {
+        *turned = Carried::default();
         match &self.place {
             Place::Body { .. } => {
                 for i in 0..3 {
                     for l in 0..3 {
                         let entry = at[3 + 3 * i + l];
                         turned.value[i] += q[entry] * axis[l];
-                        turned.terms[i].push((entry, axis[l]));
+                        turned.push(i, (entry, axis[l]));
                     }
                 }
             }
             _ => turned.value = *axis,
         }
-        turned
     }
 }
 
 /// A vector of up to 3 numbers and its derivatives in its component's positions:
-/// `terms[i]` lists `(position, ∂value_i/∂position)`.
-#[derive(Debug, Clone, Default)]
+/// `terms[i][..len[i]]` lists `(position, ∂value_i/∂position)` (at most 4: an origin's
+/// coordinate and a rotation's row).
+#[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Carried {
     pub value: [f64; 3],
-    pub terms: [Vec<(usize, f64)>; 3],
+    terms: [[(usize, f64); 4]; 3],
+    len: [usize; 3],
+}
+
+impl Carried {
+    fn push(&mut self, i: usize, term: (usize, f64)) {
+        self.terms[i][self.len[i]] = term;
+        self.len[i] += 1;
+    }
+
+    /// The derivatives of entry `i`.
+    pub fn terms(&self, i: usize) -> &[(usize, f64)] {
+        &self.terms[i][..self.len[i]]
+    }
 }
 
 /// What a joint holds.
@@ -365,13 +379,14 @@ impl Joint {
         terms: &mut Vec<(usize, usize, usize, f64)>,
     ) -> f64 {
         terms.clear();
-        let ra = self.ends[0].evaluate(qa, &at[0]);
-        let rb = self.ends[1].evaluate(qb, &at[1]);
+        let (mut ra, mut rb) = (Carried::default(), Carried::default());
+        self.ends[0].evaluate(qa, &at[0], &mut ra);
+        self.ends[1].evaluate(qb, &at[1], &mut rb);
         let d = self.ends[0].dimension();
         let mut size: f64 = 0.0;
         // Row `row` += s · (vector i of `carried` at end `end`)'s derivatives.
         let add = |terms: &mut Vec<_>, row: usize, end: usize, carried: &Carried, i: usize, s| {
-            terms.extend(carried.terms[i].iter().map(|&(p, a)| (row, end, p, s * a)));
+            terms.extend(carried.terms(i).iter().map(|&(p, a)| (row, end, p, s * a)));
         };
         match &self.kind {
             Kind::Spherical | Kind::Revolute(..) => {
@@ -383,20 +398,21 @@ impl Joint {
                 }
             }
             Kind::Rod(length) => {
-                let r: Vec<f64> = (0..d).map(|i| ra.value[i] - rb.value[i]).collect();
+                let r: [f64; 3] = std::array::from_fn(|i| ra.value[i] - rb.value[i]);
                 let squared: f64 = r.iter().map(|x| x * x).sum();
                 value[0] = (squared - length * length) / (2.0 * length);
                 size = (squared + length * length) / (2.0 * length);
-                for (i, ri) in r.iter().enumerate() {
+                for (i, ri) in r.iter().enumerate().take(d) {
                     add(terms, 0, 0, &ra, i, ri / length);
                     add(terms, 0, 1, &rb, i, -ri / length);
                 }
             }
         }
         if let Kind::Revolute(axis_a, axis_b) = &self.kind {
-            let u = self.ends[0].axis(qa, &at[0], axis_a);
-            for (k, w) in perpendiculars(axis_b).iter().enumerate() {
-                let w = self.ends[1].axis(qb, &at[1], w);
+            let (mut u, mut w) = (Carried::default(), Carried::default());
+            self.ends[0].axis(qa, &at[0], axis_a, &mut u);
+            for (k, perpendicular) in perpendiculars(axis_b).iter().enumerate() {
+                self.ends[1].axis(qb, &at[1], perpendicular, &mut w);
                 let row = 3 + k;
                 value[row] = (0..3).map(|i| u.value[i] * w.value[i]).sum();
                 for i in 0..3 {

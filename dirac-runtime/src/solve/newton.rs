@@ -280,6 +280,8 @@ pub struct Newton<J: Jacobian = Dense> {
     /// Newton's method evaluates the Jacobian at the point it accepts (for the implicit
     /// function theorem's solves that follow) instead of checking it with the residual alone.
     jacobian_at_root: bool,
+    /// The contraction ratio is measured on the first this many unknowns (all where `None`).
+    measured: Option<usize>,
     /// The iterate of [`solve_from`](Newton::solve_from) (reused: no allocation per solve).
     iterate: DVector<f64>,
 }
@@ -349,8 +351,22 @@ impl<J: Jacobian> Newton<J> {
             constant_jacobian: false,
             parked: None,
             jacobian_at_root: false,
+            measured: None,
             iterate: DVector::zeros(n),
         })
+    }
+
+    /// Judges convergence (the update at the step tolerance) and the contraction ratio of the
+    /// root-acceptance test on the first `m` unknowns only (`None`: on all): the positions of a
+    /// step whose other unknowns are multipliers that the next step does not read (SHAKE's
+    /// impulses), on another scale and known only as well as their equations' conditioning
+    /// allows (the residual is still held on every equation). A chain of `n` masses on rods, released straight and level,
+    /// moves each mass by `g h²/2` in the first update and corrects the rods' second-order
+    /// length error in the next, a shift of the whole chain that the top rod's impulse carries
+    /// `n` times: the updates' ratio over all unknowns grows as `n` (25 at `n` = 1 000) while
+    /// the positions' is 2e-4.
+    pub(crate) fn measure_contraction_on(&mut self, m: Option<usize>) {
+        self.measured = m.map(|m| m.min(self.residual.len()));
     }
 
     /// Solves `J y = b` in place with the Jacobian factorised at `root`, which must be the root
@@ -713,7 +729,7 @@ impl<J: Jacobian> Newton<J> {
         let mut evaluations = 1;
         let mut updates = 0;
         // The last full (undamped) update's size: convergence and the contraction ratio use it.
-        let mut previous: Option<f64> = None;
+        let mut previous: Option<(f64, f64)> = None;
         let mut contraction: f64 = 0.0;
         // The largest ratio of successive updates with an earlier solve's Jacobian.
         let mut kept_ratio: f64 = 0.0;
@@ -727,8 +743,14 @@ impl<J: Jacobian> Newton<J> {
             }
             let update = amax(&self.update, grain);
             let x_max = amax(x, grain);
+            // The unknowns convergence and contraction are judged on (see
+            // `measure_contraction_on`): the update's and the point's size there.
+            let (measured, x_measured) = match self.measured {
+                Some(m) => (self.update.rows(0, m).amax(), x.rows(0, m).amax()),
+                None => (update, x_max),
+            };
             // Below this an update is round-off: never asked for, never measured.
-            let noise = options.step_tolerance.max(64.0 * f64::EPSILON) * (1.0 + x_max);
+            let noise = options.step_tolerance.max(64.0 * f64::EPSILON) * (1.0 + x_measured);
             let within = at_x.residual <= at_x.tolerance;
             // The Jacobian of the iterate before the last update, or of this one.
             let current = jacobian_at.is_some_and(|at| at + 1 >= updates);
@@ -745,15 +767,15 @@ impl<J: Jacobian> Newton<J> {
             // kept Jacobian of linear equations is their Jacobian: as Newton's, its point is
             // accepted after a refining step (without it the stiff spring's energy drifts 20
             // times further).
-            let round_off = round_off(x_max);
-            let refined = previous.is_some_and(|before| before <= noise);
+            let round_off = round_off(x_measured);
+            let refined = previous.is_some_and(|(_, before)| before <= noise);
             let settled = at_x.residual == 0.0
                 || if current {
                     refined
                 } else if self.constant_jacobian {
-                    update <= round_off && refined
+                    measured <= round_off && refined
                 } else {
-                    update <= round_off && previous.is_some_and(|before| before <= round_off)
+                    measured <= round_off && previous.is_some_and(|(_, before)| before <= round_off)
                 };
             if within && settled {
                 self.kept.pending = false;
@@ -777,9 +799,12 @@ impl<J: Jacobian> Newton<J> {
             if evaluations >= options.max_iterations {
                 break;
             }
-            if let Some(before) = previous {
-                let ratio = update / before;
-                if !current && ratio > options.max_contraction && update > round_off {
+            if let Some((full, before)) = previous {
+                // The chord's rate on every unknown decides whether to keep an older Jacobian;
+                // the measured unknowns' whether the iteration contracts toward its root.
+                let chord = update / full;
+                let ratio = measured / before;
+                if !current && chord > options.max_contraction && update > self::round_off(x_max) {
                     // An older Jacobian does not contract: evaluate it here and start the
                     // measurement again.
                     at_x = self.refresh(x, evaluate)?;
@@ -788,7 +813,7 @@ impl<J: Jacobian> Newton<J> {
                     continue;
                 }
                 // The contraction of full steps, while the iteration is still converging.
-                if !within && update > noise {
+                if !within && measured > noise {
                     if ratio > options.max_contraction {
                         return Err(self.failed(NewtonFailure::NotContracting {
                             contraction: ratio,
@@ -797,8 +822,8 @@ impl<J: Jacobian> Newton<J> {
                     }
                     contraction = contraction.max(ratio);
                 }
-                if jacobian_at.is_none() && update > round_off {
-                    kept_ratio = kept_ratio.max(ratio);
+                if jacobian_at.is_none() && measured > round_off {
+                    kept_ratio = kept_ratio.max(chord);
                 }
             }
             let length = if options.line_search {
@@ -823,7 +848,7 @@ impl<J: Jacobian> Newton<J> {
                 evaluations += 1;
                 // After an update below the step tolerance the next point is the root to
                 // round-off: its correction needs no Jacobian of its own.
-                let with_jacobian = newton && (update > noise || self.jacobian_at_root);
+                let with_jacobian = newton && (measured > noise || self.jacobian_at_root);
                 match self.evaluate(x, evaluate, with_jacobian) {
                     Ok(e) => at_x = e,
                     Err(NewtonFailure::NonFinite)
@@ -846,11 +871,11 @@ impl<J: Jacobian> Newton<J> {
                 1.0
             };
             updates += 1;
-            previous = (length == 1.0).then_some(update);
+            previous = (length == 1.0).then_some((update, measured));
         }
         Err(self.failed(NewtonFailure::NoConvergence {
             residual: at_x.residual,
-            update: previous.unwrap_or(f64::INFINITY),
+            update: previous.map_or(f64::INFINITY, |(update, _)| update),
             iterations: options.max_iterations,
         }))
     }

@@ -164,13 +164,19 @@ struct JointRows {
     at: [Vec<usize>; 2],
     /// Its first row among the junctions (its rows follow).
     first: usize,
+    /// Its rows at the point last read, and the buffers they are read with.
+    read: JointRead,
 }
 
-/// A joint's rows at a point of its components: values, the size of their terms and each end's
+/// A joint's rows at a point of its components (each end's positions and their derivatives in
+/// its chart, the rows' derivatives in the positions, as scratch), their values and each end's
 /// derivatives in its chart (rows × the component's coordinates).
-struct JointValue {
+#[derive(Debug, Clone)]
+struct JointRead {
+    positions: [Vec<f64>; 2],
+    derivatives: [DMatrix<f64>; 2],
+    terms: Vec<(usize, usize, usize, f64)>,
     values: Vec<f64>,
-    size: f64,
     chart: [DMatrix<f64>; 2],
 }
 
@@ -729,57 +735,36 @@ impl Modular {
             });
         }
         self.junction_names.insert(name);
+        let k = joint.rows();
+        let sized = |f: &dyn Fn(&dyn Part) -> (usize, usize)| {
+            ends.map(|end| end.map_or((0, 0), |c| f(&*self.components[c].part)))
+        };
+        let [pa, pb] = sized(&|p| (p.positions(), p.coordinates()));
+        let read = JointRead {
+            positions: [vec![0.0; pa.0], vec![0.0; pb.0]],
+            derivatives: [DMatrix::zeros(pa.0, pa.1), DMatrix::zeros(pb.0, pb.1)],
+            terms: Vec::new(),
+            values: vec![0.0; k],
+            chart: [DMatrix::zeros(k, pa.1), DMatrix::zeros(k, pb.1)],
+        };
         self.joints.push(JointRows {
             joint,
             ends,
             at,
             first,
+            read,
         });
         self.end_run();
         Ok(())
     }
 
-    /// The junctions with the joints' rows read at the positions `q` (every component's, in the
-    /// order of [`position_names`](Self::position_names); the current ones where `None`): their
-    /// coefficients the rows' differentials in the charts there. `Err(InconsistentInitialState)`
-    /// where given positions violate a joint.
-    fn joined_at(&self, q: Option<&[f64]>, tolerance: f64) -> Result<Vec<Coupling>, DiracError> {
-        let mut junctions = self.junctions.clone();
-        let coordinates = self.components.iter().map(|c| c.part.coordinates());
-        let zeros = vec![0.0; coordinates.max().unwrap_or(0)];
-        let components = &self.components;
-        for rows in &self.joints {
-            let own = |c: usize| {
-                let at = components[c].position;
-                q.map(|q| &q[at..at + components[c].part.positions()])
-            };
-            let origin = |c: usize| &zeros[..components[c].part.coordinates()];
-            let value = joint_value(components, rows, own, origin);
-            if q.is_some() {
-                for (row, g) in value.values.iter().enumerate() {
-                    if exceeds(g.abs(), tolerance * value.size) {
-                        return Err(DiracError::InconsistentInitialState(format!(
-                            "the initial positions violate joint {}: g = {g:.3e}",
-                            rows.joint.row_name(row)
-                        )));
-                    }
-                }
-            }
-            for row in 0..rows.joint.rows() {
-                for term in &mut junctions[rows.first + row].terms {
-                    let e = usize::from(rows.ends[0] != Some(term.0));
-                    term.2 = value.chart[e][(row, term.1)];
-                }
-            }
-        }
-        Ok(junctions)
-    }
-
-    /// Reads the joints' rows at the current state (after a start and after every step), and
-    /// each component's terms from the junctions.
+    /// Reads the joints' rows at the current state (after a start and after every step) into
+    /// their junctions' coefficients, and each component's terms from the junctions.
     fn refresh_joints(&mut self) {
         if !self.joints.is_empty() {
-            self.junctions = self.joined_at(None, 0.0).expect("no check without positions");
+            let (components, joints) = (&self.components, &mut self.joints);
+            read_joints(components, joints, &mut self.junctions, None, 0.0)
+                .expect("no check without positions");
             self.couple();
         }
     }
@@ -1040,7 +1025,9 @@ impl Modular {
                 .map_err(|e| in_component(&component.name, e))?;
             started.push(state);
         }
-        let junctions = self.joined_at(Some(q), tolerance)?;
+        let mut junctions = self.junctions.clone();
+        let (components, joints) = (&self.components, &mut self.joints);
+        read_joints(components, joints, &mut junctions, Some(q), tolerance)?;
         Self::check_junctions(&self.components, &junctions, v, tolerance)?;
         let hidden = Hidden::find(&self.components, &junctions, (q, v), tolerance)?;
         self.junctions = junctions;
@@ -1090,8 +1077,12 @@ impl Modular {
             }
         };
         let unknowns = jacobian.size();
+        let mut newton = Newton::with_jacobian(jacobian, self.options)?;
+        // The contraction test on the components' unknowns, not the joints' impulses.
+        let measured = (!self.joints.is_empty()).then(|| unknowns - self.junctions.len());
+        newton.measure_contraction_on(measured);
         let mut run = Box::new(Running {
-            newton: Newton::with_jacobian(jacobian, self.options)?,
+            newton,
             unknowns: DVector::zeros(unknowns),
             predictor: Predictor::new(unknowns),
             steps: 0,
@@ -1121,6 +1112,7 @@ impl Modular {
             return Err(error);
         }
         run.newton = Newton::with_jacobian(self.bordered()?, self.options)?;
+        run.newton.measure_contraction_on(measured);
         self.run = Some(run);
         Ok(())
     }
@@ -1234,7 +1226,7 @@ impl Modular {
         }
         let share = self.junction_share();
         let components = &mut self.components;
-        let (joints, junctions) = (&self.joints, &self.junctions);
+        let (joints, junctions) = (&mut self.joints, &self.junctions);
         let (row_terms, row_starts) = (&run.row_terms, &run.row_starts);
         let evaluate = |x: &DVector<f64>,
                         r: &mut DVector<f64>,
@@ -1286,9 +1278,9 @@ impl Modular {
                 &x[at..at + components[c].part.coordinates()]
             };
             let mut joined: f64 = 0.0;
-            for joint in joints {
-                let value = joint_value(components, joint, |_| None, step);
-                for (row, &g) in value.values.iter().enumerate() {
+            for joint in joints.iter_mut() {
+                let size = joint_value(components, joint, |_| None, step);
+                for (row, &g) in joint.read.values.iter().enumerate() {
                     let coupling = &junctions[joint.first + row];
                     rows[coupling.rank] = g;
                     let Some(blocks) = blocks.as_deref_mut() else {
@@ -1298,11 +1290,11 @@ impl Modular {
                         let touching = &components[c].touching;
                         let t = touching.binary_search(&coupling.rank).expect("it touches c");
                         let e = usize::from(joint.ends[0] != Some(c));
-                        blocks[c].g[(t, i)] = value.chart[e][(row, i)];
+                        blocks[c].g[(t, i)] = joint.read.chart[e][(row, i)];
                         blocks[c].e[(i, t)] = share * a;
                     }
                 }
-                joined = joined.max(value.size);
+                joined = joined.max(size);
             }
             scale.max(size).max(joined)
         };
@@ -1394,13 +1386,12 @@ impl Modular {
             let at = components[c].offset;
             &moved[at..at + components[c].part.coordinates()]
         };
-        let joints = self.joints.iter().flat_map(|joint| {
-            joint_value(components, joint, |_| None, step)
-                .values
-                .into_iter()
-                .map(f64::abs)
-        });
-        Ok((report, largest([violation, violations, largest(joints)])))
+        let mut joints: f64 = 0.0;
+        for joint in &mut self.joints {
+            joint_value(components, joint, |_| None, step);
+            joints = largest(joint.read.values.iter().map(|g| g.abs()).chain([joints]));
+        }
+        Ok((report, largest([violation, violations, joints])))
     }
 
     /// The name of unknown `column` of a step (`first`: the junctions' first).
@@ -1707,43 +1698,74 @@ impl Modular {
 }
 
 /// A joint's rows at the point each end's chart reaches with `xi(c)` from the positions `q(c)`
-/// (the current ones where `None`).
+/// (the current ones where `None`), into its `read`; the size of their terms.
 fn joint_value<'q>(
     components: &[Component],
-    rows: &JointRows,
+    rows: &mut JointRows,
     q: impl Fn(usize) -> Option<&'q [f64]>,
     xi: impl Fn(usize) -> &'q [f64],
-) -> JointValue {
-    let k = rows.joint.rows();
-    let mut positions: [Vec<f64>; 2] = Default::default();
-    let mut derivatives: [DMatrix<f64>; 2] = Default::default();
+) -> f64 {
+    let read = &mut rows.read;
     for (e, end) in rows.ends.iter().enumerate() {
         if let Some(c) = *end {
-            let part = &components[c].part;
-            positions[e] = vec![0.0; part.positions()];
-            derivatives[e] = DMatrix::zeros(part.positions(), part.coordinates());
-            part.chart_positions(q(c), xi(c), &mut positions[e], &mut derivatives[e]);
+            let (positions, derivatives) = (&mut read.positions[e], &mut read.derivatives[e]);
+            components[c]
+                .part
+                .chart_positions(q(c), xi(c), positions, derivatives);
         }
     }
-    let (mut values, mut terms) = (vec![0.0; k], Vec::new());
-    let size = rows.joint.evaluate(
-        (&positions[0], &positions[1]),
-        &rows.at,
-        &mut values,
-        &mut terms,
-    );
-    let mut chart = derivatives.each_ref().map(|d| DMatrix::zeros(k, d.ncols()));
-    for (row, end, position, a) in terms {
-        let d = &derivatives[end];
+    let positions = (&read.positions[0][..], &read.positions[1][..]);
+    let size = rows
+        .joint
+        .evaluate(positions, &rows.at, &mut read.values, &mut read.terms);
+    read.chart.iter_mut().for_each(|c| c.fill(0.0));
+    for &(row, end, position, a) in &read.terms {
+        let d = &read.derivatives[end];
         for i in 0..d.ncols() {
-            chart[end][(row, i)] += a * d[(position, i)];
+            read.chart[end][(row, i)] += a * d[(position, i)];
         }
     }
-    JointValue {
-        values,
-        size,
-        chart,
+    size
+}
+
+/// The joints' rows read at the positions `q` (every component's, in the order of
+/// [`Modular::position_names`]; the current ones where `None`) into their junctions'
+/// coefficients: the rows' differentials in the charts there. `Err(InconsistentInitialState)`
+/// where given positions violate a joint by more than `tolerance` times its terms' size.
+fn read_joints(
+    components: &[Component],
+    joints: &mut [JointRows],
+    junctions: &mut [Coupling],
+    q: Option<&[f64]>,
+    tolerance: f64,
+) -> Result<(), DiracError> {
+    let coordinates = components.iter().map(|c| c.part.coordinates());
+    let zeros = vec![0.0; coordinates.max().unwrap_or(0)];
+    for rows in joints {
+        let own = |c: usize| {
+            let at = components[c].position;
+            q.map(|q| &q[at..at + components[c].part.positions()])
+        };
+        let origin = |c: usize| &zeros[..components[c].part.coordinates()];
+        let size = joint_value(components, rows, own, origin);
+        if q.is_some()
+            && let Some(row) = (0..rows.joint.rows())
+                .find(|&row| exceeds(rows.read.values[row].abs(), tolerance * size))
+        {
+            return Err(DiracError::InconsistentInitialState(format!(
+                "the initial positions violate joint {}: g = {:.3e}",
+                rows.joint.row_name(row),
+                rows.read.values[row]
+            )));
+        }
+        for row in 0..rows.joint.rows() {
+            for term in &mut junctions[rows.first + row].terms {
+                let e = usize::from(rows.ends[0] != Some(term.0));
+                term.2 = rows.read.chart[e][(row, term.1)];
+            }
+        }
     }
+    Ok(())
 }
 
 /// `Σ t` over `terms` and the size of what it sums, `Σ |t|` (a residual row and its scale).

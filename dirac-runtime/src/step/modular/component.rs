@@ -10,7 +10,8 @@
 //! axes. Its positions are the numbers of its point (a rotation's nine entries, row by row).
 
 use nalgebra::{DMatrix, DVector, SVector};
-use num_dual::Dual64;
+use nalgebra::{Const, U1};
+use num_dual::{Derivative, DualSVec64};
 
 use crate::base::constraint_point::ConstraintPoint;
 use crate::base::error::DiracError;
@@ -693,14 +694,16 @@ impl<E: ComponentEquations<N> + 'static, const N: usize> Part for Model<E, N> {
                 .expect("a component's own position numbers")
         });
         let point = given.as_ref().unwrap_or_else(|| &self.state().q);
-        for i in 0..N {
-            let seeded: SVector<Dual64, N> =
-                SVector::from_fn(|k, _| Dual64::new(xi[k], if k == i { 1.0 } else { 0.0 }));
-            let moved = self.space().retract(point, &seeded);
-            let entries = <E::Manifold as Manifold<N>>::point_entries(&moved);
-            for (r, entry) in entries.iter().enumerate() {
-                positions[r] = entry.re;
-                jacobian[(r, i)] = entry.eps;
+        let unit = |i: usize| SVector::<f64, N>::from_fn(|r, _| if r == i { 1.0 } else { 0.0 });
+        let seeded: SVector<DualSVec64<N>, N> =
+            SVector::from_fn(|k, _| DualSVec64::new(xi[k], Derivative::some(unit(k))));
+        let moved = self.space().retract(point, &seeded);
+        let entries = <E::Manifold as Manifold<N>>::point_entries(&moved);
+        for (r, entry) in entries.iter().enumerate() {
+            positions[r] = entry.re;
+            let row = entry.eps.unwrap_generic(Const::<N>, U1);
+            for i in 0..N {
+                jacobian[(r, i)] = row[i];
             }
         }
     }
