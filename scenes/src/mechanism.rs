@@ -183,6 +183,66 @@ pub fn body_chain_momentum(q: &[f64], p: &[f64]) -> Vector3<f64> {
     total
 }
 
+/// `body_chain`'s rods hinged instead about axes along their first body axes (the first about
+/// the space's `x` axis at the origin): a chain that moves in the `y`–`z` plane.
+pub fn hinge_chain(n: usize, m: f64, l: f64, g: f64, h: f64) -> Result<Modular, DiracError> {
+    let mut chain = Modular::new(Quadrature::midpoint(), h)?;
+    for k in 0..n {
+        chain.add_on_space(&link(k), rod_body(m, l, g), Product::cayley())?;
+    }
+    let (top, bottom, x) = ([0.0, 0.0, l / 2.0], [0.0, 0.0, -l / 2.0], [1.0, 0.0, 0.0]);
+    let mut above = Anchor::fixed([0.0, 0.0, 0.0]);
+    for k in 0..n {
+        let name = link(k);
+        let end = |offset| Anchor::body(&name, ["x", "y", "z"], "R", offset);
+        chain.connect(Joint::revolute(&format!("hinge{k}"), above, end(top), x, x))?;
+        above = end(bottom);
+    }
+    Ok(chain)
+}
+
+/// The plane's version of `hinge_chain`: bars (`PlanarBar`, mass `m`, length `l`, moment
+/// `m l²/12`) pinned end to end from the origin, `(x, y)` of the plane the `(y, z)` of space.
+pub fn bar_chain(n: usize, m: f64, l: f64, g: f64, h: f64) -> Result<Modular, DiracError> {
+    let mut chain = Modular::new(Quadrature::midpoint(), h)?;
+    let bar = PlanarBar {
+        m,
+        i: m * l * l / 12.0,
+        g,
+    };
+    for k in 0..n {
+        chain.add(&link(k), bar)?;
+    }
+    let mut above = Anchor::fixed([0.0, 0.0]);
+    for k in 0..n {
+        let name = link(k);
+        let end = |sign: f64| Anchor::planar(&name, ["x", "y"], "theta", [sign * l / 2.0, 0.0]);
+        chain.connect(Joint::spherical(&format!("pin{k}"), above, end(1.0)))?;
+        above = end(-1.0);
+    }
+    Ok(chain)
+}
+
+/// `bar_chain`'s positions and velocities with its bars turned by `alpha` about the space's
+/// `x` axis from hanging (as `hinge_chain`'s rods turned by `Rot_x(alpha)`) at rates `rates`.
+pub fn bar_chain_state(alpha: &[f64], rates: &[f64], l: f64) -> (Vec<f64>, Vec<f64>) {
+    let (mut q, mut v) = (Vec::new(), Vec::new());
+    let (mut pivot, mut moving) = (Vector2::zeros(), Vector2::zeros());
+    for (a, w) in alpha.iter().zip(rates) {
+        // From the centre to the top: Rot_x(α) e_z = (−sin α, cos α) in the plane.
+        let theta = a + std::f64::consts::FRAC_PI_2;
+        let up = Vector2::new(theta.cos(), theta.sin());
+        let turning = Vector2::new(-theta.sin(), theta.cos()) * *w;
+        let centre = pivot - up * (l / 2.0);
+        let velocity = moving - turning * (l / 2.0);
+        q.extend([centre[0], centre[1], theta]);
+        v.extend([velocity[0], velocity[1], *w]);
+        pivot -= up * l;
+        moving -= turning * l;
+    }
+    (q, v)
+}
+
 /// A four-bar linkage's bar lengths: crank, coupler, rocker, and the ground between the pivots.
 pub const FOUR_BAR: [f64; 4] = [1.0, 2.5, 2.0, 2.2];
 

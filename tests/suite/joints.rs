@@ -195,6 +195,51 @@ fn a_chain_of_bodies_keeps_its_vertical_angular_momentum_to_round_off() {
     assert!(drift < 0.05 * e0.abs().max(1.0), "energy error {drift:.2e} of {e0}");
 }
 
+/// A chain of rods hinged about parallel axes, in space and in the plane, at step `h` over
+/// 1 s: the largest distance between their centres (`y`, `z` of space against the plane's).
+fn hinged_against_pinned(h: f64) -> f64 {
+    let (n, l, g) = (3, 1.0, 9.81);
+    let alpha = [0.9, 0.4, -0.2];
+    let rates = [0.0, 1.0, -0.5];
+    let mut hinged = mechanism::hinge_chain(n, 1.0, l, g, h).unwrap();
+    let attitudes: Vec<Matrix3<f64>> = alpha
+        .iter()
+        .map(|&a| Rotation3::from_axis_angle(&Vector3::x_axis(), a).into_inner())
+        .collect();
+    let omegas: Vec<Vector3<f64>> = rates.iter().map(|&w| Vector3::new(w, 0.0, 0.0)).collect();
+    let (q0, v0) = mechanism::body_chain_state(&attitudes, &omegas, l);
+    hinged.start_from_velocity(&q0, &v0).unwrap();
+    let mut pinned = mechanism::bar_chain(n, 1.0, l, g, h).unwrap();
+    let (q0, v0) = mechanism::bar_chain_state(&alpha, &rates, l);
+    pinned.start_from_velocity(&q0, &v0).unwrap();
+    let steps = (1.0 / h).round() as u64;
+    for k in 0..steps {
+        hinged.step().unwrap();
+        pinned.step().unwrap();
+        assert!(hinged.constraint_violation().unwrap() < 1e-12, "step {k}");
+        assert!(pinned.constraint_violation().unwrap() < 1e-12, "step {k}");
+    }
+    let (q, p) = (hinged.q(), pinned.q());
+    let mut worst: f64 = 0.0;
+    for b in 0..n {
+        let (body, bar) = (&q.as_slice()[12 * b..12 * b + 12], &p.as_slice()[3 * b..3 * b + 3]);
+        // The motion stays in the plane: x = 0, and the hinge axis R e_x = e_x.
+        assert!(body[0].abs() < 1e-12, "x = {}", body[0]);
+        assert!((body[3] - 1.0).abs() < 1e-12 && body[6].abs() < 1e-12 && body[9].abs() < 1e-12);
+        worst = worst.max((body[1] - bar[0]).abs()).max((body[2] - bar[1]).abs());
+    }
+    worst
+}
+
+#[test]
+fn hinged_rods_in_space_move_as_pinned_bars_in_the_plane() {
+    // Two second-order discretisations of one motion (the Cayley chart in space, the angle in
+    // the plane): their distance falls as h².
+    let (coarse, fine) = (hinged_against_pinned(0.004), hinged_against_pinned(0.002));
+    let order = (coarse / fine).log2();
+    assert!(coarse < 2e-5 && (order - 2.0).abs() < 0.2, "{coarse:.2e}, {fine:.2e}: {order:.2}");
+}
+
 #[test]
 fn joints_that_cannot_be_made_are_refused_with_the_reason() {
     let mut chain = mechanism::point_chain(2, 1.0, 1.0, 9.81, 0.01).unwrap();
