@@ -71,12 +71,15 @@ fn main() -> Result<(), Failure> {
             evaluations as f64 / steps as f64,
         );
         if let Some((m, before)) = previous {
-            let exponent = (fastest.as_secs_f64() / before.as_secs_f64()).ln()
-                / (n as f64 / m as f64).ln();
+            let exponent =
+                (fastest.as_secs_f64() / before.as_secs_f64()).ln() / (n as f64 / m as f64).ln();
             growth.push(format!("{m} → {n}: {exponent:.2}"));
         }
         previous = Some((n, fastest));
     }
-    println!("\ngrowth exponent of the time a step: {}", growth.join(", "));
+    println!(
+        "\ngrowth exponent of the time a step: {}",
+        growth.join(", ")
+    );
     Ok(())
 }

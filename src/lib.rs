@@ -48,12 +48,13 @@ pub mod prelude {
     pub use dirac_macros::dirac_system;
     pub use dirac_runtime::nalgebra::{Matrix3, SMatrix, SVector, Vector3};
     pub use dirac_runtime::{
-        Anchor, Boundary, Composition, Configuration, ConfigurationSpace, ConstraintPoint, Crossing,
-        DiracError, DiracSystem, Direction, DiscreteLagrangian, DualNum, Euclidean, Event,
-        ExplicitSystem, Feedback, Field, FirstOrderScheme, HamiltonianSystem, HolonomicScheme,
-        Input, Interconnected, Interconnection, Joint, Junction, ManifoldStepper, Modular, NewtonOptions,
-        Positive, Product, Progress, Quadrature, Rates, Repeated, Retraction, Rule, Run, Sample,
-        Scalar, SeparableDensity, Solution, Solver, Status, Stepper, TimeTransformed, Trajectory,
+        Anchor, Boundary, Composition, Configuration, ConfigurationSpace, ConstraintPoint,
+        Crossing, DiracError, DiracSystem, Direction, DiscreteLagrangian, DualNum, Euclidean,
+        Event, ExplicitSystem, Feedback, Field, FirstOrderScheme, HamiltonianSystem,
+        HolonomicScheme, Input, Interconnected, Interconnection, Joint, Junction, ManifoldStepper,
+        Modular, NewtonOptions, Positive, Product, Progress, Quadrature, Rates, Repeated,
+        Retraction, Rule, Run, Sample, Scalar, SeparableDensity, Solution, Solver, Status, Stepper,
+        TimeTransformed, Trajectory,
     };
 }
 

@@ -123,7 +123,11 @@ pub fn rod_body(m: f64, l: f64, g: f64) -> Body {
     let across = m * l * l / 12.0;
     Body {
         m,
-        j: [[across, 0.0, 0.0], [0.0, across, 0.0], [0.0, 0.0, across / 10.0]],
+        j: [
+            [across, 0.0, 0.0],
+            [0.0, across, 0.0],
+            [0.0, 0.0, across / 10.0],
+        ],
         g,
     }
 }
@@ -243,6 +247,162 @@ pub fn bar_chain_state(alpha: &[f64], rates: &[f64], l: f64) -> (Vec<f64>, Vec<f
     (q, v)
 }
 
+/// A body of a tree: its parent (`None`: the root), the joint's point in the parent's axes and
+/// in its own, its mass and inertia about its centre.
+#[derive(Debug, Clone, Copy)]
+pub struct Limb {
+    pub name: &'static str,
+    pub parent: Option<usize>,
+    pub at_parent: [f64; 3],
+    pub at_self: [f64; 3],
+    pub m: f64,
+    pub j: [f64; 3],
+}
+
+/// A humanoid-like tree of nine bodies joined by ball joints: a torso, two arms and two legs of
+/// two segments each, in the body axes of a figure standing along `z`.
+pub const HUMANOID: [Limb; 9] = [
+    Limb {
+        name: "torso",
+        parent: None,
+        at_parent: [0.0; 3],
+        at_self: [0.0; 3],
+        m: 30.0,
+        j: [1.2, 1.0, 0.4],
+    },
+    Limb {
+        name: "upper_arm_left",
+        parent: Some(0),
+        at_parent: [0.0, 0.25, 0.3],
+        at_self: [0.0, 0.0, 0.15],
+        m: 2.0,
+        j: [0.015, 0.015, 0.002],
+    },
+    Limb {
+        name: "forearm_left",
+        parent: Some(1),
+        at_parent: [0.0, 0.0, -0.15],
+        at_self: [0.0, 0.0, 0.13],
+        m: 1.5,
+        j: [0.009, 0.009, 0.001],
+    },
+    Limb {
+        name: "upper_arm_right",
+        parent: Some(0),
+        at_parent: [0.0, -0.25, 0.3],
+        at_self: [0.0, 0.0, 0.15],
+        m: 2.0,
+        j: [0.015, 0.015, 0.002],
+    },
+    Limb {
+        name: "forearm_right",
+        parent: Some(3),
+        at_parent: [0.0, 0.0, -0.15],
+        at_self: [0.0, 0.0, 0.13],
+        m: 1.5,
+        j: [0.009, 0.009, 0.001],
+    },
+    Limb {
+        name: "thigh_left",
+        parent: Some(0),
+        at_parent: [0.0, 0.12, -0.35],
+        at_self: [0.0, 0.0, 0.22],
+        m: 8.0,
+        j: [0.13, 0.13, 0.03],
+    },
+    Limb {
+        name: "shin_left",
+        parent: Some(5),
+        at_parent: [0.0, 0.0, -0.22],
+        at_self: [0.0, 0.0, 0.22],
+        m: 4.0,
+        j: [0.06, 0.06, 0.008],
+    },
+    Limb {
+        name: "thigh_right",
+        parent: Some(0),
+        at_parent: [0.0, -0.12, -0.35],
+        at_self: [0.0, 0.0, 0.22],
+        m: 8.0,
+        j: [0.13, 0.13, 0.03],
+    },
+    Limb {
+        name: "shin_right",
+        parent: Some(7),
+        at_parent: [0.0, 0.0, -0.22],
+        at_self: [0.0, 0.0, 0.22],
+        m: 4.0,
+        j: [0.06, 0.06, 0.008],
+    },
+];
+
+/// The tree `limbs` as bodies (gravity `g`) joined by ball joints, free in space (its root is
+/// held by nothing); the midpoint rule (Cayley chart) with step `h`.
+pub fn tree(limbs: &[Limb], g: f64, h: f64) -> Result<Modular, DiracError> {
+    let mut tree = Modular::new(Quadrature::midpoint(), h)?;
+    for limb in limbs {
+        let [a, b, c] = limb.j;
+        let j = [[a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]];
+        tree.add_on_space(limb.name, Body { m: limb.m, j, g }, Product::cayley())?;
+    }
+    for limb in limbs {
+        let Some(parent) = limb.parent else { continue };
+        let end = |name: &str, offset| Anchor::body(name, ["x", "y", "z"], "R", offset);
+        let joint = Joint::spherical(
+            limb.name,
+            end(limbs[parent].name, limb.at_parent),
+            end(limb.name, limb.at_self),
+        );
+        tree.connect(joint)?;
+    }
+    Ok(tree)
+}
+
+/// The tree's positions and velocities (in `tree`'s order) with attitudes `attitudes`, body
+/// angular velocities `omegas`, the root's centre at `root` moving at `velocity`: each child
+/// placed and moved so that its joint's two points coincide and move alike.
+pub fn tree_state(
+    limbs: &[Limb],
+    attitudes: &[Matrix3<f64>],
+    omegas: &[Vector3<f64>],
+    (root, velocity): (Vector3<f64>, Vector3<f64>),
+) -> (Vec<f64>, Vec<f64>) {
+    let mut centres: Vec<(Vector3<f64>, Vector3<f64>)> = Vec::new();
+    for (k, limb) in limbs.iter().enumerate() {
+        let (r, w) = (attitudes[k], omegas[k]);
+        let placed = match limb.parent {
+            None => (root, velocity),
+            Some(p) => {
+                let (rp, wp) = (attitudes[p], omegas[p]);
+                let (a, b) = (Vector3::from(limb.at_parent), Vector3::from(limb.at_self));
+                let (cp, vp) = centres[p];
+                let joint = cp + rp * a;
+                let moving = vp + rp * wp.cross(&a);
+                (joint - r * b, moving - r * w.cross(&b))
+            }
+        };
+        centres.push(placed);
+    }
+    let (mut q, mut v) = (Vec::new(), Vec::new());
+    for (k, (centre, moving)) in centres.iter().enumerate() {
+        q.extend(centre.iter());
+        q.extend(attitudes[k].transpose().iter());
+        v.extend(moving.iter());
+        v.extend(omegas[k].iter());
+    }
+    (q, v)
+}
+
+/// The total linear momentum of bodies at positions `q` with momenta `p` (each `x, R`;
+/// `p_x, π`), and their angular momentum about the origin.
+pub fn bodies_momenta(q: &[f64], p: &[f64]) -> (Vector3<f64>, Vector3<f64>) {
+    let mut linear = Vector3::zeros();
+    for p in p.chunks(6) {
+        linear += Vector3::new(p[0], p[1], p[2]);
+    }
+    (linear, body_chain_momentum(q, p))
+}
+
 /// A four-bar linkage's bar lengths: crank, coupler, rocker, and the ground between the pivots.
 pub const FOUR_BAR: [f64; 4] = [1.0, 2.5, 2.0, 2.2];
 
@@ -265,10 +425,26 @@ pub fn four_bar(g: f64, h: f64) -> Result<Modular, DiracError> {
         Anchor::planar(name, ["x", "y"], "theta", [sign * len / 2.0, 0.0])
     };
     let pins = [
-        ("ground_crank", Anchor::fixed([0.0, 0.0]), end("crank", a, -1.0)),
-        ("crank_coupler", end("crank", a, 1.0), end("coupler", b, -1.0)),
-        ("coupler_rocker", end("coupler", b, 1.0), end("rocker", c, 1.0)),
-        ("rocker_ground", end("rocker", c, -1.0), Anchor::fixed([d, 0.0])),
+        (
+            "ground_crank",
+            Anchor::fixed([0.0, 0.0]),
+            end("crank", a, -1.0),
+        ),
+        (
+            "crank_coupler",
+            end("crank", a, 1.0),
+            end("coupler", b, -1.0),
+        ),
+        (
+            "coupler_rocker",
+            end("coupler", b, 1.0),
+            end("rocker", c, 1.0),
+        ),
+        (
+            "rocker_ground",
+            end("rocker", c, -1.0),
+            Anchor::fixed([d, 0.0]),
+        ),
     ];
     for (name, first, second) in pins {
         linkage.connect(Joint::spherical(name, first, second))?;
@@ -302,7 +478,8 @@ pub fn four_bar_state(phi: f64, omega: f64) -> (Vec<f64>, Vec<f64>) {
         .expect("a four-bar away from its dead points")
         * (-perp(phi) * (a * omega));
     let (beta, gamma) = (rates[0], rates[1]);
-    let centre = |from: Vector2<f64>, t: f64, len: f64| from + Vector2::new(t.cos(), t.sin()) * (len / 2.0);
+    let centre =
+        |from: Vector2<f64>, t: f64, len: f64| from + Vector2::new(t.cos(), t.sin()) * (len / 2.0);
     let moving = |from: Vector2<f64>, t: f64, w: f64, len: f64| from + perp(t) * (w * len / 2.0);
     let crank_velocity = perp(phi) * (a * omega);
     let q = [

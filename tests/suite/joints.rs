@@ -15,7 +15,10 @@ use scenes::mechanism::{self, FourBarMonolithic, PlanarMass, PointChain2};
 
 /// The largest entry of `a − b`.
 fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -101,9 +104,16 @@ fn the_four_bar_closes_its_loop_at_every_step_as_one_model_does() {
         }
     }
     // The crank has turned past a full revolution.
-    assert!(joined.q()[2] > 1.0 + std::f64::consts::TAU, "crank at {}", joined.q()[2]);
+    assert!(
+        joined.q()[2] > 1.0 + std::f64::consts::TAU,
+        "crank at {}",
+        joined.q()[2]
+    );
     assert!(worst < 1e-11, "joined and one model differ by {worst:.2e}");
-    assert!(drift < 1e-4, "the energy's relative error reached {drift:.2e}");
+    assert!(
+        drift < 1e-4,
+        "the energy's relative error reached {drift:.2e}"
+    );
 }
 
 /// The n-link chain of trep's scene, straight and level at rest, over `t` at step `h` in
@@ -151,10 +161,15 @@ fn trep_s_chain_in_maximal_coordinates_converges_to_the_reduced_chain_at_second_
     }
     // The reduced chain's midpoint rule has an error of the same size: both are second order.
     let mut reduced = Stepper::new(system, Quadrature::midpoint(), 0.01).unwrap();
-    reduced.start_from_velocity(theta, SVector::zeros()).unwrap();
+    reduced
+        .start_from_velocity(theta, SVector::zeros())
+        .unwrap();
     reduced.run(100).unwrap();
     let theirs = distance(reduced.q().as_slice(), exact.as_slice());
-    assert!(errors[0] < 10.0 * theirs && theirs < 10.0 * errors[0], "{errors:?} vs {theirs}");
+    assert!(
+        errors[0] < 10.0 * theirs && theirs < 10.0 * errors[0],
+        "{errors:?} vs {theirs}"
+    );
 }
 
 #[test]
@@ -188,11 +203,20 @@ fn a_chain_of_bodies_keeps_its_vertical_angular_momentum_to_round_off() {
             drift = drift.max((energy(&chain) - e0).abs());
         }
     }
-    assert!(j0[2].abs() > 0.1, "a chain turning about the vertical: {j0}");
-    assert!(worst < 1e-13, "the vertical angular momentum moved by {worst:.2e}");
+    assert!(
+        j0[2].abs() > 0.1,
+        "a chain turning about the vertical: {j0}"
+    );
+    assert!(
+        worst < 1e-13,
+        "the vertical angular momentum moved by {worst:.2e}"
+    );
     // The horizontal components are not conserved (gravity's torque).
     assert!((momentum(&chain)[0] - j0[0]).abs() > 1e-3);
-    assert!(drift < 0.05 * e0.abs().max(1.0), "energy error {drift:.2e} of {e0}");
+    assert!(
+        drift < 0.05 * e0.abs().max(1.0),
+        "energy error {drift:.2e} of {e0}"
+    );
 }
 
 /// A chain of rods hinged about parallel axes, in space and in the plane, at step `h` over
@@ -222,11 +246,16 @@ fn hinged_against_pinned(h: f64) -> f64 {
     let (q, p) = (hinged.q(), pinned.q());
     let mut worst: f64 = 0.0;
     for b in 0..n {
-        let (body, bar) = (&q.as_slice()[12 * b..12 * b + 12], &p.as_slice()[3 * b..3 * b + 3]);
+        let (body, bar) = (
+            &q.as_slice()[12 * b..12 * b + 12],
+            &p.as_slice()[3 * b..3 * b + 3],
+        );
         // The motion stays in the plane: x = 0, and the hinge axis R e_x = e_x.
         assert!(body[0].abs() < 1e-12, "x = {}", body[0]);
         assert!((body[3] - 1.0).abs() < 1e-12 && body[6].abs() < 1e-12 && body[9].abs() < 1e-12);
-        worst = worst.max((body[1] - bar[0]).abs()).max((body[2] - bar[1]).abs());
+        worst = worst
+            .max((body[1] - bar[0]).abs())
+            .max((body[2] - bar[1]).abs());
     }
     worst
 }
@@ -237,7 +266,48 @@ fn hinged_rods_in_space_move_as_pinned_bars_in_the_plane() {
     // the plane): their distance falls as h².
     let (coarse, fine) = (hinged_against_pinned(0.004), hinged_against_pinned(0.002));
     let order = (coarse / fine).log2();
-    assert!(coarse < 2e-5 && (order - 2.0).abs() < 0.2, "{coarse:.2e}, {fine:.2e}: {order:.2}");
+    assert!(
+        coarse < 2e-5 && (order - 2.0).abs() < 0.2,
+        "{coarse:.2e}, {fine:.2e}: {order:.2}"
+    );
+}
+
+#[test]
+fn a_free_humanoid_tree_keeps_its_momenta_and_joints() {
+    // Nine bodies, eight ball joints, no gravity: linear and angular momentum are conserved.
+    let limbs = mechanism::HUMANOID;
+    let mut tree = mechanism::tree(&limbs, 0.0, 0.005).unwrap();
+    let attitudes: Vec<Matrix3<f64>> = (0..limbs.len())
+        .map(|k| {
+            let turn = Vector3::new(0.3 * k as f64, -0.2, 0.1 * (k % 3) as f64);
+            Rotation3::new(turn).into_inner()
+        })
+        .collect();
+    let omegas: Vec<Vector3<f64>> = (0..limbs.len())
+        .map(|k| Vector3::new((k as f64).sin(), 2.0 * (k as f64).cos(), 0.5))
+        .collect();
+    let moving = (Vector3::new(0.1, 0.0, 0.2), Vector3::new(0.3, -0.1, 0.0));
+    let (q0, v0) = mechanism::tree_state(&limbs, &attitudes, &omegas, moving);
+    tree.start_from_velocity(&q0, &v0).unwrap();
+    let momenta =
+        |tree: &Modular| mechanism::bodies_momenta(tree.q().as_slice(), tree.p().as_slice());
+    let (linear0, angular0) = momenta(&tree);
+    let (mut linear, mut angular): (f64, f64) = (0.0, 0.0);
+    for k in 0..2000 {
+        tree.step().unwrap();
+        assert!(tree.constraint_violation().unwrap() < 1e-12, "step {k}");
+        let (l, a) = momenta(&tree);
+        linear = linear.max((l - linear0).amax());
+        angular = angular.max((a - angular0).amax());
+    }
+    assert!(
+        linear0.norm() > 1.0 && angular0.norm() > 1.0,
+        "{linear0}, {angular0}"
+    );
+    assert!(
+        linear < 1e-12 && angular < 1e-12,
+        "momenta moved by {linear:.2e}, {angular:.2e}"
+    );
 }
 
 #[test]
@@ -264,7 +334,10 @@ fn joints_that_cannot_be_made_are_refused_with_the_reason() {
     let saved = chain.q();
     q[3] += 1e-3;
     let off = chain.start_from_velocity(&q, &v).unwrap_err();
-    assert!(matches!(off, DiracError::InconsistentInitialState(_)), "{off}");
+    assert!(
+        matches!(off, DiracError::InconsistentInitialState(_)),
+        "{off}"
+    );
     assert!(off.to_string().contains("rod1[0]"), "{off}");
     assert_eq!(chain.q(), saved);
     let (q, mut v) = mechanism::point_chain_state(&[half_pi, 0.0], &[1.0, 0.0], 1.0);

@@ -357,8 +357,7 @@ impl Joint {
                     );
                 }
                 let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-                if !(norm(u).is_finite() && norm(u) > 0.0 && norm(w).is_finite() && norm(w) > 0.0)
-                {
+                if !(norm(u).is_finite() && norm(u) > 0.0 && norm(w).is_finite() && norm(w) > 0.0) {
                     return invalid("an axis that is zero or not finite".into());
                 }
                 Ok(())
@@ -390,8 +389,8 @@ impl Joint {
         };
         match &self.kind {
             Kind::Spherical | Kind::Revolute(..) => {
-                for i in 0..d {
-                    value[i] = ra.value[i] - rb.value[i];
+                for (i, row) in value.iter_mut().enumerate().take(d) {
+                    *row = ra.value[i] - rb.value[i];
                     size = size.max(ra.value[i].abs()).max(rb.value[i].abs());
                     add(terms, i, 0, &ra, i, 1.0);
                     add(terms, i, 1, &rb, i, -1.0);
@@ -546,7 +545,10 @@ mod tests {
         ];
         for joint in refused {
             let error = joint.check().unwrap_err().to_string();
-            assert!(error.contains(&format!("joint {}", joint.name())), "{error}");
+            assert!(
+                error.contains(&format!("joint {}", joint.name())),
+                "{error}"
+            );
         }
         assert!(Joint::rod("fine", fixed(), mass(), 1.0).check().is_ok());
     }

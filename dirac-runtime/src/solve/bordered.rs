@@ -287,15 +287,11 @@ impl Jacobian for Bordered {
     fn fits(&self, n: usize) -> bool {
         n == self.size
             && self.diagonal.len() == self.blocks.len()
-            && self
-                .diagonal
-                .iter()
-                .zip(&self.blocks)
-                .all(|(j, b)| {
-                    j.own.shape() == (b.pivots.len(), b.pivots.len())
-                        && j.e.shape() == b.e.shape()
-                        && j.g.shape() == b.g.shape()
-                })
+            && self.diagonal.iter().zip(&self.blocks).all(|(j, b)| {
+                j.own.shape() == (b.pivots.len(), b.pivots.len())
+                    && j.e.shape() == b.e.shape()
+                    && j.g.shape() == b.g.shape()
+            })
     }
 
     fn restore(&mut self, _n: usize) {

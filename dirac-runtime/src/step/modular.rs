@@ -703,7 +703,9 @@ impl Modular {
                 ));
             };
             let part = &self.components[c].part;
-            let theirs: Vec<String> = (0..part.positions()).map(|i| part.position_name(i)).collect();
+            let theirs: Vec<String> = (0..part.positions())
+                .map(|i| part.position_name(i))
+                .collect();
             for wanted in anchor.position_names() {
                 let Some(i) = theirs.iter().position(|p| *p == wanted) else {
                     return invalid(format!(
@@ -1089,7 +1091,10 @@ impl Modular {
             multipliers: vec![0.0; self.junctions.len()],
             row_terms,
             row_starts,
-            jointed: order.iter().map(|&j| self.junctions[j].joint.is_some()).collect(),
+            jointed: order
+                .iter()
+                .map(|&j| self.junctions[j].joint.is_some())
+                .collect(),
             moved: vec![0.0; unknowns - self.junctions.len()],
             violation: 0.0,
             report: None,
@@ -1288,7 +1293,9 @@ impl Modular {
                     };
                     for &(c, i, a) in &coupling.terms {
                         let touching = &components[c].touching;
-                        let t = touching.binary_search(&coupling.rank).expect("it touches c");
+                        let t = touching
+                            .binary_search(&coupling.rank)
+                            .expect("it touches c");
                         let e = usize::from(joint.ends[0] != Some(c));
                         blocks[c].g[(t, i)] = joint.read.chart[e][(row, i)];
                         blocks[c].e[(i, t)] = share * a;
@@ -1397,7 +1404,11 @@ impl Modular {
     /// The name of unknown `column` of a step (`first`: the junctions' first).
     fn unknown_name(&self, column: usize, first: usize) -> String {
         if let Some(junction) = self.junctions.iter().find(|j| first + j.rank == column) {
-            let kind = if junction.joint.is_some() { "joint" } else { "junction" };
+            let kind = if junction.joint.is_some() {
+                "joint"
+            } else {
+                "junction"
+            };
             return format!("the multiplier of {kind} {}", junction.name);
         }
         let component = self

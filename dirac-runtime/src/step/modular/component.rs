@@ -9,8 +9,8 @@
 //! body angular velocity, the body angular momentum and the step's rotation in the body's
 //! axes. Its positions are the numbers of its point (a rotation's nine entries, row by row).
 
-use nalgebra::{DMatrix, DVector, SVector};
 use nalgebra::{Const, U1};
+use nalgebra::{DMatrix, DVector, SVector};
 use num_dual::{Derivative, DualSVec64};
 
 use crate::base::constraint_point::ConstraintPoint;
