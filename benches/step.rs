@@ -108,6 +108,38 @@ fn chain_step<const L: usize>(
     });
 }
 
+/// trep's n-link chain in maximal coordinates (`scenes::mechanism::point_chain`: point masses
+/// on rods held by joints, the modular step), n = 10, 20, 40, 100, 1 000: as `chain_step`, each
+/// measurement steps from the start for `max(200, 4000 / n)` steps, starting over (untimed)
+/// from the same state; the time reported is per step.
+fn mechanism(c: &mut Criterion) {
+    use scenes::mechanism;
+    let mut group = c.benchmark_group("mechanism_chain");
+    group.sample_size(20);
+    for n in [10, 20, 40, 100, 1000] {
+        let theta = vec![std::f64::consts::FRAC_PI_2; n];
+        let (q0, v0) = mechanism::point_chain_state(&theta, &vec![0.0; n], 1.0);
+        let mut chain = mechanism::point_chain(n, 1.0, 1.0, 9.81, 0.01).expect("valid scene");
+        let stretch = 200.max(4000 / n) as u64;
+        group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter_custom(|iterations| {
+                let runs = iterations.div_ceil(stretch);
+                let mut total = Duration::ZERO;
+                for _ in 0..runs {
+                    chain.start_from_velocity(&q0, &v0).expect("consistent start");
+                    let clock = Instant::now();
+                    for _ in 0..stretch {
+                        black_box(chain.step()).expect("step");
+                    }
+                    total += clock.elapsed();
+                }
+                total.mul_f64(iterations as f64 / (runs * stretch) as f64)
+            })
+        });
+    }
+    group.finish();
+}
+
 /// The n-link chain in trep's scene for n = 2, 4, 5, 8, 10, 16, 20, 32, 40, 64: trep's sizes
 /// (trep 1.0.2, `MidpointVI`, timed beside it on the same machine) and the
 /// powers of two the growth exponent is fitted over.
@@ -1018,6 +1050,7 @@ criterion_group!(
     generated_vs_hand,
     quadratures,
     chain_growth,
+    mechanism,
     constrained,
     step_derivatives,
     newer_classes

@@ -32,6 +32,12 @@ const GROUPS: &[(&str, &str)] = &[
          scripts, run beside the bench).",
     ),
     (
+        "mechanism_chain",
+        "trep's n-link chain in maximal coordinates: point masses on rods held by joints, stepped \
+         by the modular step, by number of links (over trep's stretch of the fall, as \
+         `chain_trep_scene`).",
+    ),
+    (
         "constrained_midpoint_step",
         "Midpoint steps of constrained and degenerate models.",
     ),
