@@ -126,7 +126,9 @@ fn mechanism(c: &mut Criterion) {
                 let runs = iterations.div_ceil(stretch);
                 let mut total = Duration::ZERO;
                 for _ in 0..runs {
-                    chain.start_from_velocity(&q0, &v0).expect("consistent start");
+                    chain
+                        .start_from_velocity(&q0, &v0)
+                        .expect("consistent start");
                     let clock = Instant::now();
                     for _ in 0..stretch {
                         black_box(chain.step()).expect("step");

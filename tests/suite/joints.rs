@@ -13,6 +13,22 @@ use scenes::cartesian_pendulum::CartesianPendulum;
 use scenes::chain::Chain;
 use scenes::mechanism::{self, FourBarMonolithic, PlanarMass, PointChain2};
 
+/// The largest distance between the points `a` of body `i` and `b` of body `j` (`None`: the
+/// origin) over `pairs`, read off the positions `q` (each body's centre, then its attitude row
+/// by row).
+fn ball_gaps(q: &[f64], pairs: &[(Option<usize>, [f64; 3], usize, [f64; 3])]) -> f64 {
+    let point = |body: usize, a: [f64; 3]| {
+        let q = &q[12 * body..12 * body + 12];
+        let r = Matrix3::from_row_slice(&q[3..12]);
+        Vector3::new(q[0], q[1], q[2]) + r * Vector3::from(a)
+    };
+    let gaps = pairs.iter().map(|&(i, a, j, b)| {
+        let first = i.map_or(Vector3::zeros(), |i| point(i, a));
+        (first - point(j, b)).amax()
+    });
+    gaps.fold(0.0, f64::max)
+}
+
 /// The largest entry of `a − b`.
 fn distance(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
@@ -195,9 +211,13 @@ fn a_chain_of_bodies_keeps_its_vertical_angular_momentum_to_round_off() {
     let energy = |chain: &Modular| chain.energies().unwrap().iter().sum::<f64>();
     let e0 = energy(&chain);
     let (mut worst, mut drift): (f64, f64) = (0.0, 0.0);
+    let (top, bottom) = ([0.0, 0.0, l / 2.0], [0.0, 0.0, -l / 2.0]);
+    let balls: Vec<_> = (0..n).map(|k| (k.checked_sub(1), bottom, k, top)).collect();
     for k in 0..1000 {
         chain.step().unwrap();
         assert!(chain.constraint_violation().unwrap() < 1e-12, "step {k}");
+        // The accepted positions themselves hold the joints.
+        assert!(ball_gaps(chain.q().as_slice(), &balls) < 1e-12, "step {k}");
         worst = worst.max((momentum(&chain)[2] - j0[2]).abs());
         if k % 100 == 99 {
             drift = drift.max((energy(&chain) - e0).abs());
@@ -293,9 +313,15 @@ fn a_free_humanoid_tree_keeps_its_momenta_and_joints() {
         |tree: &Modular| mechanism::bodies_momenta(tree.q().as_slice(), tree.p().as_slice());
     let (linear0, angular0) = momenta(&tree);
     let (mut linear, mut angular): (f64, f64) = (0.0, 0.0);
+    let balls: Vec<_> = limbs
+        .iter()
+        .enumerate()
+        .filter_map(|(k, limb)| Some((Some(limb.parent?), limb.at_parent, k, limb.at_self)))
+        .collect();
     for k in 0..2000 {
         tree.step().unwrap();
         assert!(tree.constraint_violation().unwrap() < 1e-12, "step {k}");
+        assert!(ball_gaps(tree.q().as_slice(), &balls) < 1e-12, "step {k}");
         let (l, a) = momenta(&tree);
         linear = linear.max((l - linear0).amax());
         angular = angular.max((a - angular0).amax());
@@ -308,6 +334,82 @@ fn a_free_humanoid_tree_keeps_its_momenta_and_joints() {
         linear < 1e-12 && angular < 1e-12,
         "momenta moved by {linear:.2e}, {angular:.2e}"
     );
+}
+
+#[test]
+fn an_included_chain_s_joints_step_as_its_own() {
+    // Two links included as `upper`, a third joined to them: trep's three-link chain.
+    let (m, l, g, h) = (1.0, 1.0, 9.81, 0.01);
+    let mut whole = Modular::new(Quadrature::midpoint(), h).unwrap();
+    whole
+        .include("upper", mechanism::point_chain(2, m, l, g, h).unwrap())
+        .unwrap();
+    whole.add("last", PlanarMass { m, g }).unwrap();
+    let rod = Joint::rod(
+        "rod",
+        Anchor::point("upper.link1", ["x", "y"]),
+        Anchor::point("last", ["x", "y"]),
+        l,
+    );
+    whole.connect(rod).unwrap();
+    let names = whole.junction_names();
+    assert_eq!(names, ["upper.rod0[0]", "upper.rod1[0]", "rod[0]"]);
+    let mut three = mechanism::point_chain(3, m, l, g, h).unwrap();
+    let (q0, v0) = mechanism::point_chain_state(&[1.2, 0.7, 0.3], &[0.0, 0.5, -1.0], l);
+    whole.start_from_velocity(&q0, &v0).unwrap();
+    three.start_from_velocity(&q0, &v0).unwrap();
+    for _ in 0..500 {
+        whole.step().unwrap();
+        three.step().unwrap();
+    }
+    assert!(distance(whole.q().as_slice(), three.q().as_slice()) < 1e-13);
+    // Names the included joints already hold.
+    let mut other = Modular::new(Quadrature::midpoint(), h).unwrap();
+    other.add("m", PlanarMass { m, g }).unwrap();
+    other
+        .join(Junction::new("upper.rod0").flow("m.x", 1.0))
+        .unwrap();
+    let clash = other.include("upper", mechanism::point_chain(2, m, l, g, h).unwrap());
+    assert!(clash.unwrap_err().to_string().contains("upper.rod0"));
+}
+
+#[test]
+fn a_long_chain_steps_across_threads_as_on_one() {
+    // Enough links for the components' passes to be split across rayon's threads.
+    let n = 2500;
+    let theta = vec![std::f64::consts::FRAC_PI_2; n];
+    let (q0, v0) = mechanism::point_chain_state(&theta, &vec![0.0; n], 1.0);
+    let mut states = Vec::new();
+    for parallel in [false, true] {
+        let chain = mechanism::point_chain(n, 1.0, 1.0, 9.81, 0.01).unwrap();
+        let mut chain = chain.with_parallel(parallel);
+        chain.start_from_velocity(&q0, &v0).unwrap();
+        chain.run(5).unwrap();
+        assert!(chain.constraint_violation().unwrap() < 1e-12);
+        states.push((chain.q(), chain.multipliers().unwrap().to_vec()));
+    }
+    assert_eq!(states[0], states[1]);
+}
+
+#[test]
+fn a_joint_on_a_coordinate_without_kinetic_energy_is_refused_at_the_start() {
+    /// A massless point in a potential well: its step is fixed by the joint alone.
+    #[dirac_system(coordinates(x, y), lagrangian = -(x * x + 2.0 * y * y))]
+    struct Massless;
+    let mut model = Modular::new(Quadrature::midpoint(), 0.01).unwrap();
+    model.add("p", Massless).unwrap();
+    let rod = Joint::rod(
+        "rod",
+        Anchor::fixed([0.0, 0.0]),
+        Anchor::point("p", ["x", "y"]),
+        1.0,
+    );
+    model.connect(rod).unwrap();
+    let error = model
+        .start_from_velocity(&[1.0, 0.0], &[0.0, 0.0])
+        .unwrap_err();
+    assert!(matches!(error, DiracError::Unsupported(_)), "{error}");
+    assert!(error.to_string().contains("joint rod on p"), "{error}");
 }
 
 #[test]
@@ -328,6 +430,9 @@ fn joints_that_cannot_be_made_are_refused_with_the_reason() {
     assert!(itself.contains("with itself"));
     let taken = error(chain.connect(Joint::rod("rod1", bob("link0"), bob("link1"), 1.0)));
     assert!(taken.contains("named \"rod1\""));
+    // A junction named as a joint's row.
+    let row = chain.join(Junction::new("rod1[0]").flow("link0.x", 1.0));
+    assert!(error(row).contains("rod1[0]"));
     // Positions off the rods, and velocities along them.
     let half_pi = std::f64::consts::FRAC_PI_2;
     let (mut q, v) = mechanism::point_chain_state(&[half_pi, 0.0], &[1.0, 0.0], 1.0);

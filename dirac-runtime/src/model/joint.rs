@@ -535,20 +535,40 @@ mod tests {
         let fixed = || Anchor::fixed([0.0, 0.0, 0.0]);
         let mass = || Anchor::point("m", ["x", "y", "z"]);
         let planar = || Anchor::planar("p", ["x", "y"], "t", [1.0, 0.0]);
+        let body = || Anchor::body("b", ["x", "y", "z"], "R", [0.0, 0.0, 1.0]);
         let refused = [
-            Joint::spherical("both fixed", fixed(), fixed()),
-            Joint::spherical("dimensions", planar(), mass()),
-            Joint::rod("length", fixed(), mass(), 0.0),
-            Joint::revolute("no axes", fixed(), mass(), [1.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
-            Joint::revolute("zero axis", fixed(), fixed(), [0.0; 3], [1.0, 0.0, 0.0]),
-            Joint::spherical("not finite", Anchor::fixed([f64::NAN, 0.0, 0.0]), mass()),
+            (
+                Joint::spherical("both fixed", fixed(), fixed()),
+                "both ends are fixed",
+            ),
+            (
+                Joint::spherical("dimensions", planar(), mass()),
+                "dimension 2 and 3",
+            ),
+            (
+                Joint::rod("length", fixed(), mass(), 0.0),
+                "length 0 is not positive",
+            ),
+            (
+                Joint::revolute("no axes", fixed(), mass(), [1.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+                "a hinge needs both ends turning",
+            ),
+            (
+                Joint::revolute("zero axis", fixed(), body(), [0.0; 3], [1.0, 0.0, 0.0]),
+                "an axis that is zero",
+            ),
+            (
+                Joint::spherical("not finite", Anchor::fixed([f64::NAN, 0.0, 0.0]), mass()),
+                "not finite",
+            ),
         ];
-        for joint in refused {
+        for (joint, why) in refused {
             let error = joint.check().unwrap_err().to_string();
             assert!(
-                error.contains(&format!("joint {}", joint.name())),
+                error.contains(&format!("joint {}: ", joint.name())),
                 "{error}"
             );
+            assert!(error.contains(why), "{error}");
         }
         assert!(Joint::rod("fine", fixed(), mass(), 1.0).check().is_ok());
     }

@@ -15,7 +15,9 @@
 //! and `p_{k+1}^c` gains `(1 − σ) Σ_j μ_j a_j^c`: exactly the monolithic equations. Newton's
 //! method solves them with a [`Bordered`] Jacobian: each `∂R_c/∂x_c` is factorised on its own
 //! and the junctions' Schur complement, a band matrix along a chain, couples them, so a chain
-//! of `K` components costs `O(K)` per step. The components can be assembled, factorised and
+//! of `K` components costs `O(K)` per step. Joints ([`Modular::connect`]) are junctions whose
+//! rows are holonomic constraints on the components' positions, held as SHAKE holds them
+//! (`σ = 1`, `g(q_{k+1}) = 0`): mechanisms in maximal coordinates. The components can be assembled, factorised and
 //! solved in parallel (rayon, [`Modular::with_parallel`]). Hidden constraints across the components
 //! (parallel capacitors in different components) are held at every step's end as a model holds
 //! its own (see `hidden`).
@@ -523,12 +525,14 @@ impl Modular {
             ));
         }
         let prefix = format!("{name}.");
-        if let Some(j) = other
-            .junctions
-            .iter()
-            .find(|j| self.junction_names.contains(&format!("{prefix}{}", j.name)))
+        let theirs = other.junctions.iter().map(|j| &j.name);
+        let joints = other.joints.iter().map(|j| j.joint.name());
+        if let Some(name) = theirs
+            .map(String::as_str)
+            .chain(joints)
+            .find(|name| self.junction_names.contains(&format!("{prefix}{name}")))
         {
-            return invalid(format!("two junctions are named {prefix}{}", j.name));
+            return invalid(format!("two junctions are named {prefix}{name}"));
         }
         if let (Some(mine), Some(theirs)) = (self.constrained, other.constrained) {
             let (mine, theirs) = (&self.components[mine], &other.components[theirs]);
@@ -571,9 +575,8 @@ impl Modular {
             junction.terms.iter_mut().for_each(|t| t.0 += base);
             if let Some((joint, _)) = &mut junction.joint {
                 *joint += first_joint;
-            } else {
-                self.junction_names.insert(junction.name.clone());
             }
+            self.junction_names.insert(junction.name.clone());
             self.junctions.push(junction);
         }
         for mut rows in other.joints {
@@ -686,8 +689,12 @@ impl Modular {
         let invalid = |why: String| Err(DiracError::InvalidInterconnection(why));
         joint.check()?;
         let name = joint.name().to_string();
-        if self.junction_names.contains(&name) {
-            return invalid(format!("two junctions or joints are named {name:?}"));
+        let rows = (0..joint.rows()).map(|row| joint.row_name(row));
+        if let Some(taken) = std::iter::once(name.clone())
+            .chain(rows)
+            .find(|n| self.junction_names.contains(n))
+        {
+            return invalid(format!("two junctions or joints are named {taken:?}"));
         }
         let mut ends = [None, None];
         let mut at = [Vec::new(), Vec::new()];
@@ -737,6 +744,8 @@ impl Modular {
             });
         }
         self.junction_names.insert(name);
+        self.junction_names
+            .extend((0..joint.rows()).map(|row| joint.row_name(row)));
         let k = joint.rows();
         let sized = |f: &dyn Fn(&dyn Part) -> (usize, usize)| {
             ends.map(|end| end.map_or((0, 0), |c| f(&*self.components[c].part)))
@@ -769,6 +778,30 @@ impl Modular {
                 .expect("no check without positions");
             self.couple();
         }
+    }
+
+    /// `Unsupported` where a joint holds a component with coordinates without kinetic energy
+    /// at the positions `q` and velocities `v`: their hidden constraints and projections would
+    /// move the step's end after the joint was solved there.
+    fn check_jointed(&self, q: &[f64], v: &[f64]) -> Result<(), DiracError> {
+        for rows in &self.joints {
+            for c in rows.ends.iter().flatten() {
+                let component = &self.components[*c];
+                let (part, at) = (&component.part, component.position);
+                let velocities = &v[component.first..component.first + part.coordinates()];
+                let dead = part.degenerate(&q[at..at + part.positions()], velocities);
+                if let Some(&i) = dead.coordinates.first() {
+                    return Err(DiracError::Unsupported(format!(
+                        "joint {} on {}, whose coordinate {} has no kinetic energy (a joint's \
+                         component must determine its own step)",
+                        rows.joint.name(),
+                        component.name,
+                        part.coordinate_name(i)
+                    )));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Each component's junction terms and the junctions touching it, from the junctions.
@@ -1027,6 +1060,7 @@ impl Modular {
                 .map_err(|e| in_component(&component.name, e))?;
             started.push(state);
         }
+        self.check_jointed(q, v)?;
         let mut junctions = self.junctions.clone();
         let (components, joints) = (&self.components, &mut self.joints);
         read_joints(components, joints, &mut junctions, Some(q), tolerance)?;
@@ -1533,9 +1567,9 @@ impl Modular {
     }
 
     /// The largest constraint violation of the last step: the components' own (as
-    /// [`Stepper::constraint_violation`](crate::Stepper::constraint_violation)) and the
+    /// [`Stepper::constraint_violation`](crate::Stepper::constraint_violation)), the
     /// junctions' `|Σ_c a_j^c · ξ^c|` (`ξ^c` the component's step in its chart, `q_{k+1}^c −
-    /// q_k^c` on `Rⁿ`).
+    /// q_k^c` on `Rⁿ`) and the joints' `|g(q_{k+1})|`.
     pub fn constraint_violation(&self) -> Result<f64, DiracError> {
         Ok(self.running()?.violation)
     }
@@ -1552,7 +1586,8 @@ impl Modular {
     /// junctions `Σ_c a_j^c · v_c = 0` and the velocity forms `dc(q) v = 0` of hidden
     /// constraints across the components (each with a multiplier, as a junction's, and each
     /// spanning every component it combines), solved by Newton's method from the last step's
-    /// velocities. Its matrix is a band matrix with each junction's row beside the components
+    /// velocities (a joint's rows are its differential at the current positions). Its matrix
+    /// is a band matrix with each junction's row beside the components
     /// it joins (a chain costs `O(K)`), factorised with partial pivoting, so components without
     /// kinetic energy, whose velocities only the junctions fix, need no block of their own.
     pub fn velocities(&self) -> Result<DVector<f64>, DiracError> {
