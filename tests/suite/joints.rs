@@ -13,10 +13,13 @@ use scenes::cartesian_pendulum::CartesianPendulum;
 use scenes::chain::Chain;
 use scenes::mechanism::{self, FourBarMonolithic, PlanarMass, PointChain2};
 
+/// A ball joint between the point `a` of body `i` (`None`: the origin) and `b` of body `j`.
+type Ball = (Option<usize>, [f64; 3], usize, [f64; 3]);
+
 /// The largest distance between the points `a` of body `i` and `b` of body `j` (`None`: the
 /// origin) over `pairs`, read off the positions `q` (each body's centre, then its attitude row
 /// by row).
-fn ball_gaps(q: &[f64], pairs: &[(Option<usize>, [f64; 3], usize, [f64; 3])]) -> f64 {
+fn ball_gaps(q: &[f64], pairs: &[Ball]) -> f64 {
     let point = |body: usize, a: [f64; 3]| {
         let q = &q[12 * body..12 * body + 12];
         let r = Matrix3::from_row_slice(&q[3..12]);
