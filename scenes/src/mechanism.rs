@@ -525,6 +525,107 @@ pub struct FourBarMonolithic {
     pub g: f64,
 }
 
+/// A slider-crank's lengths: the crank and the connecting rod.
+pub const SLIDER_CRANK: [f64; 2] = [1.0, 3.0];
+
+/// A slider-crank in the vertical plane: the crank (`crank`) pinned to the ground at the
+/// origin, the connecting rod (`rod`) pinned to its tip, the slider (`slider`, a block of mass 1
+/// and moment 0.1) pinned to the rod's other end and sliding on the ground's `x` axis (a
+/// prismatic joint); bars of unit mass per length, gravity `g`, the midpoint rule with step `h`.
+pub fn slider_crank(g: f64, h: f64) -> Result<Modular, DiracError> {
+    let [a, b] = SLIDER_CRANK;
+    let mut mechanism = Modular::new(Quadrature::midpoint(), h)?;
+    for (name, len) in [("crank", a), ("rod", b)] {
+        let i = len * len * len / 12.0;
+        mechanism.add(name, PlanarBar { m: len, i, g })?;
+    }
+    let block = PlanarBar { m: 1.0, i: 0.1, g };
+    mechanism.add("slider", block)?;
+    let end = |name: &str, offset: f64| Anchor::planar(name, ["x", "y"], "theta", [offset, 0.0]);
+    let ground = Anchor::fixed([0.0, 0.0]);
+    mechanism.connect(Joint::spherical(
+        "pivot",
+        ground.clone(),
+        end("crank", -a / 2.0),
+    ))?;
+    mechanism.connect(Joint::spherical(
+        "wrist",
+        end("crank", a / 2.0),
+        end("rod", -b / 2.0),
+    ))?;
+    mechanism.connect(Joint::spherical(
+        "pin",
+        end("rod", b / 2.0),
+        end("slider", 0.0),
+    ))?;
+    mechanism.connect(Joint::prismatic(
+        "rail",
+        ground,
+        end("slider", 0.0),
+        [1.0, 0.0],
+    ))?;
+    Ok(mechanism)
+}
+
+/// The slider-crank's positions and velocities (in `slider_crank`'s order) with the crank at
+/// angle `phi` turning at `omega`.
+pub fn slider_crank_state(phi: f64, omega: f64) -> (Vec<f64>, Vec<f64>) {
+    let [a, b] = SLIDER_CRANK;
+    let perp = |t: f64| Vector2::new(-t.sin(), t.cos());
+    let tip = Vector2::new(a * phi.cos(), a * phi.sin());
+    let x = tip[0] + (b * b - tip[1] * tip[1]).sqrt();
+    let beta = (-tip[1]).atan2(x - tip[0]);
+    // b β̇ e(β)⊥ − ẋ e_x = −a ω e(φ)⊥.
+    let m = Matrix2::from_columns(&[perp(beta) * b, Vector2::new(-1.0, 0.0)]);
+    let rates = m.try_inverse().expect("away from the dead points") * (-perp(phi) * (a * omega));
+    let (beta_rate, slide) = (rates[0], rates[1]);
+    let tip_velocity = perp(phi) * (a * omega);
+    let along = |t: f64| Vector2::new(t.cos(), t.sin());
+    let crank = along(phi) * (a / 2.0);
+    let rod = tip + along(beta) * (b / 2.0);
+    let q = vec![crank[0], crank[1], phi, rod[0], rod[1], beta, x, 0.0, 0.0];
+    let rod_velocity = tip_velocity + perp(beta) * (beta_rate * b / 2.0);
+    let crank_velocity = perp(phi) * (omega * a / 2.0);
+    let v = vec![
+        crank_velocity[0],
+        crank_velocity[1],
+        omega,
+        rod_velocity[0],
+        rod_velocity[1],
+        beta_rate,
+        slide,
+        0.0,
+        0.0,
+    ];
+    (q, v)
+}
+
+/// The slider-crank as one model on `R⁹` with its three pins and its rail as eight holonomic
+/// constraints (the monolithic step's equations of `slider_crank`).
+#[dirac_system(
+    coordinates(x1, y1, t1, x2, y2, t2, x3, y3, t3),
+    lagrangian = 0.5 * a * (dot(x1).powi(2) + dot(y1).powi(2)) + a.powi(3) / 24.0 * dot(t1).powi(2)
+        + 0.5 * b * (dot(x2).powi(2) + dot(y2).powi(2)) + b.powi(3) / 24.0 * dot(t2).powi(2)
+        + 0.5 * (dot(x3).powi(2) + dot(y3).powi(2)) + 0.05 * dot(t3).powi(2)
+        - g * (a * y1 + b * y2 + y3),
+    holonomic(
+        x1 - 0.5 * a * cos(t1),
+        y1 - 0.5 * a * sin(t1),
+        x1 + 0.5 * a * cos(t1) - x2 + 0.5 * b * cos(t2),
+        y1 + 0.5 * a * sin(t1) - y2 + 0.5 * b * sin(t2),
+        x2 + 0.5 * b * cos(t2) - x3,
+        y2 + 0.5 * b * sin(t2) - y3,
+        t3,
+        y3,
+    ),
+)]
+#[derive(Debug, Clone, Copy)]
+pub struct SliderCrankMonolithic {
+    pub a: f64,
+    pub b: f64,
+    pub g: f64,
+}
+
 /// The four-bar's energy at positions `q` and velocities `v` (`four_bar(g, …)`'s order).
 pub fn four_bar_energy(q: &[f64], v: &[f64], g: f64) -> f64 {
     let lengths = [FOUR_BAR[0], FOUR_BAR[1], FOUR_BAR[2]];

@@ -377,6 +377,141 @@ fn an_included_chain_s_joints_step_as_its_own() {
 }
 
 #[test]
+fn the_slider_crank_steps_as_one_model_with_its_rail_and_pins() {
+    let [a, b] = mechanism::SLIDER_CRANK;
+    let (g, h) = (9.81, 0.002);
+    let mut joined = mechanism::slider_crank(g, h).unwrap();
+    let model = mechanism::SliderCrankMonolithic { a, b, g };
+    let mut one = Stepper::new(model, Quadrature::midpoint(), h).unwrap();
+    let (q0, v0) = mechanism::slider_crank_state(0.8, 3.0);
+    joined.start_from_velocity(&q0, &v0).unwrap();
+    one.start_from_velocity(
+        SVector::from_column_slice(&q0),
+        SVector::from_column_slice(&v0),
+    )
+    .unwrap();
+    let mut worst: f64 = 0.0;
+    for k in 0..2000 {
+        joined.step().unwrap();
+        one.step().unwrap();
+        worst = worst.max(distance(joined.q().as_slice(), one.q().as_slice()));
+        let q = joined.q();
+        // The slider on its rail, unturned.
+        assert!(q[7].abs() < 1e-12 && q[8].abs() < 1e-12, "step {k}");
+    }
+    // The crank has turned a full revolution: the slider went to and fro.
+    assert!(
+        joined.q()[2] > 0.8 + std::f64::consts::TAU,
+        "crank at {}",
+        joined.q()[2]
+    );
+    assert!(worst < 1e-12, "joined and one model differ by {worst:.2e}");
+}
+
+/// A body at rest on a rail through the origin along `axis` in space, its frame held parallel
+/// to space's, under gravity along `−z`: its positions and attitude over `steps` steps of `h`
+/// against the closed form `x = x₀ − ½ g (a·e_z) t² a`, `R = R₀`.
+#[test]
+fn a_body_on_a_rail_slides_as_the_closed_form() {
+    let (g, h) = (9.81, 0.01);
+    let axis = [1.0, 2.0, 2.0];
+    let a = Vector3::new(1.0, 2.0, 2.0) / 3.0;
+    let mut slider = Modular::new(Quadrature::midpoint(), h).unwrap();
+    let body = mechanism::rod_body(2.0, 1.0, g);
+    slider
+        .add_on_space("block", body, Product::cayley())
+        .unwrap();
+    let rail = Joint::prismatic(
+        "rail",
+        Anchor::fixed([0.0, 0.0, 0.0]),
+        Anchor::body("block", ["x", "y", "z"], "R", [0.0; 3]),
+        axis,
+    );
+    slider.connect(rail).unwrap();
+    let x0 = a * 0.5;
+    let identity = Matrix3::<f64>::identity();
+    let q0: Vec<f64> = x0.iter().chain(identity.iter()).copied().collect();
+    let v0 = [a[0] * 0.3, a[1] * 0.3, a[2] * 0.3, 0.0, 0.0, 0.0];
+    slider.start_from_velocity(&q0, &v0).unwrap();
+    let mut worst: f64 = 0.0;
+    for k in 1..=1000 {
+        slider.step().unwrap();
+        let t = k as f64 * h;
+        let exact = x0 + a * (0.3 * t - 0.5 * g * a[2] * t * t);
+        let q = slider.q();
+        let x = Vector3::new(q[0], q[1], q[2]);
+        worst = worst.max((x - exact).amax() / (1.0 + exact.amax()));
+        assert!((Matrix3::from_row_slice(&q.as_slice()[3..12]) - identity).amax() < 1e-14);
+    }
+    assert!(
+        worst < 1e-12,
+        "the slide is {worst:.2e} off its closed form"
+    );
+}
+
+#[test]
+fn welded_and_universally_joined_bodies_keep_their_joints_and_momenta() {
+    // Three bodies free in space: the second welded to the first, the third on a universal
+    // joint to the second; no gravity, so both momenta are conserved.
+    let (l, h) = (1.0, 0.005);
+    let mut bodies = Modular::new(Quadrature::midpoint(), h).unwrap();
+    for k in 0..3 {
+        let rod = mechanism::rod_body(1.0 + k as f64, l, 0.0);
+        bodies
+            .add_on_space(&mechanism::link(k), rod, Product::cayley())
+            .unwrap();
+    }
+    let (top, bottom) = ([0.0, 0.0, l / 2.0], [0.0, 0.0, -l / 2.0]);
+    let end = |k: usize, offset| Anchor::body(&mechanism::link(k), ["x", "y", "z"], "R", offset);
+    bodies
+        .connect(Joint::fixed("weld", end(0, bottom), end(1, top)))
+        .unwrap();
+    let cardan = Joint::universal(
+        "cardan",
+        end(1, bottom),
+        end(2, top),
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+    );
+    bodies.connect(cardan).unwrap();
+    // The first two straight and turning together, the third turning about its own axes.
+    let turn = Rotation3::new(Vector3::new(0.3, -0.4, 0.2)).into_inner();
+    let third = turn * Rotation3::new(Vector3::new(0.5, 0.0, 0.0)).into_inner();
+    let omegas = [
+        Vector3::new(0.4, -0.7, 0.9),
+        Vector3::new(0.4, -0.7, 0.9),
+        Vector3::new(0.0, 0.0, 0.0),
+    ];
+    // The third turned about the cross's first axis; its rate the second's and a spin about
+    // that axis (one of the universal joint's two freedoms), read in its axes.
+    let spin = third.transpose() * (turn * omegas[1]) + Vector3::new(1.5, 0.0, 0.0);
+    let omegas = [omegas[0], omegas[1], spin];
+    let (q0, v0) = mechanism::body_chain_state(&[turn, turn, third], &omegas, l);
+    bodies.start_from_velocity(&q0, &v0).unwrap();
+    let momenta = |b: &Modular| mechanism::bodies_momenta(b.q().as_slice(), b.p().as_slice());
+    let (linear0, angular0) = momenta(&bodies);
+    let (mut linear, mut angular): (f64, f64) = (0.0, 0.0);
+    for k in 0..2000 {
+        bodies.step().unwrap();
+        let q = bodies.q();
+        let r = |k: usize| Matrix3::from_row_slice(&q.as_slice()[12 * k + 3..12 * k + 12]);
+        // The weld: parallel frames; the universal joint: its axes perpendicular.
+        assert!((r(0) - r(1)).amax() < 1e-12, "step {k}");
+        let (u, w) = (r(1) * Vector3::x(), r(2) * Vector3::y());
+        assert!(u.dot(&w).abs() < 1e-12, "step {k}");
+        let balls = [(Some(0), bottom, 1, top), (Some(1), bottom, 2, top)];
+        assert!(ball_gaps(q.as_slice(), &balls) < 1e-12, "step {k}");
+        let (l, a) = momenta(&bodies);
+        linear = linear.max((l - linear0).amax());
+        angular = angular.max((a - angular0).amax());
+    }
+    assert!(
+        linear < 1e-12 && angular < 1e-12,
+        "momenta moved by {linear:.2e}, {angular:.2e}"
+    );
+}
+
+#[test]
 fn a_long_chain_steps_across_threads_as_on_one() {
     // Enough links for the components' passes to be split across rayon's threads.
     let n = 2500;

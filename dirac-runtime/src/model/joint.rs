@@ -5,7 +5,8 @@
 //! positions of the components it joins, `g(q^A, q^B) = 0`, with rows that are not linear in
 //! them: two points held together (a ball joint in space, a pin in the plane), two points held
 //! at a distance (a massless rod), an axis of one body held along an axis of the other (a
-//! hinge). Each end is an [`Anchor`]: a point fixed in space, a point whose coordinates are a
+//! hinge) or across it (a universal joint), two frames held parallel (a weld), or parallel
+//! with the points on a line (a slider). Each end is an [`Anchor`]: a point fixed in space, a point whose coordinates are a
 //! component's own (a point mass), or a point fixed in a body: `x + R a` for a body at `x`
 //! turned by the rotation `R`, `(x, y) + Rot(θ) a` in the plane.
 //!
@@ -149,13 +150,18 @@ impl Anchor {
         }
     }
 
-    /// Whether the anchor turns with a frame an axis can be fixed in (a body in space, or
-    /// space itself).
+    /// Whether the anchor turns with a frame an axis can be fixed in (a body, in space or in
+    /// the plane, or space itself); a point mass has none.
     fn has_axes(&self) -> bool {
-        match &self.place {
-            Place::Fixed(p) => p.len() == 3,
-            Place::Body { .. } => true,
-            Place::Point { .. } | Place::Planar { .. } => false,
+        !matches!(self.place, Place::Point { .. })
+    }
+
+    /// Its frame's angle in the plane (0 for a fixed anchor), with its derivative.
+    fn angle(&self, q: &[f64], at: &[usize], angle: &mut Carried) {
+        *angle = Carried::default();
+        if let Place::Planar { .. } = self.place {
+            angle.value[0] = q[at[2]];
+            angle.push(0, (at[2], 1.0));
         }
     }
 
@@ -195,7 +201,8 @@ impl Anchor {
         }
     }
 
-    /// The axis `axis` (in the anchor's frame) at the positions `q`, with its derivatives.
+    /// The axis `axis` (in the anchor's frame; its first two numbers in the plane) at the
+    /// positions `q`, with its derivatives.
     fn axis(&self, q: &[f64], at: &[usize], axis: &[f64; 3], turned: &mut Carried) {
         *turned = Carried::default();
         match &self.place {
@@ -208,7 +215,15 @@ impl Anchor {
                     }
                 }
             }
-            _ => turned.value = *axis,
+            Place::Planar { .. } => {
+                let (s, c) = q[at[2]].sin_cos();
+                let [a, b] = [axis[0], axis[1]];
+                turned.value[0] = c * a - s * b;
+                turned.value[1] = s * a + c * b;
+                turned.push(0, (at[2], -s * a - c * b));
+                turned.push(1, (at[2], c * a - s * b));
+            }
+            Place::Fixed(_) | Place::Point { .. } => turned.value = *axis,
         }
     }
 }
@@ -244,6 +259,12 @@ enum Kind {
     Rod(f64),
     /// The points coincide and the axes (each in its end's frame) stay parallel.
     Revolute([f64; 3], [f64; 3]),
+    /// The points coincide and the axes (each in its end's frame) stay perpendicular.
+    Universal([f64; 3], [f64; 3]),
+    /// The points coincide and the frames stay parallel.
+    Fixed,
+    /// The frames stay parallel and the points on a line along this axis of `a`'s frame.
+    Prismatic([f64; 3]),
 }
 
 /// A holonomic junction between two [`Anchor`]s (see the [module](self)).
@@ -274,6 +295,33 @@ impl Joint {
         Self::new(name, Kind::Revolute(axis_a, axis_b), a, b)
     }
 
+    /// A universal joint (a Cardan joint) in space: the points coincide and the axis `axis_a`
+    /// of `a`'s frame stays perpendicular to the axis `axis_b` of `b`'s: four rows.
+    pub fn universal(name: &str, a: Anchor, b: Anchor, axis_a: [f64; 3], axis_b: [f64; 3]) -> Self {
+        Self::new(name, Kind::Universal(axis_a, axis_b), a, b)
+    }
+
+    /// Welds the ends: the points coincide and `b`'s frame stays parallel to `a`'s (bodies
+    /// welded in another attitude give their axes so that they are parallel where joined). In
+    /// space six rows, the last three `(R_a e_x)·(R_b e_y)`, `(R_a e_x)·(R_b e_z)`,
+    /// `(R_a e_y)·(R_b e_z)`; in the plane three, the last `θ_b − θ_a`.
+    pub fn fixed(name: &str, a: Anchor, b: Anchor) -> Self {
+        Self::new(name, Kind::Fixed, a, b)
+    }
+
+    /// A slider: `b`'s frame stays parallel to `a`'s and `b`'s point on the line through
+    /// `a`'s along `axis` (in `a`'s frame; two numbers in the plane). In space five rows, the
+    /// frames' three and `(r_b − r_a)·(R_a n_k)` for two `n_k` perpendicular to the axis; in
+    /// the plane two, `θ_b − θ_a` and `(r_b − r_a)·Rot(θ_a) n`.
+    pub fn prismatic<const D: usize>(name: &str, a: Anchor, b: Anchor, axis: [f64; D]) -> Self {
+        let mut padded = [0.0; 3];
+        for (p, x) in padded.iter_mut().zip(axis) {
+            *p = x;
+        }
+        let axis = if D <= 3 { padded } else { [f64::NAN; 3] };
+        Self::new(name, Kind::Prismatic(axis), a, b)
+    }
+
     fn new(name: &str, kind: Kind, a: Anchor, b: Anchor) -> Self {
         Self {
             name: name.into(),
@@ -299,10 +347,16 @@ impl Joint {
 
     /// The number of its rows (of multipliers).
     pub fn rows(&self) -> usize {
+        let d = self.ends[0].dimension();
         match self.kind {
-            Kind::Spherical => self.ends[0].dimension(),
+            Kind::Spherical => d,
             Kind::Rod(_) => 1,
             Kind::Revolute(..) => 5,
+            Kind::Universal(..) => 4,
+            Kind::Fixed if d == 3 => 6,
+            Kind::Fixed => 3,
+            Kind::Prismatic(_) if d == 3 => 5,
+            Kind::Prismatic(_) => 2,
         }
     }
 
@@ -344,23 +398,33 @@ impl Joint {
                 "its ends lie in spaces of dimension {da} and {db}: both must be 2 or both 3"
             ));
         }
+        let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let axis = |v: &[f64; 3]| norm(v).is_finite() && norm(v) > 0.0;
+        let framed = a.has_axes() && b.has_axes();
         match &self.kind {
             Kind::Rod(length) if !(length.is_finite() && *length > 0.0) => {
                 invalid(format!("the length {length} is not positive and finite"))
             }
-            Kind::Revolute(u, w) => {
-                if !(a.has_axes() && b.has_axes()) {
+            Kind::Revolute(u, w) | Kind::Universal(u, w) => {
+                if !(framed && da == 3) {
                     return invalid(
-                        "a hinge needs both ends turning with a frame in space (a body, or \
-                         fixed); in the plane a pin is a spherical joint"
+                        "a hinge or a universal joint needs both ends turning with a frame in \
+                         space (a body, or fixed); in the plane a pin is a spherical joint"
                             .into(),
                     );
                 }
-                let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-                if !(norm(u).is_finite() && norm(u) > 0.0 && norm(w).is_finite() && norm(w) > 0.0) {
+                if !(axis(u) && axis(w)) {
                     return invalid("an axis that is zero or not finite".into());
                 }
                 Ok(())
+            }
+            Kind::Fixed | Kind::Prismatic(_) if !framed => invalid(
+                "a weld or a slider needs both ends turning with a frame (a body in space or in \
+                 the plane, or fixed), not a point mass"
+                    .into(),
+            ),
+            Kind::Prismatic(u) if !axis(u) => {
+                invalid("an axis that is zero or not finite (or of more than 3 numbers)".into())
             }
             _ => Ok(()),
         }
@@ -388,7 +452,7 @@ impl Joint {
             terms.extend(carried.terms(i).iter().map(|&(p, a)| (row, end, p, s * a)));
         };
         match &self.kind {
-            Kind::Spherical | Kind::Revolute(..) => {
+            Kind::Spherical | Kind::Revolute(..) | Kind::Universal(..) | Kind::Fixed => {
                 for (i, row) in value.iter_mut().enumerate().take(d) {
                     *row = ra.value[i] - rb.value[i];
                     size = size.max(ra.value[i].abs()).max(rb.value[i].abs());
@@ -406,23 +470,92 @@ impl Joint {
                     add(terms, 0, 1, &rb, i, -ri / length);
                 }
             }
+            Kind::Prismatic(_) => {}
         }
-        if let Kind::Revolute(axis_a, axis_b) = &self.kind {
+        // Row `row` = u · w, `u` carried by end 0 and `w` by end 1.
+        let dot = |terms: &mut Vec<_>, value: &mut [f64], row: usize, u: &Carried, w: &Carried| {
+            value[row] = (0..3).map(|i| u.value[i] * w.value[i]).sum();
+            for i in 0..3 {
+                add(terms, row, 0, u, i, w.value[i]);
+                add(terms, row, 1, w, i, u.value[i]);
+            }
+        };
+        let (mut u, mut w) = (Carried::default(), Carried::default());
+        // The frames held parallel: three dots of their axes in space, the angle in the plane.
+        let parallel = |terms: &mut Vec<_>, value: &mut [f64], first: usize| {
             let (mut u, mut w) = (Carried::default(), Carried::default());
-            self.ends[0].axis(qa, &at[0], axis_a, &mut u);
-            for (k, perpendicular) in perpendiculars(axis_b).iter().enumerate() {
-                self.ends[1].axis(qb, &at[1], perpendicular, &mut w);
-                let row = 3 + k;
-                value[row] = (0..3).map(|i| u.value[i] * w.value[i]).sum();
-                for i in 0..3 {
-                    add(terms, row, 0, &u, i, w.value[i]);
-                    add(terms, row, 1, &w, i, u.value[i]);
+            if d == 3 {
+                let e = |k: usize| std::array::from_fn(|i| if i == k { 1.0 } else { 0.0 });
+                for (row, (i, j)) in [(0, 1), (0, 2), (1, 2)].into_iter().enumerate() {
+                    self.ends[0].axis(qa, &at[0], &e(i), &mut u);
+                    self.ends[1].axis(qb, &at[1], &e(j), &mut w);
+                    dot(terms, value, first + row, &u, &w);
+                }
+            } else {
+                self.ends[0].angle(qa, &at[0], &mut u);
+                self.ends[1].angle(qb, &at[1], &mut w);
+                value[first] = w.value[0] - u.value[0];
+                add(terms, first, 0, &u, 0, -1.0);
+                add(terms, first, 1, &w, 0, 1.0);
+            }
+        };
+        match &self.kind {
+            Kind::Revolute(axis_a, axis_b) => {
+                self.ends[0].axis(qa, &at[0], axis_a, &mut u);
+                for (k, perpendicular) in perpendiculars(axis_b).iter().enumerate() {
+                    self.ends[1].axis(qb, &at[1], perpendicular, &mut w);
+                    dot(terms, value, 3 + k, &u, &w);
                 }
                 size = size.max(1.0);
             }
+            Kind::Universal(axis_a, axis_b) => {
+                self.ends[0].axis(qa, &at[0], &unit(axis_a), &mut u);
+                self.ends[1].axis(qb, &at[1], &unit(axis_b), &mut w);
+                dot(terms, value, 3, &u, &w);
+                size = size.max(1.0);
+            }
+            Kind::Fixed => {
+                parallel(terms, value, d);
+                size = size.max(1.0);
+            }
+            Kind::Prismatic(axis) => {
+                // The frames, then the offset across the axis (read in `a`'s frame).
+                parallel(terms, value, 0);
+                let first = if d == 3 { 3 } else { 1 };
+                let across: Vec<[f64; 3]> = if d == 3 {
+                    perpendiculars(axis).to_vec()
+                } else {
+                    let n = unit(axis);
+                    vec![[-n[1], n[0], 0.0]]
+                };
+                let r: [f64; 3] = std::array::from_fn(|i| rb.value[i] - ra.value[i]);
+                for (k, n) in across.iter().enumerate() {
+                    let row = first + k;
+                    self.ends[0].axis(qa, &at[0], n, &mut u);
+                    value[row] = (0..d).map(|i| r[i] * u.value[i]).sum();
+                    for i in 0..d {
+                        add(terms, row, 1, &rb, i, u.value[i]);
+                        add(terms, row, 0, &ra, i, -u.value[i]);
+                        add(terms, row, 0, &u, i, r[i]);
+                    }
+                }
+                size = size.max(
+                    ra.value
+                        .iter()
+                        .chain(&rb.value)
+                        .fold(1.0, |m, x| m.max(x.abs())),
+                );
+            }
+            Kind::Spherical | Kind::Rod(_) => {}
         }
         size
     }
+}
+
+/// `v` scaled to unit length.
+fn unit(v: &[f64; 3]) -> [f64; 3] {
+    let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    v.map(|x| x / norm)
 }
 
 /// Two unit vectors perpendicular to `axis` and to each other.
@@ -490,6 +623,55 @@ mod tests {
                 vec![0.2, 0.5, 1.1],
                 vec![],
             ),
+            (
+                Joint::universal(
+                    "cardan",
+                    Anchor::body("a", ["x", "y", "z"], "R", [0.1, 0.2, 0.5]),
+                    Anchor::body("b", ["x", "y", "z"], "R", [0.0, -0.3, 0.2]),
+                    [1.0, 0.5, 0.0],
+                    [0.0, 1.0, 1.0],
+                ),
+                body.to_vec(),
+                body.iter().rev().copied().collect::<Vec<f64>>(),
+            ),
+            (
+                Joint::fixed(
+                    "weld",
+                    Anchor::body("a", ["x", "y", "z"], "R", [0.1, 0.2, 0.5]),
+                    Anchor::body("b", ["x", "y", "z"], "R", [0.0, -0.3, 0.2]),
+                ),
+                body.to_vec(),
+                body.iter().rev().copied().collect::<Vec<f64>>(),
+            ),
+            (
+                Joint::prismatic(
+                    "slider",
+                    Anchor::body("a", ["x", "y", "z"], "R", [0.1, 0.2, 0.5]),
+                    Anchor::body("b", ["x", "y", "z"], "R", [0.0, -0.3, 0.2]),
+                    [0.3, -1.0, 0.4],
+                ),
+                body.to_vec(),
+                body.iter().rev().copied().collect::<Vec<f64>>(),
+            ),
+            (
+                Joint::prismatic(
+                    "planar slider",
+                    Anchor::planar("a", ["x", "y"], "t", [0.4, -0.1]),
+                    Anchor::planar("b", ["x", "y"], "t", [-0.2, 0.3]),
+                    [1.0, 2.0],
+                ),
+                vec![0.2, 0.5, 1.1],
+                vec![-0.3, 0.8, -0.6],
+            ),
+            (
+                Joint::fixed(
+                    "planar weld",
+                    Anchor::fixed([0.3, 0.1]),
+                    Anchor::planar("b", ["x", "y"], "t", [-0.2, 0.3]),
+                ),
+                vec![],
+                vec![-0.3, 0.8, -0.6],
+            ),
         ];
         for (joint, qa, qb) in cases {
             joint.check().unwrap();
@@ -551,7 +733,22 @@ mod tests {
             ),
             (
                 Joint::revolute("no axes", fixed(), mass(), [1.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
-                "a hinge needs both ends turning",
+                "a hinge or a universal joint needs both ends turning",
+            ),
+            (
+                Joint::revolute(
+                    "planar",
+                    planar(),
+                    planar(),
+                    [1.0, 0.0, 0.0],
+                    [1.0, 0.0, 0.0],
+                ),
+                "in the plane a pin is a spherical joint",
+            ),
+            (Joint::fixed("weld", mass(), body()), "not a point mass"),
+            (
+                Joint::prismatic("slider", body(), body(), [0.0, 0.0, 0.0]),
+                "an axis that is zero",
             ),
             (
                 Joint::revolute("zero axis", fixed(), body(), [0.0; 3], [1.0, 0.0, 0.0]),
