@@ -804,7 +804,8 @@ impl<J: Jacobian> Newton<J> {
                 // the measured unknowns' whether the iteration contracts toward its root.
                 let chord = update / full;
                 let ratio = measured / before;
-                if !current && chord > options.max_contraction && update > self::round_off(x_max) {
+                let slow = chord.max(ratio) > options.max_contraction;
+                if !current && slow && update > self::round_off(x_max) {
                     // An older Jacobian does not contract: evaluate it here and start the
                     // measurement again.
                     at_x = self.refresh(x, evaluate)?;
