@@ -512,6 +512,28 @@ fn welded_and_universally_joined_bodies_keep_their_joints_and_momenta() {
 }
 
 #[test]
+fn a_chain_stepped_with_kept_jacobians_reaches_newton_s_roots() {
+    // A Jacobian kept from an earlier step is evaluated anew where the positions' updates stop
+    // contracting (not refused: the iteration, not the step, was slow).
+    let n = 10;
+    let theta = vec![std::f64::consts::FRAC_PI_2; n];
+    let (q0, v0) = mechanism::point_chain_state(&theta, &vec![0.0; n], 1.0);
+    let mut ends = Vec::new();
+    for reuse in [None, Some(0.25)] {
+        let options = NewtonOptions {
+            jacobian_reuse: reuse,
+            ..Default::default()
+        };
+        let chain = mechanism::point_chain(n, 1.0, 1.0, 9.81, 0.01).unwrap();
+        let mut chain = chain.with_newton_options(options).unwrap();
+        chain.start_from_velocity(&q0, &v0).unwrap();
+        chain.run(400).unwrap();
+        ends.push(chain.q());
+    }
+    assert!(distance(ends[0].as_slice(), ends[1].as_slice()) < 1e-12);
+}
+
+#[test]
 fn a_long_chain_steps_across_threads_as_on_one() {
     // Enough links for the components' passes to be split across rayon's threads.
     let n = 2500;
