@@ -156,97 +156,121 @@ impl Anchor {
         !matches!(self.place, Place::Point { .. })
     }
 
-    /// Its frame's angle in the plane (0 for a fixed anchor), with its derivative.
-    fn angle(&self, q: &[f64], at: &[usize], angle: &mut Carried) {
-        *angle = Carried::default();
-        if let Place::Planar { .. } = self.place {
-            angle.value[0] = q[at[2]];
-            angle.push(0, (at[2], 1.0));
-        }
-    }
-
-    /// The point at the positions `q` of its component (`at`: the indices of
-    /// [`position_names`](Self::position_names) in `q`), with its derivatives.
-    pub(crate) fn evaluate(&self, q: &[f64], at: &[usize], point: &mut Carried) {
-        *point = Carried::default();
-        match &self.place {
-            Place::Fixed(p) => point.value[..p.len()].copy_from_slice(p),
-            Place::Point { origin, .. } => {
+    /// What it carries at the positions `q` of its component (`at`: the indices of
+    /// [`position_names`](Self::position_names) in `q`): its point, an axis of its frame, or its
+    /// frame's angle in the plane.
+    fn carry<'a>(&'a self, q: &'a [f64], at: &'a [usize], what: Carrier) -> Carried<'a> {
+        let mut value = [0.0; 3];
+        match (&self.place, what) {
+            (Place::Fixed(p), Carrier::Point) => value[..p.len()].copy_from_slice(p),
+            (Place::Point { origin, .. }, Carrier::Point) => {
                 for i in 0..origin.len() {
-                    point.value[i] = q[at[i]];
-                    point.push(i, (at[i], 1.0));
+                    value[i] = q[at[i]];
                 }
             }
-            Place::Body { offset, .. } => {
-                for i in 0..3 {
-                    point.value[i] = q[at[i]];
-                    point.push(i, (at[i], 1.0));
-                    for l in 0..3 {
-                        let entry = at[3 + 3 * i + l];
-                        point.value[i] += q[entry] * offset[l];
-                        point.push(i, (entry, offset[l]));
-                    }
+            (Place::Body { offset, .. }, Carrier::Point) => {
+                for (i, v) in value.iter_mut().enumerate() {
+                    *v = q[at[i]]
+                        + (0..3)
+                            .map(|l| q[at[3 + 3 * i + l]] * offset[l])
+                            .sum::<f64>();
                 }
             }
-            Place::Planar { offset, .. } => {
+            (Place::Planar { offset, .. }, Carrier::Point) => {
                 let (s, c) = q[at[2]].sin_cos();
                 let [a, b] = *offset;
-                point.value[0] = q[at[0]] + c * a - s * b;
-                point.value[1] = q[at[1]] + s * a + c * b;
-                point.push(0, (at[0], 1.0));
-                point.push(0, (at[2], -s * a - c * b));
-                point.push(1, (at[1], 1.0));
-                point.push(1, (at[2], c * a - s * b));
+                value[0] = q[at[0]] + c * a - s * b;
+                value[1] = q[at[1]] + s * a + c * b;
             }
-        }
-    }
-
-    /// The axis `axis` (in the anchor's frame; its first two numbers in the plane) at the
-    /// positions `q`, with its derivatives.
-    fn axis(&self, q: &[f64], at: &[usize], axis: &[f64; 3], turned: &mut Carried) {
-        *turned = Carried::default();
-        match &self.place {
-            Place::Body { .. } => {
-                for i in 0..3 {
-                    for l in 0..3 {
-                        let entry = at[3 + 3 * i + l];
-                        turned.value[i] += q[entry] * axis[l];
-                        turned.push(i, (entry, axis[l]));
-                    }
+            (Place::Body { .. }, Carrier::Axis(axis)) => {
+                for (i, v) in value.iter_mut().enumerate() {
+                    *v = (0..3).map(|l| q[at[3 + 3 * i + l]] * axis[l]).sum();
                 }
             }
-            Place::Planar { .. } => {
+            (Place::Planar { .. }, Carrier::Axis(axis)) => {
                 let (s, c) = q[at[2]].sin_cos();
-                let [a, b] = [axis[0], axis[1]];
-                turned.value[0] = c * a - s * b;
-                turned.value[1] = s * a + c * b;
-                turned.push(0, (at[2], -s * a - c * b));
-                turned.push(1, (at[2], c * a - s * b));
+                value[0] = c * axis[0] - s * axis[1];
+                value[1] = s * axis[0] + c * axis[1];
             }
-            Place::Fixed(_) | Place::Point { .. } => turned.value = *axis,
+            (_, Carrier::Axis(axis)) => value = axis,
+            (Place::Planar { .. }, Carrier::Angle) => value[0] = q[at[2]],
+            (_, Carrier::Angle) => {}
+        }
+        Carried {
+            anchor: self,
+            q,
+            at,
+            what,
+            value,
         }
     }
 }
 
-/// A vector of up to 3 numbers and its derivatives in its component's positions:
-/// `terms[i][..len[i]]` lists `(position, ∂value_i/∂position)` (at most 4: an origin's
-/// coordinate and a rotation's row).
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Carried {
-    pub value: [f64; 3],
-    terms: [[(usize, f64); 4]; 3],
-    len: [usize; 3],
+/// What an end carries (see [`Anchor::carry`]).
+#[derive(Debug, Clone, Copy)]
+enum Carrier {
+    Point,
+    Axis([f64; 3]),
+    Angle,
 }
 
-impl Carried {
-    fn push(&mut self, i: usize, term: (usize, f64)) {
-        self.terms[i][self.len[i]] = term;
-        self.len[i] += 1;
-    }
+/// A vector of up to 3 numbers an end carries at its component's positions, its derivatives
+/// read on demand.
+#[derive(Debug, Clone, Copy)]
+struct Carried<'a> {
+    anchor: &'a Anchor,
+    q: &'a [f64],
+    at: &'a [usize],
+    what: Carrier,
+    value: [f64; 3],
+}
 
-    /// The derivatives of entry `i`.
-    pub fn terms(&self, i: usize) -> &[(usize, f64)] {
-        &self.terms[i][..self.len[i]]
+impl Carried<'_> {
+    /// `each(position, ∂value_i/∂position)` for the positions entry `i` depends on.
+    #[inline]
+    fn terms(&self, i: usize, mut each: impl FnMut(usize, f64)) {
+        let (q, at) = (self.q, self.at);
+        match (&self.anchor.place, self.what) {
+            (Place::Point { .. }, Carrier::Point) => each(at[i], 1.0),
+            (Place::Body { offset, .. }, Carrier::Point) => {
+                each(at[i], 1.0);
+                for (l, a) in offset.iter().enumerate() {
+                    each(at[3 + 3 * i + l], *a);
+                }
+            }
+            (Place::Body { .. }, Carrier::Axis(axis)) => {
+                for (l, a) in axis.iter().enumerate() {
+                    each(at[3 + 3 * i + l], *a);
+                }
+            }
+            (Place::Planar { offset, .. }, Carrier::Point) => {
+                let (s, c) = q[at[2]].sin_cos();
+                let [a, b] = *offset;
+                each(at[i], 1.0);
+                each(
+                    at[2],
+                    if i == 0 {
+                        -s * a - c * b
+                    } else {
+                        c * a - s * b
+                    },
+                );
+            }
+            (Place::Planar { .. }, Carrier::Axis(axis)) => {
+                let (s, c) = q[at[2]].sin_cos();
+                let [a, b] = [axis[0], axis[1]];
+                each(
+                    at[2],
+                    if i == 0 {
+                        -s * a - c * b
+                    } else {
+                        c * a - s * b
+                    },
+                );
+            }
+            (Place::Planar { .. }, Carrier::Angle) if i == 0 => each(at[2], 1.0),
+            _ => {}
+        }
     }
 }
 
@@ -432,123 +456,129 @@ impl Joint {
 
     /// Its rows at the positions `qa`, `qb` of its ends' components (`at`: the indices of each
     /// anchor's [`position_names`](Anchor::position_names)): the values into `value`, the
-    /// derivatives as `(row, end, position, ∂)` into `terms` (cleared first); the size of the
-    /// terms the rows sum.
+    /// derivatives by `add(row, end, position, ∂)`; the size of the terms the rows sum.
     pub(crate) fn evaluate(
         &self,
         (qa, qb): (&[f64], &[f64]),
         at: &[Vec<usize>; 2],
         value: &mut [f64],
-        terms: &mut Vec<(usize, usize, usize, f64)>,
+        add: impl FnMut(usize, usize, usize, f64),
     ) -> f64 {
-        terms.clear();
-        let (mut ra, mut rb) = (Carried::default(), Carried::default());
-        self.ends[0].evaluate(qa, &at[0], &mut ra);
-        self.ends[1].evaluate(qb, &at[1], &mut rb);
-        let d = self.ends[0].dimension();
+        let [a, b] = &self.ends;
+        let d = a.dimension();
+        let mut rows = Rows { value, add, d };
+        let carry = |end: usize, what| {
+            let (anchor, q) = if end == 0 { (a, qa) } else { (b, qb) };
+            anchor.carry(q, &at[end], what)
+        };
+        let axis = Carrier::Axis;
+        let (ra, rb) = (carry(0, Carrier::Point), carry(1, Carrier::Point));
         let mut size: f64 = 0.0;
-        // Row `row` += s · (vector i of `carried` at end `end`)'s derivatives.
-        let add = |terms: &mut Vec<_>, row: usize, end: usize, carried: &Carried, i: usize, s| {
-            terms.extend(carried.terms(i).iter().map(|&(p, a)| (row, end, p, s * a)));
+        // The frames held parallel from row `first`: three dots of their axes in space, the
+        // angle in the plane.
+        let parallel = |rows: &mut Rows<'_, _>, first: usize| {
+            if d == 3 {
+                let e = |k: usize| std::array::from_fn(|i| if i == k { 1.0 } else { 0.0 });
+                for (row, (i, j)) in [(0, 1), (0, 2), (1, 2)].into_iter().enumerate() {
+                    rows.dot(first + row, &carry(0, axis(e(i))), &carry(1, axis(e(j))));
+                }
+            } else {
+                let (u, w) = (carry(0, Carrier::Angle), carry(1, Carrier::Angle));
+                rows.value[first] = w.value[0] - u.value[0];
+                rows.with(first, 0, &u, 0, -1.0);
+                rows.with(first, 1, &w, 0, 1.0);
+            }
         };
         match &self.kind {
             Kind::Spherical | Kind::Revolute(..) | Kind::Universal(..) | Kind::Fixed => {
-                for (i, row) in value.iter_mut().enumerate().take(d) {
-                    *row = ra.value[i] - rb.value[i];
+                for i in 0..d {
+                    rows.value[i] = ra.value[i] - rb.value[i];
                     size = size.max(ra.value[i].abs()).max(rb.value[i].abs());
-                    add(terms, i, 0, &ra, i, 1.0);
-                    add(terms, i, 1, &rb, i, -1.0);
+                    rows.with(i, 0, &ra, i, 1.0);
+                    rows.with(i, 1, &rb, i, -1.0);
                 }
             }
             Kind::Rod(length) => {
                 let r: [f64; 3] = std::array::from_fn(|i| ra.value[i] - rb.value[i]);
                 let squared: f64 = r.iter().map(|x| x * x).sum();
-                value[0] = (squared - length * length) / (2.0 * length);
+                rows.value[0] = (squared - length * length) / (2.0 * length);
                 size = (squared + length * length) / (2.0 * length);
                 for (i, ri) in r.iter().enumerate().take(d) {
-                    add(terms, 0, 0, &ra, i, ri / length);
-                    add(terms, 0, 1, &rb, i, -ri / length);
+                    rows.with(0, 0, &ra, i, ri / length);
+                    rows.with(0, 1, &rb, i, -ri / length);
                 }
             }
             Kind::Prismatic(_) => {}
         }
-        // Row `row` = u · w, `u` carried by end 0 and `w` by end 1.
-        let dot = |terms: &mut Vec<_>, value: &mut [f64], row: usize, u: &Carried, w: &Carried| {
-            value[row] = (0..3).map(|i| u.value[i] * w.value[i]).sum();
-            for i in 0..3 {
-                add(terms, row, 0, u, i, w.value[i]);
-                add(terms, row, 1, w, i, u.value[i]);
-            }
-        };
-        let (mut u, mut w) = (Carried::default(), Carried::default());
-        // The frames held parallel: three dots of their axes in space, the angle in the plane.
-        let parallel = |terms: &mut Vec<_>, value: &mut [f64], first: usize| {
-            let (mut u, mut w) = (Carried::default(), Carried::default());
-            if d == 3 {
-                let e = |k: usize| std::array::from_fn(|i| if i == k { 1.0 } else { 0.0 });
-                for (row, (i, j)) in [(0, 1), (0, 2), (1, 2)].into_iter().enumerate() {
-                    self.ends[0].axis(qa, &at[0], &e(i), &mut u);
-                    self.ends[1].axis(qb, &at[1], &e(j), &mut w);
-                    dot(terms, value, first + row, &u, &w);
-                }
-            } else {
-                self.ends[0].angle(qa, &at[0], &mut u);
-                self.ends[1].angle(qb, &at[1], &mut w);
-                value[first] = w.value[0] - u.value[0];
-                add(terms, first, 0, &u, 0, -1.0);
-                add(terms, first, 1, &w, 0, 1.0);
-            }
-        };
         match &self.kind {
             Kind::Revolute(axis_a, axis_b) => {
-                self.ends[0].axis(qa, &at[0], axis_a, &mut u);
+                let u = carry(0, axis(*axis_a));
                 for (k, perpendicular) in perpendiculars(axis_b).iter().enumerate() {
-                    self.ends[1].axis(qb, &at[1], perpendicular, &mut w);
-                    dot(terms, value, 3 + k, &u, &w);
+                    rows.dot(3 + k, &u, &carry(1, axis(*perpendicular)));
                 }
                 size = size.max(1.0);
             }
             Kind::Universal(axis_a, axis_b) => {
-                self.ends[0].axis(qa, &at[0], &unit(axis_a), &mut u);
-                self.ends[1].axis(qb, &at[1], &unit(axis_b), &mut w);
-                dot(terms, value, 3, &u, &w);
+                let (u, w) = (carry(0, axis(unit(axis_a))), carry(1, axis(unit(axis_b))));
+                rows.dot(3, &u, &w);
                 size = size.max(1.0);
             }
             Kind::Fixed => {
-                parallel(terms, value, d);
+                parallel(&mut rows, d);
                 size = size.max(1.0);
             }
-            Kind::Prismatic(axis) => {
+            Kind::Prismatic(along) => {
                 // The frames, then the offset across the axis (read in `a`'s frame).
-                parallel(terms, value, 0);
+                parallel(&mut rows, 0);
                 let first = if d == 3 { 3 } else { 1 };
                 let across: Vec<[f64; 3]> = if d == 3 {
-                    perpendiculars(axis).to_vec()
+                    perpendiculars(along).to_vec()
                 } else {
-                    let n = unit(axis);
+                    let n = unit(along);
                     vec![[-n[1], n[0], 0.0]]
                 };
                 let r: [f64; 3] = std::array::from_fn(|i| rb.value[i] - ra.value[i]);
                 for (k, n) in across.iter().enumerate() {
                     let row = first + k;
-                    self.ends[0].axis(qa, &at[0], n, &mut u);
-                    value[row] = (0..d).map(|i| r[i] * u.value[i]).sum();
+                    let u = carry(0, axis(*n));
+                    rows.value[row] = (0..d).map(|i| r[i] * u.value[i]).sum();
                     for i in 0..d {
-                        add(terms, row, 1, &rb, i, u.value[i]);
-                        add(terms, row, 0, &ra, i, -u.value[i]);
-                        add(terms, row, 0, &u, i, r[i]);
+                        rows.with(row, 1, &rb, i, u.value[i]);
+                        rows.with(row, 0, &ra, i, -u.value[i]);
+                        rows.with(row, 0, &u, i, r[i]);
                     }
                 }
-                size = size.max(
-                    ra.value
-                        .iter()
-                        .chain(&rb.value)
-                        .fold(1.0, |m, x| m.max(x.abs())),
-                );
+                let biggest = ra.value.iter().chain(&rb.value);
+                size = size.max(biggest.fold(1.0, |m, x| m.max(x.abs())));
             }
             Kind::Spherical | Kind::Rod(_) => {}
         }
         size
+    }
+}
+
+/// A joint's rows as they are written: their values and, through `add(row, end, position, ∂)`,
+/// their derivatives; `d` the dimension of the space the ends lie in.
+struct Rows<'v, F> {
+    value: &'v mut [f64],
+    add: F,
+    d: usize,
+}
+
+impl<F: FnMut(usize, usize, usize, f64)> Rows<'_, F> {
+    /// Row `row` gains `s` times the derivatives of entry `i` of what end `end` carries.
+    fn with(&mut self, row: usize, end: usize, carried: &Carried, i: usize, s: f64) {
+        let add = &mut self.add;
+        carried.terms(i, |p, x| add(row, end, p, s * x));
+    }
+
+    /// Row `row` is `u · w`, `u` carried by end 0 and `w` by end 1.
+    fn dot(&mut self, row: usize, u: &Carried, w: &Carried) {
+        self.value[row] = (0..3).map(|i| u.value[i] * w.value[i]).sum();
+        for i in 0..self.d {
+            self.with(row, 0, u, i, w.value[i]);
+            self.with(row, 1, w, i, u.value[i]);
+        }
     }
 }
 
@@ -681,7 +711,8 @@ mod tests {
             ];
             let rows = joint.rows();
             let (mut value, mut terms) = (vec![0.0; rows], Vec::new());
-            joint.evaluate((&qa, &qb), &at, &mut value, &mut terms);
+            let add = |row, end, position, a| terms.push((row, end, position, a));
+            joint.evaluate((&qa, &qb), &at, &mut value, add);
             for end in 0..2 {
                 let n = [qa.len(), qb.len()][end];
                 for p in 0..n {
@@ -690,7 +721,7 @@ mod tests {
                         let (mut a, mut b) = (qa.clone(), qb.clone());
                         [&mut a, &mut b][end][p] += sign * h;
                         let mut v = vec![0.0; rows];
-                        joint.evaluate((&a, &b), &at, &mut v, &mut Vec::new());
+                        joint.evaluate((&a, &b), &at, &mut v, |_, _, _, _| {});
                         v
                     };
                     let (up, down) = (moved(1.0), moved(-1.0));

@@ -171,13 +171,12 @@ struct JointRows {
 }
 
 /// A joint's rows at a point of its components (each end's positions and their derivatives in
-/// its chart, the rows' derivatives in the positions, as scratch), their values and each end's
-/// derivatives in its chart (rows × the component's coordinates).
+/// its chart, as scratch), their values and each end's derivatives in its chart (rows × the
+/// component's coordinates).
 #[derive(Debug, Clone)]
 struct JointRead {
     positions: [Vec<f64>; 2],
     derivatives: [DMatrix<f64>; 2],
-    terms: Vec<(usize, usize, usize, f64)>,
     values: Vec<f64>,
     chart: [DMatrix<f64>; 2],
 }
@@ -754,7 +753,6 @@ impl Modular {
         let read = JointRead {
             positions: [vec![0.0; pa.0], vec![0.0; pb.0]],
             derivatives: [DMatrix::zeros(pa.0, pa.1), DMatrix::zeros(pb.0, pb.1)],
-            terms: Vec::new(),
             values: vec![0.0; k],
             chart: [DMatrix::zeros(k, pa.1), DMatrix::zeros(k, pb.1)],
         };
@@ -1761,17 +1759,17 @@ fn joint_value<'q>(
         }
     }
     let positions = (&read.positions[0][..], &read.positions[1][..]);
-    let size = rows
-        .joint
-        .evaluate(positions, &rows.at, &mut read.values, &mut read.terms);
     read.chart.iter_mut().for_each(|c| c.fill(0.0));
-    for &(row, end, position, a) in &read.terms {
-        let d = &read.derivatives[end];
+    let (chart, derivatives) = (&mut read.chart, &read.derivatives);
+    // ∂g/∂ξ = ∂g/∂q · ∂q/∂ξ, a position's term at a time.
+    let add = |row: usize, end: usize, position: usize, a: f64| {
+        let d = &derivatives[end];
         for i in 0..d.ncols() {
-            read.chart[end][(row, i)] += a * d[(position, i)];
+            chart[end][(row, i)] += a * d[(position, i)];
         }
-    }
-    size
+    };
+    rows.joint
+        .evaluate(positions, &rows.at, &mut read.values, add)
 }
 
 /// The joints' rows read at the positions `q` (every component's, in the order of
