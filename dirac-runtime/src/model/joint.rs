@@ -542,10 +542,10 @@ impl Joint {
                     let row = first + k;
                     let u = carry(0, axis(*n));
                     rows.value[row] = (0..d).map(|i| r[i] * u.value[i]).sum();
-                    for i in 0..d {
+                    for (i, ri) in r.iter().enumerate().take(d) {
                         rows.with(row, 1, &rb, i, u.value[i]);
                         rows.with(row, 0, &ra, i, -u.value[i]);
-                        rows.with(row, 0, &u, i, r[i]);
+                        rows.with(row, 0, &u, i, *ri);
                     }
                 }
                 let biggest = ra.value.iter().chain(&rb.value);
