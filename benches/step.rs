@@ -90,28 +90,38 @@ fn chain_step<const L: usize>(
             SVector::zeros(),
         )
         .expect("finite start");
-    let stretch = 200.max(4000 / L) as u64;
     group.bench_with_input(BenchmarkId::from_parameter(L), &L, |b, _| {
-        b.iter_custom(|iterations| {
-            let runs = iterations.div_ceil(stretch);
-            let mut total = Duration::ZERO;
-            for _ in 0..runs {
-                let mut stepper = started.clone();
-                let clock = Instant::now();
-                for _ in 0..stretch {
-                    black_box(stepper.step()).expect("step");
-                }
-                total += clock.elapsed();
+        over_stretches(b, L, || started.clone(), |stepper| stepper.step());
+    });
+}
+
+/// Times steps over trep's stretch of the fall of an `n`-link chain, `max(200, 4000 / n)` steps
+/// from the start (`start`, untimed, gives a started model to `step`): the time per step.
+fn over_stretches<M>(
+    bencher: &mut criterion::Bencher<'_>,
+    n: usize,
+    mut start: impl FnMut() -> M,
+    mut step: impl FnMut(&mut M) -> Result<(), DiracError>,
+) {
+    let stretch = 200.max(4000 / n) as u64;
+    bencher.iter_custom(|iterations| {
+        let runs = iterations.div_ceil(stretch);
+        let mut total = Duration::ZERO;
+        for _ in 0..runs {
+            let mut model = start();
+            let clock = Instant::now();
+            for _ in 0..stretch {
+                black_box(step(&mut model)).expect("step");
             }
-            total.mul_f64(iterations as f64 / (runs * stretch) as f64)
-        })
+            total += clock.elapsed();
+        }
+        total.mul_f64(iterations as f64 / (runs * stretch) as f64)
     });
 }
 
 /// trep's n-link chain in maximal coordinates (`scenes::mechanism::point_chain`: point masses
-/// on rods held by joints, the modular step), n = 10, 20, 40, 100, 1 000: as `chain_step`, each
-/// measurement steps from the start for `max(200, 4000 / n)` steps, starting over (untimed)
-/// from the same state; the time reported is per step.
+/// on rods held by joints, the modular step), n = 10, 20, 40, 100, 1 000, timed as
+/// `chain_step`.
 fn mechanism(c: &mut Criterion) {
     use scenes::mechanism;
     let mut group = c.benchmark_group("mechanism_chain");
@@ -119,24 +129,15 @@ fn mechanism(c: &mut Criterion) {
     for n in [10, 20, 40, 100, 1000] {
         let theta = vec![std::f64::consts::FRAC_PI_2; n];
         let (q0, v0) = mechanism::point_chain_state(&theta, &vec![0.0; n], 1.0);
-        let mut chain = mechanism::point_chain(n, 1.0, 1.0, 9.81, 0.01).expect("valid scene");
-        let stretch = 200.max(4000 / n) as u64;
         group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
-            b.iter_custom(|iterations| {
-                let runs = iterations.div_ceil(stretch);
-                let mut total = Duration::ZERO;
-                for _ in 0..runs {
-                    chain
-                        .start_from_velocity(&q0, &v0)
-                        .expect("consistent start");
-                    let clock = Instant::now();
-                    for _ in 0..stretch {
-                        black_box(chain.step()).expect("step");
-                    }
-                    total += clock.elapsed();
-                }
-                total.mul_f64(iterations as f64 / (runs * stretch) as f64)
-            })
+            let start = || {
+                let mut chain = mechanism::point_chain(n, 1.0, 1.0, 9.81, 0.01).expect("scene");
+                chain
+                    .start_from_velocity(&q0, &v0)
+                    .expect("consistent start");
+                chain
+            };
+            over_stretches(b, n, start, Modular::step);
         });
     }
     group.finish();

@@ -51,7 +51,11 @@ fn main() -> Result<(), Failure> {
     for &n in &sizes {
         // trep's stretch; at 10 000 links 50 steps (the chain's whip needs a smaller step by
         // step 64).
-        let steps = if n > 1_000 { 50 } else { (4_000 / n).max(200) as u64 };
+        let steps = if n > 1_000 {
+            50
+        } else {
+            (4_000 / n).max(200) as u64
+        };
         let (mut fastest, mut evaluations, mut worst) = (Duration::MAX, 0, 0.0_f64);
         for round in 0..4 {
             let mut chain = chain(n)?;

@@ -32,6 +32,24 @@ fn ball_gaps(q: &[f64], pairs: &[Ball]) -> f64 {
     gaps.fold(0.0, f64::max)
 }
 
+/// A mechanism and the one model with its joints as holonomic constraints, both started from
+/// the positions and velocities `(q0, v0)` and stepped by the midpoint rule with step `h`.
+fn started<S: DiracSystem<N>, const N: usize>(
+    mut joined: Modular,
+    model: S,
+    h: f64,
+    (q0, v0): (Vec<f64>, Vec<f64>),
+) -> (Modular, Stepper<S, N>) {
+    let mut one = Stepper::new(model, Quadrature::midpoint(), h).unwrap();
+    joined.start_from_velocity(&q0, &v0).unwrap();
+    let (q0, v0) = (
+        SVector::from_column_slice(&q0),
+        SVector::from_column_slice(&v0),
+    );
+    one.start_from_velocity(q0, v0).unwrap();
+    (joined, one)
+}
+
 /// The largest entry of `a − b`.
 fn distance(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
@@ -97,16 +115,9 @@ fn trep_s_two_link_chain_joined_steps_as_one_model_with_holonomic_rods() {
 fn the_four_bar_closes_its_loop_at_every_step_as_one_model_does() {
     let [a, b, c, d] = mechanism::FOUR_BAR;
     let (g, h) = (9.81, 0.002);
-    let mut joined = mechanism::four_bar(g, h).unwrap();
     let model = FourBarMonolithic { a, b, c, d, g };
-    let mut one = Stepper::new(model, Quadrature::midpoint(), h).unwrap();
-    let (q0, v0) = mechanism::four_bar_state(1.0, 2.0);
-    joined.start_from_velocity(&q0, &v0).unwrap();
-    one.start_from_velocity(
-        SVector::from_column_slice(&q0),
-        SVector::from_column_slice(&v0),
-    )
-    .unwrap();
+    let start = mechanism::four_bar_state(1.0, 2.0);
+    let (mut joined, mut one) = started(mechanism::four_bar(g, h).unwrap(), model, h, start);
     let energy = |joined: &Modular| {
         let (q, v) = (joined.q(), joined.velocities().unwrap());
         mechanism::four_bar_energy(q.as_slice(), v.as_slice(), g)
@@ -380,16 +391,10 @@ fn an_included_chain_s_joints_step_as_its_own() {
 fn the_slider_crank_steps_as_one_model_with_its_rail_and_pins() {
     let [a, b] = mechanism::SLIDER_CRANK;
     let (g, h) = (9.81, 0.002);
-    let mut joined = mechanism::slider_crank(g, h).unwrap();
     let model = mechanism::SliderCrankMonolithic { a, b, g };
-    let mut one = Stepper::new(model, Quadrature::midpoint(), h).unwrap();
-    let (q0, v0) = mechanism::slider_crank_state(0.8, 3.0);
-    joined.start_from_velocity(&q0, &v0).unwrap();
-    one.start_from_velocity(
-        SVector::from_column_slice(&q0),
-        SVector::from_column_slice(&v0),
-    )
-    .unwrap();
+    let start = mechanism::slider_crank_state(0.8, 3.0);
+    let mechanism = mechanism::slider_crank(g, h).unwrap();
+    let (mut joined, mut one) = started(mechanism, model, h, start);
     let mut worst: f64 = 0.0;
     for k in 0..2000 {
         joined.step().unwrap();

@@ -622,17 +622,16 @@ mod tests {
         // A body turned about an oblique axis, a planar body, point masses.
         let (s, c) = 0.7_f64.sin_cos();
         let body = [0.3, -0.2, 0.9, c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0];
+        let reversed = || body.iter().rev().copied().collect::<Vec<f64>>();
+        let (first, second) = (
+            || Anchor::body("a", ["x", "y", "z"], "R", [0.1, 0.2, 0.5]),
+            || Anchor::body("b", ["x", "y", "z"], "R", [0.0, -0.3, 0.2]),
+        );
         let cases = [
             (
-                Joint::revolute(
-                    "hinge",
-                    Anchor::body("a", ["x", "y", "z"], "R", [0.1, 0.2, 0.5]),
-                    Anchor::body("b", ["x", "y", "z"], "R", [0.0, -0.3, 0.2]),
-                    [1.0, 0.0, 0.0],
-                    [0.0, 1.0, 1.0],
-                ),
+                Joint::revolute("hinge", first(), second(), [1.0, 0.0, 0.0], [0.0, 1.0, 1.0]),
                 body.to_vec(),
-                body.iter().rev().copied().collect::<Vec<f64>>(),
+                reversed(),
             ),
             (
                 Joint::spherical(
@@ -656,32 +655,23 @@ mod tests {
             (
                 Joint::universal(
                     "cardan",
-                    Anchor::body("a", ["x", "y", "z"], "R", [0.1, 0.2, 0.5]),
-                    Anchor::body("b", ["x", "y", "z"], "R", [0.0, -0.3, 0.2]),
+                    first(),
+                    second(),
                     [1.0, 0.5, 0.0],
                     [0.0, 1.0, 1.0],
                 ),
                 body.to_vec(),
-                body.iter().rev().copied().collect::<Vec<f64>>(),
+                reversed(),
             ),
             (
-                Joint::fixed(
-                    "weld",
-                    Anchor::body("a", ["x", "y", "z"], "R", [0.1, 0.2, 0.5]),
-                    Anchor::body("b", ["x", "y", "z"], "R", [0.0, -0.3, 0.2]),
-                ),
+                Joint::fixed("weld", first(), second()),
                 body.to_vec(),
-                body.iter().rev().copied().collect::<Vec<f64>>(),
+                reversed(),
             ),
             (
-                Joint::prismatic(
-                    "slider",
-                    Anchor::body("a", ["x", "y", "z"], "R", [0.1, 0.2, 0.5]),
-                    Anchor::body("b", ["x", "y", "z"], "R", [0.0, -0.3, 0.2]),
-                    [0.3, -1.0, 0.4],
-                ),
+                Joint::prismatic("slider", first(), second(), [0.3, -1.0, 0.4]),
                 body.to_vec(),
-                body.iter().rev().copied().collect::<Vec<f64>>(),
+                reversed(),
             ),
             (
                 Joint::prismatic(
