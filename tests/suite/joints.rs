@@ -50,6 +50,12 @@ fn started<S: DiracSystem<N>, const N: usize>(
     (joined, one)
 }
 
+/// trep's start of an `n`-link chain of unit rods: straight and level, at rest.
+fn straight(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let theta = vec![std::f64::consts::FRAC_PI_2; n];
+    mechanism::point_chain_state(&theta, &vec![0.0; n], 1.0)
+}
+
 /// The largest entry of `a − b`.
 fn distance(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
@@ -150,8 +156,7 @@ fn the_four_bar_closes_its_loop_at_every_step_as_one_model_does() {
 /// maximal coordinates: its absolute angles at the end.
 fn maximal_chain_angles<const L: usize>(h: f64, t: f64) -> Vec<f64> {
     let mut chain = mechanism::point_chain(L, 1.0, 1.0, 9.81, h).unwrap();
-    let theta = [std::f64::consts::FRAC_PI_2; L];
-    let (q0, v0) = mechanism::point_chain_state(&theta, &[0.0; L], 1.0);
+    let (q0, v0) = straight(L);
     chain.start_from_velocity(&q0, &v0).unwrap();
     let steps = (t / h).round() as u64;
     for _ in 0..steps {
@@ -521,8 +526,7 @@ fn a_chain_stepped_with_kept_jacobians_reaches_newton_s_roots() {
     // A Jacobian kept from an earlier step is evaluated anew where the positions' updates stop
     // contracting (not refused: the iteration, not the step, was slow).
     let n = 10;
-    let theta = vec![std::f64::consts::FRAC_PI_2; n];
-    let (q0, v0) = mechanism::point_chain_state(&theta, &vec![0.0; n], 1.0);
+    let (q0, v0) = straight(n);
     let mut ends = Vec::new();
     for reuse in [None, Some(0.25)] {
         let options = NewtonOptions {
@@ -542,8 +546,7 @@ fn a_chain_stepped_with_kept_jacobians_reaches_newton_s_roots() {
 fn a_long_chain_steps_across_threads_as_on_one() {
     // Enough links for the components' passes to be split across rayon's threads.
     let n = 2500;
-    let theta = vec![std::f64::consts::FRAC_PI_2; n];
-    let (q0, v0) = mechanism::point_chain_state(&theta, &vec![0.0; n], 1.0);
+    let (q0, v0) = straight(n);
     let mut states = Vec::new();
     for parallel in [false, true] {
         let chain = mechanism::point_chain(n, 1.0, 1.0, 9.81, 0.01).unwrap();

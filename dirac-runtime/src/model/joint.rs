@@ -206,6 +206,12 @@ impl Anchor {
     }
 }
 
+/// `d(Rot(θ) a)/dθ` in the plane.
+fn turning(theta: f64, [a, b]: [f64; 2]) -> [f64; 2] {
+    let (s, c) = theta.sin_cos();
+    [-s * a - c * b, c * a - s * b]
+}
+
 /// What an end carries (see [`Anchor::carry`]).
 #[derive(Debug, Clone, Copy)]
 enum Carrier {
@@ -244,29 +250,11 @@ impl Carried<'_> {
                 }
             }
             (Place::Planar { offset, .. }, Carrier::Point) => {
-                let (s, c) = q[at[2]].sin_cos();
-                let [a, b] = *offset;
                 each(at[i], 1.0);
-                each(
-                    at[2],
-                    if i == 0 {
-                        -s * a - c * b
-                    } else {
-                        c * a - s * b
-                    },
-                );
+                each(at[2], turning(q[at[2]], *offset)[i]);
             }
             (Place::Planar { .. }, Carrier::Axis(axis)) => {
-                let (s, c) = q[at[2]].sin_cos();
-                let [a, b] = [axis[0], axis[1]];
-                each(
-                    at[2],
-                    if i == 0 {
-                        -s * a - c * b
-                    } else {
-                        c * a - s * b
-                    },
-                );
+                each(at[2], turning(q[at[2]], [axis[0], axis[1]])[i]);
             }
             (Place::Planar { .. }, Carrier::Angle) if i == 0 => each(at[2], 1.0),
             _ => {}
