@@ -7,10 +7,12 @@
 //! refusal of the ill-posed LC circuit is shown. Pictures: `output/convergence.png`,
 //! `output/energy_error.png`, `output/knife_edge.png`, `output/lc_circuit.png`,
 //! `output/cart_pole_lqr.png`, `output/long_horizon_energy.png`, `output/heavy_top.png`,
-//! `output/heavy_top_invariants.png`. Models on rotations and unit vectors: the heavy top (both
+//! `output/heavy_top_invariants.png`, `output/rigid_chain.png`, `output/humanoid.png`. Models
+//! on rotations and unit vectors: the heavy top (both
 //! retractions), the 3D pendulum against a quaternion reference, the spherical pendulum on `S²`
 //! beside the Cartesian one, the rolling ball at each constraint point, a satellite's slew, and
-//! a satellite with reaction wheels held by LQR on the step map's derivatives.
+//! a satellite with reaction wheels held by LQR on the step map's derivatives. Mechanisms of
+//! bodies joined by joints: a four-bar linkage, a slider-crank and a tumbling humanoid.
 //!
 //! `cargo run --release --example tour`
 
@@ -87,6 +89,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     reports.push(scenes::shafted_body::report()?);
     reports.push(scenes::satellite::report()?);
     reports.push(scenes::reaction_wheels::report()?);
+    // Mechanisms in maximal coordinates: bodies joined by joints, by parts.
+    reports.extend(scenes::mechanism::reports()?);
     // A field: the sine-Gordon kink–antikink collision.
     reports.push(scenes::field::report()?);
     scenes::print_table(&reports);

@@ -2,14 +2,16 @@
 //! under the three discrete constraints, the LC circuit against its closed form, and the
 //! cart-pole balanced by LQR on the step map's derivatives, the pendulum's energy error against
 //! cost to T = 10⁴ beside the explicit Runge–Kutta and BDF peers, the heavy top's nutation, its
-//! energy error and vertical momentum over 10⁶ steps, and a chain of two rigid bodies in space.
+//! energy error and vertical momentum over 10⁶ steps, a chain of two rigid bodies in space, and
+//! a humanoid-like tree of bodies on ball joints tumbling free.
 
 use std::error::Error;
 
 use dirac::prelude::*;
 
 use super::{
-    cart_pole, circuit, double_pendulum, knife_edge, pendulum, rigid_body, rigid_chain, study,
+    cart_pole, circuit, double_pendulum, knife_edge, mechanism, pendulum, rigid_body, rigid_chain,
+    study,
 };
 use dirac::plot::{Series, SpaceSeries, line_chart, space_chart};
 
@@ -25,7 +27,36 @@ pub fn draw_all() -> Result<Vec<&'static str>, Box<dyn Error>> {
         heavy_top_nutation()?,
         heavy_top_invariants()?,
         chain_in_space()?,
+        humanoid_in_space()?,
     ])
+}
+
+/// The free humanoid (nine bodies on eight ball joints, no gravity) over 2 s (midpoint, Cayley,
+/// h = 0.005): its skeleton at the start and at the end, and the paths of its left hand and of
+/// its centre of mass, which moves on a line (its momentum is kept).
+pub fn humanoid_in_space() -> Result<&'static str, Box<dyn Error>> {
+    let path = "output/humanoid.png";
+    let frames = mechanism::humanoid_motion(0.005, 400, 4)?;
+    let (first, last) = (&frames[0], &frames[frames.len() - 1]);
+    let trail = |label: &str, point: fn(&mechanism::Skeleton) -> [f64; 3]| SpaceSeries {
+        label: label.into(),
+        points: frames.iter().map(point).collect(),
+    };
+    let skeleton = |label: String, frame: &mechanism::Skeleton| SpaceSeries {
+        label,
+        points: frame.1.clone(),
+    };
+    space_chart(
+        path,
+        "A humanoid of nine bodies on ball joints, tumbling free for 2 s",
+        &[
+            skeleton("at t = 0".into(), first),
+            skeleton(format!("at t = {:.0}", last.0), last),
+            trail("its left hand", |f| f.2),
+            trail("its centre of mass", |f| f.3),
+        ],
+    )?;
+    Ok(path)
 }
 
 /// The heavy top's symmetry axis `R e₃` seen from above over 4 s (midpoint, Cayley,

@@ -6,9 +6,18 @@
 //!   (absolute angles), and as `PointChain2`, one model with its rods as holonomic constraints.
 //! - A chain of rigid rods in space hanging from ball joints (`body_chain`).
 //! - A four-bar linkage in the plane, a closed loop of three bars pinned to each other and to
-//!   the ground (`four_bar`).
+//!   the ground (`four_bar`), and a slider-crank (`slider_crank`).
+//! - A humanoid-like tree of nine bodies on ball joints, free in space (`HUMANOID`, `tree`).
+//!
+//! The tour's rows (`reports`) check each against one model with its joints as holonomic
+//! constraints or against its conserved momenta.
 
+use std::time::Instant;
+
+use dirac::nalgebra::{Matrix2, Rotation3, Vector2};
 use dirac::prelude::*;
+
+use super::Report;
 
 /// A point mass `m` in the vertical plane under gravity `g` along `−y`.
 #[dirac_system(
@@ -640,4 +649,173 @@ pub fn four_bar_energy(q: &[f64], v: &[f64], g: f64) -> f64 {
         .sum()
 }
 
-use dirac::nalgebra::{Matrix2, Vector2};
+/// The humanoid tumbling: each body turned and turning its own way, the torso drifting.
+pub fn humanoid_start() -> (Vec<f64>, Vec<f64>) {
+    let n = HUMANOID.len();
+    let attitudes: Vec<Matrix3<f64>> = (0..n)
+        .map(|k| {
+            let turn = Vector3::new(0.3 * k as f64, -0.2, 0.1 * (k % 3) as f64);
+            Rotation3::new(turn).into_inner()
+        })
+        .collect();
+    let omegas: Vec<Vector3<f64>> = (0..n)
+        .map(|k| Vector3::new((k as f64).sin(), 2.0 * (k as f64).cos(), 0.5))
+        .collect();
+    let moving = (Vector3::new(0.1, 0.0, 0.2), Vector3::new(0.3, -0.1, 0.0));
+    tree_state(&HUMANOID, &attitudes, &omegas, moving)
+}
+
+/// The humanoid's skeleton at positions `q` as one path through its joints and ends (a hand, the
+/// arms, the torso, the legs), its left hand and its centre of mass.
+pub fn humanoid_skeleton(q: &[f64]) -> (Vec<[f64; 3]>, [f64; 3], [f64; 3]) {
+    let body = |k: usize| {
+        let q = &q[12 * k..12 * k + 12];
+        (
+            Vector3::new(q[0], q[1], q[2]),
+            Matrix3::from_row_slice(&q[3..12]),
+        )
+    };
+    // A limb's joint with its parent and its far end.
+    let top = |k: usize| {
+        let (x, r) = body(k);
+        (x + r * Vector3::from(HUMANOID[k].at_self)).into()
+    };
+    let end = |k: usize| {
+        let (x, r) = body(k);
+        (x - r * Vector3::from(HUMANOID[k].at_self)).into()
+    };
+    let (centre, _) = body(0);
+    let path = vec![
+        end(2),
+        top(2),
+        top(1),
+        top(3),
+        top(4),
+        end(4),
+        top(4),
+        top(3),
+        centre.into(),
+        top(7),
+        top(8),
+        end(8),
+        top(8),
+        top(7),
+        top(5),
+        top(6),
+        end(6),
+    ];
+    let mass: f64 = HUMANOID.iter().map(|limb| limb.m).sum();
+    let weighted = (0..HUMANOID.len()).map(|k| body(k).0 * HUMANOID[k].m);
+    let of_mass = weighted.fold(Vector3::zeros(), |sum, x| sum + x) / mass;
+    (path, end(2), of_mass.into())
+}
+
+/// The free humanoid over `steps` steps of `h`, every `every`-th state: the time and
+/// [`humanoid_skeleton`].
+pub type Skeleton = (f64, Vec<[f64; 3]>, [f64; 3], [f64; 3]);
+
+/// See [`Skeleton`].
+pub fn humanoid_motion(h: f64, steps: u64, every: u64) -> Result<Vec<Skeleton>, DiracError> {
+    let mut tree = tree(&HUMANOID, 0.0, h)?;
+    let (q0, v0) = humanoid_start();
+    tree.start_from_velocity(&q0, &v0)?;
+    let mut frames = Vec::new();
+    for k in 0..=steps {
+        if k % every == 0 {
+            let (path, hand, centre) = humanoid_skeleton(tree.q().as_slice());
+            frames.push((tree.t(), path, hand, centre));
+        }
+        if k < steps {
+            tree.step()?;
+        }
+    }
+    Ok(frames)
+}
+
+/// The tour's rows: the four-bar and the slider-crank against one model with their joints as
+/// holonomic constraints (positions apart, the joints' largest violation, the energy's error),
+/// and the free humanoid (its momenta's drift).
+pub fn reports() -> Result<Vec<Report>, DiracError> {
+    let (g, h, steps) = (9.81, 0.002, 2000);
+    let [a, b, c, d] = FOUR_BAR;
+    let four_bar = against_one(
+        "four-bar (joints)",
+        four_bar(g, h)?,
+        FourBarMonolithic { a, b, c, d, g },
+        four_bar_state(1.0, 2.0),
+        (h, steps),
+    )?;
+    let [a, b] = SLIDER_CRANK;
+    let slider_crank = against_one(
+        "slider-crank (joints)",
+        slider_crank(g, h)?,
+        SliderCrankMonolithic { a, b, g },
+        slider_crank_state(0.8, 3.0),
+        (h, steps),
+    )?;
+    let start = Instant::now();
+    let (h, steps) = (0.005, 2000);
+    let mut humanoid = tree(&HUMANOID, 0.0, h)?;
+    let (q0, v0) = humanoid_start();
+    humanoid.start_from_velocity(&q0, &v0)?;
+    let momenta = |m: &Modular| bodies_momenta(m.q().as_slice(), m.p().as_slice());
+    let (linear0, angular0) = momenta(&humanoid);
+    let e0: f64 = humanoid.energies()?.iter().sum();
+    let (mut drift, mut violation): (f64, f64) = (0.0, 0.0);
+    for _ in 0..steps {
+        humanoid.step()?;
+        let (linear, angular) = momenta(&humanoid);
+        drift = drift
+            .max((linear - linear0).amax())
+            .max((angular - angular0).amax());
+        violation = violation.max(humanoid.constraint_violation()?);
+    }
+    let energy = (humanoid.energies()?.iter().sum::<f64>() - e0).abs();
+    let humanoid = Report {
+        scene: "humanoid (joints)",
+        quadrature: "midpoint".into(),
+        h,
+        steps,
+        max_energy_error: Some(energy),
+        wall: start.elapsed(),
+        check: format!("momenta to {drift:.0e}; joints to {violation:.0e}"),
+    };
+    Ok(vec![four_bar, slider_crank, humanoid])
+}
+
+/// A mechanism and the one model with its joints as holonomic constraints, stepped side by side
+/// from `(q0, v0)` by `steps` steps of `h`: the tour's row.
+fn against_one<S: DiracSystem<9>>(
+    scene: &'static str,
+    mut joined: Modular,
+    model: S,
+    (q0, v0): (Vec<f64>, Vec<f64>),
+    (h, steps): (f64, u64),
+) -> Result<Report, DiracError> {
+    let start = Instant::now();
+    let mut one = Stepper::new(model, Quadrature::midpoint(), h)?;
+    joined.start_from_velocity(&q0, &v0)?;
+    one.start_from_velocity(
+        SVector::from_column_slice(&q0),
+        SVector::from_column_slice(&v0),
+    )?;
+    let e0: f64 = joined.energies()?.iter().sum();
+    let (mut apart, mut violation, mut energy): (f64, f64, f64) = (0.0, 0.0, 0.0);
+    for _ in 0..steps {
+        joined.step()?;
+        one.step()?;
+        let q = joined.q();
+        apart = apart.max((q - SVector::<f64, 9>::from_column_slice(one.q().as_slice())).amax());
+        violation = violation.max(joined.constraint_violation()?);
+        energy = energy.max((joined.energies()?.iter().sum::<f64>() - e0).abs());
+    }
+    Ok(Report {
+        scene,
+        quadrature: "midpoint".into(),
+        h,
+        steps,
+        max_energy_error: Some(energy),
+        wall: start.elapsed(),
+        check: format!("= one model to {apart:.0e}; joints to {violation:.0e}"),
+    })
+}

@@ -316,17 +316,7 @@ fn a_free_humanoid_tree_keeps_its_momenta_and_joints() {
     // Nine bodies, eight ball joints, no gravity: linear and angular momentum are conserved.
     let limbs = mechanism::HUMANOID;
     let mut tree = mechanism::tree(&limbs, 0.0, 0.005).unwrap();
-    let attitudes: Vec<Matrix3<f64>> = (0..limbs.len())
-        .map(|k| {
-            let turn = Vector3::new(0.3 * k as f64, -0.2, 0.1 * (k % 3) as f64);
-            Rotation3::new(turn).into_inner()
-        })
-        .collect();
-    let omegas: Vec<Vector3<f64>> = (0..limbs.len())
-        .map(|k| Vector3::new((k as f64).sin(), 2.0 * (k as f64).cos(), 0.5))
-        .collect();
-    let moving = (Vector3::new(0.1, 0.0, 0.2), Vector3::new(0.3, -0.1, 0.0));
-    let (q0, v0) = mechanism::tree_state(&limbs, &attitudes, &omegas, moving);
+    let (q0, v0) = mechanism::humanoid_start();
     tree.start_from_velocity(&q0, &v0).unwrap();
     let momenta =
         |tree: &Modular| mechanism::bodies_momenta(tree.q().as_slice(), tree.p().as_slice());
