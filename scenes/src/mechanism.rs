@@ -710,11 +710,10 @@ pub fn humanoid_skeleton(q: &[f64]) -> (Vec<[f64; 3]>, [f64; 3], [f64; 3]) {
     (path, end(2), of_mass.into())
 }
 
-/// The free humanoid over `steps` steps of `h`, every `every`-th state: the time and
-/// [`humanoid_skeleton`].
+/// A time and [`humanoid_skeleton`] at it.
 pub type Skeleton = (f64, Vec<[f64; 3]>, [f64; 3], [f64; 3]);
 
-/// See [`Skeleton`].
+/// The free humanoid over `steps` steps of `h`: its [`Skeleton`] every `every`-th state.
 pub fn humanoid_motion(h: f64, steps: u64, every: u64) -> Result<Vec<Skeleton>, DiracError> {
     let mut tree = tree(&HUMANOID, 0.0, h)?;
     let (q0, v0) = humanoid_start();
@@ -761,7 +760,7 @@ pub fn reports() -> Result<Vec<Report>, DiracError> {
     let momenta = |m: &Modular| bodies_momenta(m.q().as_slice(), m.p().as_slice());
     let (linear0, angular0) = momenta(&humanoid);
     let e0: f64 = humanoid.energies()?.iter().sum();
-    let (mut drift, mut violation): (f64, f64) = (0.0, 0.0);
+    let (mut drift, mut violation, mut energy): (f64, f64, f64) = (0.0, 0.0, 0.0);
     for _ in 0..steps {
         humanoid.step()?;
         let (linear, angular) = momenta(&humanoid);
@@ -769,8 +768,8 @@ pub fn reports() -> Result<Vec<Report>, DiracError> {
             .max((linear - linear0).amax())
             .max((angular - angular0).amax());
         violation = violation.max(humanoid.constraint_violation()?);
+        energy = energy.max((humanoid.energies()?.iter().sum::<f64>() - e0).abs());
     }
-    let energy = (humanoid.energies()?.iter().sum::<f64>() - e0).abs();
     let humanoid = Report {
         scene: "humanoid (joints)",
         quadrature: "midpoint".into(),

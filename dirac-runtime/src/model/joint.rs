@@ -313,8 +313,8 @@ impl Joint {
         Self::new(name, Kind::Universal(axis_a, axis_b), a, b)
     }
 
-    /// Welds the ends: the points coincide and `b`'s frame stays parallel to `a`'s (bodies
-    /// welded in another attitude give their axes so that they are parallel where joined). In
+    /// Welds the ends: the points coincide and `b`'s frame stays parallel to `a`'s (no other
+    /// relative attitude can be given: write the bodies with axes parallel where welded). In
     /// space six rows, the last three `(R_a e_x)·(R_b e_y)`, `(R_a e_x)·(R_b e_z)`,
     /// `(R_a e_y)·(R_b e_z)`; in the plane three, the last `θ_b − θ_a`.
     pub fn fixed(name: &str, a: Anchor, b: Anchor) -> Self {
@@ -437,6 +437,9 @@ impl Joint {
             ),
             Kind::Prismatic(u) if !axis(u) => {
                 invalid("an axis that is zero or not finite (or of more than 3 numbers)".into())
+            }
+            Kind::Prismatic(u) if da == 2 && (u[2] != 0.0 || u[0] == 0.0 && u[1] == 0.0) => {
+                invalid("an axis in the plane is two numbers, not both zero".into())
             }
             _ => Ok(()),
         }
@@ -726,6 +729,7 @@ mod tests {
         let fixed = || Anchor::fixed([0.0, 0.0, 0.0]);
         let mass = || Anchor::point("m", ["x", "y", "z"]);
         let planar = || Anchor::planar("p", ["x", "y"], "t", [1.0, 0.0]);
+        let fixed2 = || Anchor::fixed([0.0, 0.0]);
         let body = || Anchor::body("b", ["x", "y", "z"], "R", [0.0, 0.0, 1.0]);
         let refused = [
             (
@@ -758,6 +762,10 @@ mod tests {
             (
                 Joint::prismatic("slider", body(), body(), [0.0, 0.0, 0.0]),
                 "an axis that is zero",
+            ),
+            (
+                Joint::prismatic("upright", planar(), fixed2(), [0.0, 0.0, 1.0]),
+                "an axis in the plane is two numbers",
             ),
             (
                 Joint::revolute("zero axis", fixed(), body(), [0.0; 3], [1.0, 0.0, 0.0]),
