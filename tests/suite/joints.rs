@@ -77,11 +77,8 @@ fn a_rod_joint_steps_the_equations_of_the_holonomic_pendulum() {
     );
     joined.connect(rod).unwrap();
     let pendulum = CartesianPendulum { m: 1.0, l: 1.0, g };
-    let mut one = Stepper::new(pendulum, Quadrature::midpoint(), h).unwrap();
     let (s, c) = 1.2_f64.sin_cos();
-    joined.start_from_velocity(&[s, -c], &[0.0, 0.0]).unwrap();
-    one.start_from_velocity(vector![s, -c], vector![0.0, 0.0])
-        .unwrap();
+    let (mut joined, mut one) = started(joined, pendulum, h, (vec![s, -c], vec![0.0, 0.0]));
     let mut worst: f64 = 0.0;
     for _ in 0..1000 {
         joined.step().unwrap();
@@ -100,13 +97,8 @@ fn a_rod_joint_steps_the_equations_of_the_holonomic_pendulum() {
 #[test]
 fn trep_s_two_link_chain_joined_steps_as_one_model_with_holonomic_rods() {
     let (m, l, g, h) = (1.0, 1.0, 9.81, 0.01);
-    let mut joined = mechanism::point_chain(2, m, l, g, h).unwrap();
-    let mut one = Stepper::new(PointChain2 { m, l, g }, Quadrature::midpoint(), h).unwrap();
-    let half_pi = std::f64::consts::FRAC_PI_2;
-    let (q0, v0) = mechanism::point_chain_state(&[half_pi, half_pi], &[0.0, 0.0], l);
-    joined.start_from_velocity(&q0, &v0).unwrap();
-    one.start_from_velocity(SVector::from_column_slice(&q0), SVector::zeros())
-        .unwrap();
+    let chain = mechanism::point_chain(2, m, l, g, h).unwrap();
+    let (mut joined, mut one) = started(chain, PointChain2 { m, l, g }, h, straight(2));
     let mut worst: f64 = 0.0;
     for _ in 0..1000 {
         joined.step().unwrap();

@@ -192,11 +192,10 @@ struct Running {
     /// The junctions' multipliers (impulses) of the last step.
     multipliers: Vec<f64>,
     /// The junctions' rows in the order of their multipliers: `(unknown, coefficient)` of the
-    /// step's end point, row `k`'s at `row_starts[k]..row_starts[k + 1]`.
+    /// step's end point, row `k`'s at `row_starts[k]..row_starts[k + 1]` (none for a joint's
+    /// row, which is evaluated as it stands).
     row_terms: Vec<(usize, f64)>,
     row_starts: Vec<usize>,
-    /// Whether the row of each multiplier is a joint's (its value not the linear row's).
-    jointed: Vec<bool>,
     /// Each component's proposed step in its chart, laid out as its unknowns (scratch).
     moved: Vec<f64>,
     violation: f64,
@@ -1099,8 +1098,11 @@ impl Modular {
         // The step's end point is a component's first unknowns (degree 1).
         let (mut row_terms, mut row_starts) = (Vec::new(), vec![0]);
         for &j in &order {
-            let terms = self.junctions[j].terms.iter();
-            row_terms.extend(terms.map(|&(c, i, a)| (self.components[c].offset + i, a)));
+            let junction = &self.junctions[j];
+            if junction.joint.is_none() {
+                let terms = junction.terms.iter();
+                row_terms.extend(terms.map(|&(c, i, a)| (self.components[c].offset + i, a)));
+            }
             row_starts.push(row_terms.len());
         }
         let jacobian = match self.bordered() {
@@ -1123,10 +1125,6 @@ impl Modular {
             multipliers: vec![0.0; self.junctions.len()],
             row_terms,
             row_starts,
-            jointed: order
-                .iter()
-                .map(|&j| self.junctions[j].joint.is_some())
-                .collect(),
             moved: vec![0.0; unknowns - self.junctions.len()],
             violation: 0.0,
             report: None,
@@ -1406,11 +1404,9 @@ impl Modular {
         };
         in_runs(parts, &mut run.moved, grain, &steps, &|(), ()| ());
         let (moved, row_terms, row_starts) = (&run.moved, &run.row_terms, &run.row_starts);
-        let jointed = &run.jointed;
         let junction = |k: usize| {
             let terms = &row_terms[row_starts[k]..row_starts[k + 1]];
-            let value = terms.iter().map(|&(u, a)| a * moved[u]).sum::<f64>().abs();
-            if jointed[k] { 0.0 } else { value }
+            terms.iter().map(|&(u, a)| a * moved[u]).sum::<f64>().abs()
         };
         let junctions = self.junctions.len();
         let violations = if grain < junctions {
@@ -1783,8 +1779,17 @@ fn read_joints(
     q: Option<&[f64]>,
     tolerance: f64,
 ) -> Result<(), DiracError> {
-    let coordinates = components.iter().map(|c| c.part.coordinates());
-    let zeros = vec![0.0; coordinates.max().unwrap_or(0)];
+    // The charts' origin, without an allocation for components of up to 64 coordinates.
+    const ORIGIN: [f64; 64] = [0.0; 64];
+    let largest = components.iter().map(|c| c.part.coordinates()).max();
+    let many;
+    let zeros: &[f64] = match largest.unwrap_or(0) {
+        n if n <= ORIGIN.len() => &ORIGIN,
+        n => {
+            many = vec![0.0; n];
+            &many
+        }
+    };
     for rows in joints {
         let own = |c: usize| {
             let at = components[c].position;
