@@ -93,6 +93,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     reports.extend(scenes::mechanism::reports()?);
     // A field: the sine-Gordon kink–antikink collision.
     reports.push(scenes::field::report()?);
+    // A field on the plane: a drum in two of its modes.
+    reports.push(scenes::membrane::report()?);
     scenes::print_table(&reports);
     scenes::save_table(&reports, "output/tour.csv")?;
     match circuit::lc_at_10(Quadrature::trapezoid(), 0.01) {

@@ -52,9 +52,9 @@ pub mod prelude {
         Crossing, DiracError, DiracSystem, Direction, DiscreteLagrangian, DualNum, Euclidean,
         Event, ExplicitSystem, Feedback, Field, FirstOrderScheme, HamiltonianSystem,
         HolonomicScheme, Input, Interconnected, Interconnection, Joint, Junction, ManifoldStepper,
-        Modular, NewtonOptions, Positive, Product, Progress, Quadrature, Rates, Repeated,
-        Retraction, Rule, Run, Sample, Scalar, SeparableDensity, Solution, Solver, Status, Stepper,
-        TimeTransformed, Trajectory,
+        Modular, NewtonOptions, PlaneDensity, PlaneField, Positive, Product, Progress, Quadrature,
+        Rates, Repeated, Retraction, Rule, Run, Sample, Scalar, SeparableDensity, Solution, Solver,
+        Status, Stepper, TimeTransformed, Trajectory,
     };
 }
 

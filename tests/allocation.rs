@@ -192,3 +192,23 @@ fn field_steps_allocate_nothing() {
     assert_eq!(count, 0, "{count} allocations in 100 steps of a field");
     assert!(kink.u().unwrap().iter().any(|u| u[0] > 3.0));
 }
+
+/// A step of a field on the plane allocates nothing either (a membrane of 60 × 40 cells with
+/// free and fixed edges, by Suzuki's composition).
+#[test]
+fn plane_field_steps_allocate_nothing() {
+    use dirac::{Boundary, PlaneField};
+    let edges = [Boundary::Free, Boundary::Fixed];
+    let sides = [(0.0, 1.5), (0.0, 1.0)];
+    let mut drum = PlaneField::new(scenes::membrane::DRUM, sides, [60, 40], edges, 0.005)
+        .unwrap()
+        .with_composition(Composition::suzuki());
+    let u0: Vec<SVector<f64, 1>> = (drum.points().into_iter())
+        .map(|[x, y]| SVector::from([x.cos() * (std::f64::consts::PI * y).sin()]))
+        .collect();
+    drum.start(&u0, &vec![SVector::zeros(); u0.len()]).unwrap();
+    drum.step().unwrap();
+    let count = allocations(|| drum.run(20).unwrap());
+    assert_eq!(count, 0, "{count} allocations in 20 steps of a plane field");
+    assert_eq!(drum.steps(), 21);
+}

@@ -3,17 +3,17 @@
 //! cart-pole balanced by LQR on the step map's derivatives, the pendulum's energy error against
 //! cost to T = 10⁴ beside the explicit Runge–Kutta and BDF peers, the heavy top's nutation, its
 //! energy error and vertical momentum over 10⁶ steps, a chain of two rigid bodies in space, and
-//! a humanoid-like tree of bodies on ball joints tumbling free.
+//! a humanoid-like tree of bodies on ball joints tumbling free, and a drum struck off its centre.
 
 use std::error::Error;
 
 use dirac::prelude::*;
 
 use super::{
-    cart_pole, circuit, double_pendulum, knife_edge, mechanism, pendulum, rigid_body, rigid_chain,
-    study,
+    cart_pole, circuit, double_pendulum, knife_edge, mechanism, membrane, pendulum, rigid_body,
+    rigid_chain, study,
 };
-use dirac::plot::{Series, SpaceSeries, line_chart, space_chart};
+use dirac::plot::{Series, SpaceSeries, line_chart, space_chart, space_time_chart};
 
 /// Writes every figure to `output/` and returns their paths.
 pub fn draw_all() -> Result<Vec<&'static str>, Box<dyn Error>> {
@@ -28,7 +28,22 @@ pub fn draw_all() -> Result<Vec<&'static str>, Box<dyn Error>> {
         heavy_top_invariants()?,
         chain_in_space()?,
         humanoid_in_space()?,
+        struck_drum()?,
     ])
+}
+
+/// The drum `[0, 1.5] × [0, 1]` (edges fixed, 120 × 80 cells) struck at `(0.5, 0.5)`, at
+/// `t = 0.6`: the ring of the strike and its reflections from the nearer edges.
+pub fn struck_drum() -> Result<&'static str, Box<dyn Error>> {
+    let path = "output/membrane.png";
+    let t = 0.6;
+    let ([x, y], u) = membrane::struck(t)?;
+    let rows: Vec<(f64, Vec<f64>)> = (y.iter().enumerate())
+        .map(|(j, &y)| (y, u[j * x.len()..(j + 1) * x.len()].to_vec()))
+        .collect();
+    let title = format!("A drum struck at (0.5, 0.5), u at t = {t}");
+    space_time_chart(path, &title, ("x", "y"), &x, &rows)?;
+    Ok(path)
 }
 
 /// The free humanoid (nine bodies on eight ball joints, no gravity) over 2 s (midpoint, Cayley,

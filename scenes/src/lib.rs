@@ -23,6 +23,7 @@ pub mod ladder;
 pub mod lotka_volterra;
 pub mod lqr;
 pub mod mechanism;
+pub mod membrane;
 pub mod motor;
 pub mod oscillator;
 pub mod peers;

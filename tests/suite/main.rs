@@ -31,6 +31,7 @@ mod lie_group;
 mod linear;
 mod modular;
 mod peers;
+mod plane_field;
 mod rigid_components;
 mod roundoff;
 mod run;

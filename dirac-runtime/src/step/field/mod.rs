@@ -50,15 +50,10 @@ use rayon::prelude::*;
 use crate::base::error::DiracError;
 use crate::model::density::SeparableDensity;
 use crate::step::composition::Composition;
+use leapfrog::{GRAIN, Grid, PARALLEL_BLOCKS, Running, is_zero};
 
-/// Nodes per block of a pass, and per parallel task: a pass over this many takes tens of
-/// microseconds.
-const GRAIN: usize = 4096;
-
-/// Blocks a field needs for its passes to be split across threads: with fewer, handing blocks
-/// to threads costs more than it gains (measured on 2 cores: 10⁴ nodes in three blocks stepped
-/// slower in parallel than on one thread).
-const PARALLEL_BLOCKS: usize = 4;
+mod leapfrog;
+pub mod plane;
 
 /// How the ends of a field's interval are held.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -87,39 +82,8 @@ pub struct Field<D, const C: usize> {
     parallel: bool,
     /// `m_j = w_j ρ(x_j)`, by node; zero at a fixed end (it does not move).
     mass: Vec<SVector<f64, C>>,
-    run: Option<Running<C>>,
-}
-
-/// The state of a run, and the buffers a step writes into before it is accepted.
-#[derive(Debug, Clone)]
-struct Running<const C: usize> {
-    /// The state.
-    now: Level<C>,
-    /// The step being taken.
-    next: Level<C>,
     /// Per block of [`GRAIN`] nodes, the shares of `∂Φ/∂u` of the cells that touch them.
-    shares: Vec<Vec<Shares<C>>>,
-    steps: u64,
-}
-
-/// A field, its momenta and its force at the nodes.
-#[derive(Debug, Clone, Default)]
-struct Level<const C: usize> {
-    /// The field at the nodes.
-    u: Vec<SVector<f64, C>>,
-    /// The momenta `m_j u̇_j` of the nodes.
-    p: Vec<SVector<f64, C>>,
-    /// `−∂Φ/∂u_j` at `u`.
-    force: Vec<SVector<f64, C>>,
-}
-
-impl<const C: usize> Level<C> {
-    /// Copies `other` into these buffers of the same lengths (no allocation).
-    fn copy_from(&mut self, other: &Self) {
-        self.u.copy_from_slice(&other.u);
-        self.p.copy_from_slice(&other.p);
-        self.force.copy_from_slice(&other.force);
-    }
+    run: Option<Running<C, Vec<Vec<Shares<C>>>>>,
 }
 
 /// Numbers that carry the derivatives along `u` and along `u_x` at once.
@@ -254,11 +218,6 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
         Ok(self)
     }
 
-    /// Whether this field's passes are split across threads.
-    fn in_parallel(&self) -> bool {
-        self.parallel && self.nodes() >= PARALLEL_BLOCKS * GRAIN
-    }
-
     /// The node masses `w_j ρ(x_j)`, checked.
     fn masses(&self) -> Result<Vec<SVector<f64, C>>, DiracError> {
         let nodes = self.nodes();
@@ -337,107 +296,15 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
         ut: &[SVector<f64, C>],
     ) -> Result<(), DiracError> {
         let nodes = self.nodes();
-        for (what, values) in [("u", u), ("u_t", ut)] {
-            if values.len() != nodes {
-                return Err(DiracError::Dimension(format!(
-                    "{what} has {} values, the field has {nodes} nodes",
-                    values.len()
-                )));
-            }
-            for (j, value) in values.iter().enumerate() {
-                if let Some(&bad) = value.iter().find(|v| !v.is_finite()) {
-                    return Err(DiracError::NonFinite {
-                        what: format!("{what} at node {j}"),
-                        value: bad,
-                    });
-                }
-            }
-        }
-        if self.boundary == Boundary::Fixed {
-            for j in [0, nodes - 1] {
-                if !is_zero(&ut[j]) {
-                    return Err(DiracError::InconsistentInitialState(format!(
-                        "the field's ends are fixed, but u_t at node {j} is {:?}",
-                        ut[j].as_slice()
-                    )));
-                }
-            }
-        }
-        let p = ut.iter().zip(&self.mass).map(|(v, m)| v.component_mul(m));
         let blocks = (0..nodes.div_ceil(GRAIN)).map(|k| {
             let nodes_in_block = GRAIN.min(nodes - k * GRAIN);
             vec![[SVector::zeros(); 2]; nodes_in_block + 1]
         });
-        let mut now = Level {
-            u: u.to_vec(),
-            p: p.collect(),
-            force: vec![SVector::zeros(); nodes],
-        };
-        let mut shares: Vec<_> = blocks.collect();
-        // The force alone: a kick by nothing (a failed start drops this run).
-        self.force_and_kick(&now.u, &mut now.force, &mut now.p, &mut shares, 0.0);
-        if let Some((j, bad)) = first_not_finite(&now.force) {
-            return Err(DiracError::NonFinite {
-                what: format!("the force on node {j} of the initial field"),
-                value: bad,
-            });
-        }
-        let run = Running {
-            next: now.clone(),
-            now,
-            shares,
-            steps: 0,
-        };
-        self.run = Some(run);
+        self.run = Some(leapfrog::start(self, u, ut, blocks.collect())?);
         Ok(())
     }
 
-    /// `p += kick · f` (where `kick` is not zero) and `u += tau · p/m` at every node that moves:
-    /// a kick by the force `f` and the drift that follows it.
-    fn kick_and_drift(
-        &self,
-        u: &mut [SVector<f64, C>],
-        p: &mut [SVector<f64, C>],
-        f: &[SVector<f64, C>],
-        (kick, tau): (f64, f64),
-    ) {
-        let block = |((u, p), (f, m))| kick_and_drift(u, p, f, m, kick, tau);
-        if self.in_parallel() {
-            let nodes = u.par_chunks_mut(GRAIN).zip(p.par_chunks_mut(GRAIN));
-            let forces = f.par_chunks(GRAIN).zip(self.mass.par_chunks(GRAIN));
-            nodes.zip(forces).for_each(block);
-        } else {
-            block(((u, p), (f, &self.mass)));
-        }
-    }
-
-    /// `f = −∂Φ/∂u` at `u` (zero at a fixed end), then `p += kick · f`, a block of [`GRAIN`]
-    /// nodes at a time: each block takes the shares of the cells that touch its nodes into its
-    /// own `shares` (a cell at a block's edge is taken by both blocks, alike).
-    fn force_and_kick(
-        &self,
-        u: &[SVector<f64, C>],
-        f: &mut [SVector<f64, C>],
-        p: &mut [SVector<f64, C>],
-        shares: &mut [Vec<Shares<C>>],
-        kick: f64,
-    ) {
-        if self.in_parallel() {
-            let blocks = f.par_chunks_mut(GRAIN).zip(p.par_chunks_mut(GRAIN));
-            let blocks = blocks.zip(shares.par_iter_mut()).enumerate();
-            blocks.for_each(|(k, ((f, p), shares))| {
-                self.block_force_and_kick(k, u, f, p, shares, kick)
-            });
-        } else {
-            let blocks = f.chunks_mut(GRAIN).zip(p.chunks_mut(GRAIN));
-            let blocks = blocks.zip(shares.iter_mut()).enumerate();
-            blocks.for_each(|(k, ((f, p), shares))| {
-                self.block_force_and_kick(k, u, f, p, shares, kick)
-            });
-        }
-    }
-
-    /// [`Field::force_and_kick`] on block `k`, whose nodes' forces and momenta are `f` and `p`.
+    /// [`Grid::force_and_kick`] on block `k`, whose nodes' forces and momenta are `f` and `p`.
     fn block_force_and_kick(
         &self,
         k: usize,
@@ -521,49 +388,16 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
 
     /// Advances `steps` steps; stops at the first error, with the state of the step before it.
     pub fn run(&mut self, steps: u64) -> Result<(), DiracError> {
-        if self.in_parallel() {
-            // Steps handed out from inside rayon's pool: one hand-off for the run, not one a pass.
-            rayon::scope(|_| (0..steps).try_for_each(|_| self.advance()))
-        } else {
-            (0..steps).try_for_each(|_| self.advance())
-        }
-    }
-
-    /// One step (see [`Field::step`]).
-    fn advance(&mut self) -> Result<(), DiracError> {
         let mut run = self.run.take().ok_or(DiracError::NotStarted)?;
-        let mut next = std::mem::take(&mut run.next);
-        next.copy_from(&run.now);
-        let Level { u, p, force: f } = &mut next;
-        // Each stage a kick, a drift and a kick; a stage's closing kick and the next one's
-        // opening kick are one, by the sum of their halves.
-        let coefficients = self.composition.coefficients();
-        for (i, &gamma) in coefficients.iter().enumerate() {
-            let tau = gamma * self.dt;
-            let opening = if i == 0 { 0.5 * tau } else { 0.0 };
-            self.kick_and_drift(u, p, f, (opening, tau));
-            let later = coefficients.get(i + 1).map_or(0.0, |g| g * self.dt);
-            self.force_and_kick(u, f, p, &mut run.shares, 0.5 * (tau + later));
-        }
-        let bad = [("field", &*u), ("momentum", &*p), ("force", &*f)]
-            .into_iter()
-            .find_map(|(what, values)| first_not_finite(values).map(|(j, v)| (what, j, v)));
-        if let Some((what, j, value)) = bad {
-            let step = run.steps;
-            run.next = next;
-            self.run = Some(run);
-            return Err(DiracError::NonFinite {
-                what: format!("the {what} at node {j} at step {step} (try a smaller step)"),
-                value,
-            });
-        }
-        run.next = std::mem::replace(&mut run.now, next);
-        run.steps += 1;
+        let field = &*self;
+        let taken = leapfrog::run_steps(self.in_parallel(), steps, || {
+            leapfrog::advance(field, &field.composition, field.dt, &mut run)
+        });
         self.run = Some(run);
-        Ok(())
+        taken
     }
 
-    fn running(&self) -> Result<&Running<C>, DiracError> {
+    fn running(&self) -> Result<&Running<C, Vec<Vec<Shares<C>>>>, DiracError> {
         self.run.as_ref().ok_or(DiracError::NotStarted)
     }
 
@@ -579,12 +413,7 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
 
     /// The rates `u̇_j = p_j / m_j` at the nodes (zero at a fixed end).
     pub fn velocities(&self) -> Result<Vec<SVector<f64, C>>, DiracError> {
-        let run = self.running()?;
-        let rate = |(p, m): (&SVector<f64, C>, &SVector<f64, C>)| match is_zero(m) {
-            true => SVector::zeros(),
-            false => p.component_div(m),
-        };
-        Ok(run.now.p.iter().zip(&self.mass).map(rate).collect())
+        Ok(leapfrog::rates(&self.running()?.now.p, &self.mass))
     }
 
     /// The time `n Δt` of the current state (0 before a start).
@@ -602,10 +431,7 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     /// order of `Δt^order`) over long runs.
     pub fn energy(&self) -> Result<f64, DiracError> {
         let run = self.running()?;
-        let kinetic: f64 = (run.now.p.iter().zip(&self.mass))
-            .filter(|(_, m)| !is_zero(m))
-            .map(|(p, m)| 0.5 * p.component_mul(&p.component_div(m)).sum())
-            .sum();
+        let kinetic = leapfrog::kinetic(&run.now.p, &self.mass);
         let nodes = run.now.u.len();
         let potential: f64 = (0..self.cells)
             .map(|i| {
@@ -621,34 +447,39 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     }
 }
 
-/// The first entry that is not finite, with its node.
-fn first_not_finite<const C: usize>(values: &[SVector<f64, C>]) -> Option<(usize, f64)> {
-    values
-        .iter()
-        .enumerate()
-        .find_map(|(j, v)| v.iter().find(|x| !x.is_finite()).map(|&x| (j, x)))
-}
+impl<D: SeparableDensity<C>, const C: usize> Grid<C> for Field<D, C> {
+    type Scratch = Vec<Vec<Shares<C>>>;
 
-/// `p += kick · f` (where `kick` is not zero) and `u += tau · p/m` at each node that moves.
-fn kick_and_drift<const C: usize>(
-    u: &mut [SVector<f64, C>],
-    p: &mut [SVector<f64, C>],
-    f: &[SVector<f64, C>],
-    mass: &[SVector<f64, C>],
-    kick: f64,
-    tau: f64,
-) {
-    for (((u, p), f), m) in u.iter_mut().zip(p.iter_mut()).zip(f).zip(mass) {
-        if kick != 0.0 {
-            *p += f * kick;
-        }
-        if !is_zero(m) {
-            *u += p.component_div(m) * tau;
+    fn mass(&self) -> &[SVector<f64, C>] {
+        &self.mass
+    }
+
+    fn in_parallel(&self) -> bool {
+        self.parallel && self.nodes() >= PARALLEL_BLOCKS * GRAIN
+    }
+
+    /// A block of [`GRAIN`] nodes at a time: each block takes the shares of the cells that touch
+    /// its nodes into its own `shares` (a cell at a block's edge is taken by both blocks, alike).
+    fn force_and_kick(
+        &self,
+        u: &[SVector<f64, C>],
+        f: &mut [SVector<f64, C>],
+        p: &mut [SVector<f64, C>],
+        shares: &mut Self::Scratch,
+        kick: f64,
+    ) {
+        if self.in_parallel() {
+            let blocks = f.par_chunks_mut(GRAIN).zip(p.par_chunks_mut(GRAIN));
+            let blocks = blocks.zip(shares.par_iter_mut()).enumerate();
+            blocks.for_each(|(k, ((f, p), shares))| {
+                self.block_force_and_kick(k, u, f, p, shares, kick)
+            });
+        } else {
+            let blocks = f.chunks_mut(GRAIN).zip(p.chunks_mut(GRAIN));
+            let blocks = blocks.zip(shares.iter_mut()).enumerate();
+            blocks.for_each(|(k, ((f, p), shares))| {
+                self.block_force_and_kick(k, u, f, p, shares, kick)
+            });
         }
     }
-}
-
-/// Whether every entry of `v` is zero (a fixed end's mass).
-fn is_zero<const C: usize>(v: &SVector<f64, C>) -> bool {
-    v.iter().all(|x| *x == 0.0)
 }

@@ -1,0 +1,524 @@
+//! The explicit multisymplectic step of a field on a rectangle of the plane.
+//!
+//! The rectangle `[a, b] × [c, d]` is cut into `N_x × N_y` cells of size `Δx × Δy`, time into
+//! steps `Δt`; the field lives at the nodes `(x_i, y_j)`. The discrete action is a sum over
+//! space–time boxes `[x_i, x_{i+1}] × [y_j, y_{j+1}] × [t_n, t_{n+1}]`, each with the trapezoidal
+//! rule over its eight corners. At a corner of a cell the slope is read along the cell's two
+//! edges that meet there: at `(x_i, y_j)` of the cell above and to the right,
+//! `u_x = (u_{i+1,j} − u_{i,j})/Δx` and `u_y = (u_{i,j+1} − u_{i,j})/Δy`, and alike at the other
+//! three corners. So
+//!
+//! ```text
+//! L_d = Δt ΔxΔy/4 Σ_corners [ ½ ρ |(u^{n+1} − u^n)/Δt|² − ½ Σ_{m=n,n+1} U(x, y, u^m, u_x^m, u_y^m) ]
+//! ```
+//!
+//! and, as on the line, the discrete Euler–Lagrange equations at every node are the
+//! Störmer–Verlet step of `K(u̇) − Φ(u)`: node masses `m = w_x w_y ρ` (`w = Δx`, or `Δx/2` at a
+//! free edge, `0` at a fixed one), `Φ = ΔxΔy/4 Σ_cells Σ_corners U`. Each node's force is the sum
+//! of what its own four corners and its four neighbours' corners give it, so a step costs `O(N)`
+//! and solves nothing. For the membrane `U = ½ κ (u_x² + u_y²)` the corners make the five-point
+//! Laplacian, whose standing and travelling waves the step keeps with the leapfrog's discrete
+//! dispersion relation exactly. Being the flow of a discrete action on cells, the step keeps
+//! the discrete multisymplectic form formula; its order is 2 in space, and in time that of the
+//! [`Composition`].
+//!
+//! ```
+//! use dirac_runtime::nalgebra::SVector;
+//! use dirac_runtime::{Boundary, PlaneDensity, PlaneField, Scalar};
+//!
+//! /// The membrane `u_tt = u_xx + u_yy`.
+//! struct Membrane;
+//! impl PlaneDensity<1> for Membrane {
+//!     fn inertia(&self, _at: [f64; 2]) -> SVector<f64, 1> {
+//!         SVector::from([1.0])
+//!     }
+//!     fn potential<S: Scalar>(&self, _at: [f64; 2], _u: &SVector<S, 1>, ux: &SVector<S, 1>, uy: &SVector<S, 1>) -> S {
+//!         (ux[0] * ux[0] + uy[0] * uy[0]) * 0.5
+//!     }
+//! }
+//! // The square drum's first mode: u = sin(πx) sin(πy) cos(√2 π t).
+//! let fixed = [Boundary::Fixed; 2];
+//! let mut drum = PlaneField::new(Membrane, [(0.0, 1.0), (0.0, 1.0)], [50, 50], fixed, 0.005)?;
+//! let pi = std::f64::consts::PI;
+//! let u0: Vec<_> = drum.points().iter().map(|[x, y]| SVector::from([(pi * x).sin() * (pi * y).sin()])).collect();
+//! drum.start(&u0, &vec![SVector::zeros(); u0.len()])?;
+//! let quarter = 1.0 / (2.0 * 2f64.sqrt()); // a quarter period: u = 0
+//! drum.run((quarter / 0.005).round() as u64)?;
+//! assert!(drum.u()?.iter().all(|u| u[0].abs() < 1e-2));
+//! # Ok::<(), dirac_runtime::DiracError>(())
+//! ```
+
+use nalgebra::{Const, SVector, U1};
+use num_dual::{Derivative, DualSVec64, HyperDualSVec64};
+use rayon::prelude::*;
+
+use super::Boundary;
+use super::leapfrog::{self, GRAIN, Grid, PARALLEL_BLOCKS, Running, is_zero};
+use crate::base::error::DiracError;
+use crate::model::density::PlaneDensity;
+use crate::step::composition::Composition;
+
+/// What a node's four corners give to `∂Φ/∂u`, by receiving node: itself ([`OWN`]) and its
+/// neighbours to the right, left, above and below ([`RIGHT`], [`LEFT`], [`UP`], [`DOWN`]).
+type Sends<const C: usize> = [SVector<f64, C>; 5];
+const OWN: usize = 0;
+const RIGHT: usize = 1;
+const LEFT: usize = 2;
+const UP: usize = 3;
+const DOWN: usize = 4;
+
+/// A field on a rectangle of the plane with a separable Lagrangian density, stepped explicitly
+/// (see the [module](self) documentation). A failed step leaves the state as it was.
+///
+/// Nodes are numbered row by row: node `(i, j)`, at `(x_i, y_j)`, is `j · n_x + i`, where `n_x`
+/// is the number of nodes along `x` ([`PlaneField::nodes`]).
+#[derive(Debug, Clone)]
+pub struct PlaneField<D, const C: usize> {
+    density: D,
+    origin: [f64; 2],
+    spacing: [f64; 2],
+    cells: [usize; 2],
+    boundary: [Boundary; 2],
+    dt: f64,
+    composition: Composition,
+    parallel: bool,
+    /// `m = w_x w_y ρ`, by node; zero at a node on a fixed edge (it does not move).
+    mass: Vec<SVector<f64, C>>,
+    /// Every node's [`Sends`].
+    run: Option<Running<C, Vec<Sends<C>>>>,
+}
+
+/// Numbers that carry the derivatives along `u` and along `u_x` at once.
+type Pair<const C: usize> = HyperDualSVec64<C, C>;
+
+impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
+    /// The field of `density` on the rectangle `[a, b] × [c, d]` (`rectangle = [(a, b), (c, d)]`)
+    /// cut into `cells = [N_x, N_y]` cells, its edges along `x` and along `y` held by
+    /// `boundary = [at x = a and b, at y = c and d]`, stepped by Störmer–Verlet with step `dt`.
+    /// Refused: `InvalidStep` for a `dt` that is not positive and finite, `Dimension` for fewer
+    /// than 2 cells along an axis (3 when periodic), `InvalidRun` for sides that are empty or
+    /// not finite, `NonFinite` for an inertia or a node's mass that is not positive and finite.
+    ///
+    /// The step is explicit, so it is stable only below a limit on `dt`: about
+    /// `√(ρ/κ) / √(1/Δx² + 1/Δy²)` for a membrane of tension `κ`, less for compositions with
+    /// large coefficients and for stiff on-site terms. Above it the field grows from step to
+    /// step until a step is refused as `NonFinite`; watch the energy.
+    pub fn new(
+        density: D,
+        rectangle: [(f64, f64); 2],
+        cells: [usize; 2],
+        boundary: [Boundary; 2],
+        dt: f64,
+    ) -> Result<Self, DiracError> {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(DiracError::InvalidStep { h: dt });
+        }
+        let mut spacing = [0.0; 2];
+        for axis in 0..2 {
+            let (name, (a, b)) = (["x", "y"][axis], rectangle[axis]);
+            let least = if boundary[axis] == Boundary::Periodic {
+                3
+            } else {
+                2
+            };
+            if cells[axis] < least {
+                return Err(DiracError::Dimension(format!(
+                    "a field needs at least {least} cells along {name} with {:?} edges, got {}",
+                    boundary[axis], cells[axis]
+                )));
+            }
+            if !(a.is_finite() && b.is_finite() && b > a) {
+                return Err(DiracError::InvalidRun(format!(
+                    "a field's side along {name} must be finite and not empty, got ({a}, {b})"
+                )));
+            }
+            spacing[axis] = (b - a) / cells[axis] as f64;
+            if !(spacing[axis] > 0.0 && spacing[axis].is_finite()) {
+                return Err(DiracError::InvalidRun(format!(
+                    "the cells of ({a}, {b}) cut into {} have width {}: it must be positive and \
+                     finite",
+                    cells[axis], spacing[axis]
+                )));
+            }
+        }
+        let mut field = Self {
+            density,
+            origin: rectangle.map(|side| side.0),
+            spacing,
+            cells,
+            boundary,
+            dt,
+            composition: Composition::verlet(),
+            parallel: false,
+            mass: Vec::new(),
+            run: None,
+        };
+        field.mass = field.masses()?;
+        Ok(field)
+    }
+
+    /// The same field stepped by `composition` of Störmer–Verlet steps (order in time
+    /// `composition.order()`; by default [`Composition::verlet`], order 2). Ends a run.
+    pub fn with_composition(mut self, composition: Composition) -> Self {
+        self.composition = composition;
+        self.run = None;
+        self
+    }
+
+    /// Whether the passes of a step over the nodes are split across rayon's threads (by default
+    /// not), in blocks of 4 096 nodes. The steps are the same bit for bit; a field of fewer than
+    /// 16 384 nodes is stepped on one thread all the same. `cargo bench --bench step --
+    /// plane_field_step` measures the gain.
+    pub fn with_parallel(mut self, parallel: bool) -> Self {
+        self.parallel = parallel;
+        self
+    }
+
+    /// The weights `w` of the nodes along `axis`: the cell width, half of it at a free edge,
+    /// zero at a fixed one.
+    fn weights(&self, axis: usize) -> Vec<f64> {
+        let n = self.nodes()[axis];
+        let width = self.spacing[axis];
+        (0..n)
+            .map(|i| match (self.boundary[axis], i == 0 || i == n - 1) {
+                (Boundary::Periodic, _) | (_, false) => width,
+                (Boundary::Fixed, true) => 0.0,
+                (Boundary::Free, true) => 0.5 * width,
+            })
+            .collect()
+    }
+
+    /// The node masses `w_x w_y ρ`, checked.
+    fn masses(&self) -> Result<Vec<SVector<f64, C>>, DiracError> {
+        let (wx, wy) = (self.weights(0), self.weights(1));
+        let nx = wx.len();
+        (0..nx * wy.len())
+            .map(|k| {
+                let at = self.position(k);
+                let rho = self.density.inertia(at);
+                if let Some(&bad) = rho.iter().find(|r| !(**r > 0.0 && r.is_finite())) {
+                    return Err(DiracError::NonFinite {
+                        what: format!("the inertia at {at:?} (it must be positive and finite)"),
+                        value: bad,
+                    });
+                }
+                let mass = rho * (wx[k % nx] * wy[k / nx]);
+                let fixed = wx[k % nx] == 0.0 || wy[k / nx] == 0.0;
+                match mass.iter().find(|m| !(fixed || **m > 0.0 && m.is_finite())) {
+                    Some(&bad) => Err(DiracError::NonFinite {
+                        what: format!(
+                            "the mass of node {k} (ρ w_x w_y must be positive and finite)"
+                        ),
+                        value: bad,
+                    }),
+                    None => Ok(mass),
+                }
+            })
+            .collect()
+    }
+
+    /// The numbers of nodes `[n_x, n_y]`: along a periodic axis as many as cells, else one more.
+    pub fn nodes(&self) -> [usize; 2] {
+        [0, 1].map(|axis| match self.boundary[axis] {
+            Boundary::Periodic => self.cells[axis],
+            Boundary::Fixed | Boundary::Free => self.cells[axis] + 1,
+        })
+    }
+
+    /// The numbers of cells `[N_x, N_y]`.
+    pub fn cells(&self) -> [usize; 2] {
+        self.cells
+    }
+
+    /// How the edges are held: `[at x = a and b, at y = c and d]`.
+    pub fn boundary(&self) -> [Boundary; 2] {
+        self.boundary
+    }
+
+    /// The cell size `[Δx, Δy]`.
+    pub fn spacing(&self) -> [f64; 2] {
+        self.spacing
+    }
+
+    /// The time step `Δt`.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// The composition each step takes.
+    pub fn composition(&self) -> &Composition {
+        &self.composition
+    }
+
+    /// The position `[x_i, y_j]` of node `k = j n_x + i`.
+    fn position(&self, k: usize) -> [f64; 2] {
+        let nx = self.nodes()[0];
+        let (i, j) = (k % nx, k / nx);
+        [
+            self.origin[0] + i as f64 * self.spacing[0],
+            self.origin[1] + j as f64 * self.spacing[1],
+        ]
+    }
+
+    /// The positions `[x, y]` of the nodes, row by row.
+    pub fn points(&self) -> Vec<[f64; 2]> {
+        let [nx, ny] = self.nodes();
+        (0..nx * ny).map(|k| self.position(k)).collect()
+    }
+
+    /// The positions `x_i` and `y_j` of the nodes along each axis.
+    pub fn axes(&self) -> [Vec<f64>; 2] {
+        let nodes = self.nodes();
+        [0, 1].map(|a| {
+            let at = |i: usize| self.origin[a] + i as f64 * self.spacing[a];
+            (0..nodes[a]).map(at).collect()
+        })
+    }
+
+    /// The neighbour of index `i` along `axis`, a step `+1` or `−1` away, where there is one.
+    fn neighbour(&self, axis: usize, i: usize, up: bool) -> Option<usize> {
+        let n = self.nodes()[axis];
+        let periodic = self.boundary[axis] == Boundary::Periodic;
+        match (up, i) {
+            (true, i) if i + 1 < n => Some(i + 1),
+            (true, _) => periodic.then_some(0),
+            (false, 0) => periodic.then_some(n - 1),
+            (false, i) => Some(i - 1),
+        }
+    }
+
+    /// Starts a run from the field `u` and its rate `u_t` at the nodes, row by row (momenta
+    /// `m u_t`). Refused with nothing changed: `Dimension` for a slice that is not one value per
+    /// node, `NonFinite` for a value that is not finite, `InconsistentInitialState` for a node
+    /// on a fixed edge that moves.
+    pub fn start(
+        &mut self,
+        u: &[SVector<f64, C>],
+        ut: &[SVector<f64, C>],
+    ) -> Result<(), DiracError> {
+        let sends = vec![[SVector::zeros(); 5]; self.mass.len()];
+        self.run = Some(leapfrog::start(self, u, ut, sends)?);
+        Ok(())
+    }
+
+    /// The shares of `∂Φ/∂u` that node `k`'s corners (`k` the node, `u` the field) give to it
+    /// and to its neighbours.
+    fn sends(&self, k: usize, u: &[SVector<f64, C>]) -> Sends<C> {
+        let nx = self.nodes()[0];
+        let (i, j) = (k % nx, k / nx);
+        let [dx, dy] = self.spacing;
+        let at = self.position(k);
+        let mut sends = [SVector::zeros(); 5];
+        for (sx, to_x) in [(1.0, RIGHT), (-1.0, LEFT)] {
+            let Some(across) = self.neighbour(0, i, sx > 0.0) else {
+                continue;
+            };
+            let ux = (u[j * nx + across] - u[k]) * (sx / dx);
+            for (sy, to_y) in [(1.0, UP), (-1.0, DOWN)] {
+                let Some(above) = self.neighbour(1, j, sy > 0.0) else {
+                    continue;
+                };
+                let uy = (u[above * nx + i] - u[k]) * (sy / dy);
+                let (by_u, by_ux, by_uy) = self.potential_gradient(at, &u[k], &ux, &uy);
+                let (along_x, along_y) = (by_ux * (sx / dx), by_uy * (sy / dy));
+                sends[OWN] += by_u - along_x - along_y;
+                sends[to_x] += along_x;
+                sends[to_y] += along_y;
+            }
+        }
+        let weight = 0.25 * dx * dy;
+        sends.map(|s| s * weight)
+    }
+
+    /// `∂Φ/∂u` at node `k` from every node's [`Sends`].
+    fn gathered(&self, k: usize, sends: &[Sends<C>]) -> SVector<f64, C> {
+        let nx = self.nodes()[0];
+        let (i, j) = (k % nx, k / nx);
+        let mut sum = sends[k][OWN];
+        let from = [
+            (self.neighbour(0, i, false).map(|l| j * nx + l), RIGHT),
+            (self.neighbour(0, i, true).map(|r| j * nx + r), LEFT),
+            (self.neighbour(1, j, false).map(|d| d * nx + i), UP),
+            (self.neighbour(1, j, true).map(|a| a * nx + i), DOWN),
+        ];
+        for (node, what) in from {
+            if let Some(node) = node {
+                sum += sends[node][what];
+            }
+        }
+        sum
+    }
+
+    /// The forces `f` on a block of nodes from `first` on, gathered from every node's
+    /// [`Sends`], and the kick `p += kick · f`.
+    fn gather(
+        &self,
+        first: usize,
+        f: &mut [SVector<f64, C>],
+        p: &mut [SVector<f64, C>],
+        sends: &[Sends<C>],
+        kick: f64,
+    ) {
+        for (k, (f, p)) in f.iter_mut().zip(p.iter_mut()).enumerate() {
+            let node = first + k;
+            *f = match is_zero(&self.mass[node]) {
+                true => SVector::zeros(),
+                false => -self.gathered(node, sends),
+            };
+            *p += *f * kick;
+        }
+    }
+
+    /// `(∂U/∂u, ∂U/∂u_x, ∂U/∂u_y)` at `(at, u, u_x, u_y)`: one pass of hyper-dual numbers with
+    /// `u` along the first infinitesimals and `u_x` along the second, one of dual numbers along
+    /// `u_y`.
+    fn potential_gradient(
+        &self,
+        at: [f64; 2],
+        u: &SVector<f64, C>,
+        ux: &SVector<f64, C>,
+        uy: &SVector<f64, C>,
+    ) -> (SVector<f64, C>, SVector<f64, C>, SVector<f64, C>) {
+        let unit = |i: usize| SVector::<f64, C>::from_fn(|j, _| if i == j { 1.0 } else { 0.0 });
+        let pair_u = SVector::from_fn(|i, _| {
+            let along = Derivative::some(unit(i));
+            Pair::new(u[i], along, Derivative::none(), Derivative::none())
+        });
+        let pair_ux = SVector::from_fn(|i, _| {
+            let along = Derivative::some(unit(i).transpose());
+            Pair::new(ux[i], Derivative::none(), along, Derivative::none())
+        });
+        let pair_uy = uy.map(Pair::from_re);
+        let value = self.density.potential(at, &pair_u, &pair_ux, &pair_uy);
+        let by_u = value.eps1.unwrap_generic(Const::<C>, U1);
+        let by_ux = value.eps2.unwrap_generic(U1, Const::<C>).transpose();
+        let plain = |v: &SVector<f64, C>| v.map(DualSVec64::<C>::from_re);
+        let dual_uy = SVector::from_fn(|i, _| DualSVec64::new(uy[i], Derivative::some(unit(i))));
+        let value = self.density.potential(at, &plain(u), &plain(ux), &dual_uy);
+        let by_uy = value.eps.unwrap_generic(Const::<C>, U1);
+        (by_u, by_ux, by_uy)
+    }
+
+    /// Advances one step. On error nothing changes: `NotStarted` before a start, `NonFinite`
+    /// where the step reaches a value that is not finite (try a smaller step).
+    pub fn step(&mut self) -> Result<(), DiracError> {
+        self.run(1)
+    }
+
+    /// Advances `steps` steps; stops at the first error, with the state of the step before it.
+    pub fn run(&mut self, steps: u64) -> Result<(), DiracError> {
+        let mut run = self.run.take().ok_or(DiracError::NotStarted)?;
+        let field = &*self;
+        let taken = leapfrog::run_steps(self.in_parallel(), steps, || {
+            leapfrog::advance(field, &field.composition, field.dt, &mut run)
+        });
+        self.run = Some(run);
+        taken
+    }
+
+    fn running(&self) -> Result<&Running<C, Vec<Sends<C>>>, DiracError> {
+        self.run.as_ref().ok_or(DiracError::NotStarted)
+    }
+
+    /// The field at the nodes, row by row.
+    pub fn u(&self) -> Result<&[SVector<f64, C>], DiracError> {
+        Ok(&self.running()?.now.u)
+    }
+
+    /// The momenta `m u̇` of the nodes (`m = w_x w_y ρ`, zero on a fixed edge).
+    pub fn momenta(&self) -> Result<&[SVector<f64, C>], DiracError> {
+        Ok(&self.running()?.now.p)
+    }
+
+    /// The force `−∂Φ/∂u` on the nodes (zero on a fixed edge): what the cells' potential pulls
+    /// each node with.
+    pub fn force(&self) -> Result<&[SVector<f64, C>], DiracError> {
+        Ok(&self.running()?.now.force)
+    }
+
+    /// The rates `u̇ = p / m` at the nodes (zero on a fixed edge).
+    pub fn velocities(&self) -> Result<Vec<SVector<f64, C>>, DiracError> {
+        Ok(leapfrog::rates(&self.running()?.now.p, &self.mass))
+    }
+
+    /// The time `n Δt` of the current state (0 before a start).
+    pub fn t(&self) -> f64 {
+        self.run.as_ref().map_or(0.0, |r| r.steps as f64 * self.dt)
+    }
+
+    /// The number of steps taken since the start.
+    pub fn steps(&self) -> u64 {
+        self.run.as_ref().map_or(0, |r| r.steps)
+    }
+
+    /// The energy of the semi-discrete field, `Σ |p|²_{m⁻¹}/2 + Φ(u)`. The step does not keep it
+    /// exactly; it keeps a nearby modified energy, so its error stays bounded (of the order of
+    /// `Δt^order`) over long runs.
+    pub fn energy(&self) -> Result<f64, DiracError> {
+        let run = self.running()?;
+        let u = &run.now.u;
+        let kinetic = leapfrog::kinetic(&run.now.p, &self.mass);
+        let nx = self.nodes()[0];
+        let [dx, dy] = self.spacing;
+        let corners = |k: usize| {
+            let (i, j) = (k % nx, k / nx);
+            let mut sum = 0.0;
+            for (sx, across) in [1.0, -1.0].map(|s| (s, self.neighbour(0, i, s > 0.0))) {
+                for (sy, above) in [1.0, -1.0].map(|s| (s, self.neighbour(1, j, s > 0.0))) {
+                    if let (Some(across), Some(above)) = (across, above) {
+                        let ux = (u[j * nx + across] - u[k]) * (sx / dx);
+                        let uy = (u[above * nx + i] - u[k]) * (sy / dy);
+                        sum += self.density.potential(self.position(k), &u[k], &ux, &uy);
+                    }
+                }
+            }
+            sum
+        };
+        let potential: f64 = (0..u.len()).map(corners).sum();
+        Ok(kinetic + 0.25 * dx * dy * potential)
+    }
+}
+
+impl<D: PlaneDensity<C>, const C: usize> Grid<C> for PlaneField<D, C> {
+    type Scratch = Vec<Sends<C>>;
+
+    fn mass(&self) -> &[SVector<f64, C>] {
+        &self.mass
+    }
+
+    fn in_parallel(&self) -> bool {
+        self.parallel && self.mass.len() >= PARALLEL_BLOCKS * GRAIN
+    }
+
+    /// Two passes over the nodes, each a block of [`GRAIN`] nodes at a time: every node's
+    /// [`Sends`], then each node's gathered force and kick.
+    fn force_and_kick(
+        &self,
+        u: &[SVector<f64, C>],
+        f: &mut [SVector<f64, C>],
+        p: &mut [SVector<f64, C>],
+        sends: &mut Self::Scratch,
+        kick: f64,
+    ) {
+        let send = |(b, block): (usize, &mut [Sends<C>])| {
+            for (k, s) in block.iter_mut().enumerate() {
+                *s = self.sends(b * GRAIN + k, u);
+            }
+        };
+        if self.in_parallel() {
+            sends.par_chunks_mut(GRAIN).enumerate().for_each(send);
+        } else {
+            sends.chunks_mut(GRAIN).enumerate().for_each(send);
+        }
+        let sends = &*sends;
+        if self.in_parallel() {
+            let blocks = f.par_chunks_mut(GRAIN).zip(p.par_chunks_mut(GRAIN));
+            let gather = |(b, (f, p))| self.gather(b * GRAIN, f, p, sends, kick);
+            blocks.enumerate().for_each(gather);
+        } else {
+            let blocks = f.chunks_mut(GRAIN).zip(p.chunks_mut(GRAIN));
+            let gather = |(b, (f, p))| self.gather(b * GRAIN, f, p, sends, kick);
+            blocks.enumerate().for_each(gather);
+        }
+    }
+}

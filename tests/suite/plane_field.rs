@@ -1,0 +1,488 @@
+//! Fields on a rectangle of the plane (`PlaneField`): the membrane's discrete dispersion relation
+//! held exactly with fixed, free and periodic edges, the order in space and time against the
+//! drum's modes, the compositions' orders in time, the force as the gradient of the discrete
+//! potential for a nonlinear anisotropic medium, the multisymplectic law node by node, a
+//! hand-written five-point leapfrog followed to round-off, bounded energy, parallel steps,
+//! refusals.
+
+use std::f64::consts::{PI, TAU};
+
+use crate::support::{assert_order, energy_error_first_and_last_tenth};
+use dirac::nalgebra::SVector;
+use dirac::{Boundary, Composition, DiracError, PlaneDensity, PlaneField, Scalar};
+use scenes::membrane::{self, CoupledMembranes, DRUM, Membrane};
+
+/// One-component values at the nodes of `field` of `f(x, y)`.
+fn at<D: PlaneDensity<1>>(
+    field: &PlaneField<D, 1>,
+    f: impl Fn(f64, f64) -> f64,
+) -> Vec<SVector<f64, 1>> {
+    let points = field.points().into_iter();
+    points.map(|[x, y]| SVector::from([f(x, y)])).collect()
+}
+
+/// The largest `|u − exact(x, y)|` over the nodes.
+fn error<D: PlaneDensity<1>>(field: &PlaneField<D, 1>, exact: impl Fn(f64, f64) -> f64) -> f64 {
+    let u = field.u().unwrap().iter();
+    let gap = u
+        .zip(field.points())
+        .map(|(u, [x, y])| (u[0] - exact(x, y)).abs());
+    gap.fold(0.0, f64::max)
+}
+
+/// The leapfrog's modes of the five-point membrane are exact solutions of the step, whatever
+/// holds the edges: standing waves `sin·sin` on a drum fixed all round and `cos·sin` with two
+/// free edges (whose half and quarter cells keep `cos` an eigenvector), a wave `cos(k_x x − ωt)`
+/// travelling round a periodic axis over a `cos` of free edges. Each is followed to round-off
+/// over 2 000 steps at `sin(ωΔt/2) = (Δt/2) ω_h`, where the continuum's `ω = |k|` is off by
+/// order one.
+#[test]
+fn the_membrane_keeps_its_discrete_dispersion_relation() {
+    let (sides, cells, dt) = ([(0.0, 2.0), (0.0, 1.5)], [20, 12], 0.05);
+    let (fixed, free, periodic) = (Boundary::Fixed, Boundary::Free, Boundary::Periodic);
+    type Shape = fn(f64, f64, [f64; 2]) -> f64;
+    let sin_sin: Shape = |x, y, k| (k[0] * x).sin() * (k[1] * y).sin();
+    let cos_sin: Shape = |x, y, k| (k[0] * x).cos() * (k[1] * y).sin();
+    let cases: [([Boundary; 2], [f64; 2], Shape); 3] = [
+        ([fixed, fixed], [PI, 2.0 * PI / 1.5], sin_sin),
+        ([free, fixed], [1.5 * PI, 2.0 * PI / 1.5], cos_sin),
+        ([periodic, free], [TAU, PI / 1.5], |x, y, k| {
+            (k[0] * x).cos() * (k[1] * y).cos()
+        }),
+    ];
+    for (boundary, k, shape) in cases {
+        let mut drum = PlaneField::new(DRUM, sides, cells, boundary, dt).unwrap();
+        let omega = membrane::discrete_frequency(k, drum.spacing(), dt);
+        let travelling = boundary[0] == periodic;
+        // Störmer–Verlet's momentum at t_n is (u^{n+1} − u^{n−1})/(2Δt).
+        let rate = |x: f64, y: f64| match travelling {
+            true => (k[0] * x).sin() * (k[1] * y).cos() * (omega * dt).sin() / dt,
+            false => 0.0,
+        };
+        drum.start(&at(&drum, |x, y| shape(x, y, k)), &at(&drum, rate))
+            .unwrap();
+        drum.run(2_000).unwrap();
+        let t = drum.t();
+        let exact = |omega: f64| {
+            move |x: f64, y: f64| match travelling {
+                true => (k[0] * x - omega * t).cos() * (k[1] * y).cos(),
+                false => shape(x, y, k) * (omega * t).cos(),
+            }
+        };
+        let discrete = error(&drum, exact(omega));
+        let continuum = error(&drum, exact(membrane::frequency(k)));
+        println!("{boundary:?}: discrete relation {discrete:.2e}, continuum's {continuum:.2e}");
+        assert!(discrete < 1e-11, "{boundary:?}: off by {discrete:e}");
+        assert!(
+            continuum > 0.1,
+            "{boundary:?}: continuum as close, {continuum:e}"
+        );
+    }
+}
+
+/// In space and time together (Δt = Δx/2), the drum fixed all round converges at order 2 to its
+/// mode `sin(πx) sin(2πy) cos(√5 π t)` of the continuum.
+#[test]
+fn the_drum_converges_at_order_two() {
+    let t = 1.0;
+    let omega = 5f64.sqrt() * PI;
+    let exact = |x: f64, y: f64| (PI * x).sin() * (2.0 * PI * y).sin() * (omega * t).cos();
+    let sizes = [12, 24, 48];
+    let errors: Vec<f64> = sizes
+        .iter()
+        .map(|&n| {
+            let dx = 1.0 / n as f64;
+            let fixed = [Boundary::Fixed; 2];
+            let square = [(0.0, 1.0); 2];
+            let mut drum = PlaneField::new(DRUM, square, [n, n], fixed, 0.5 * dx).unwrap();
+            let u0 = at(&drum, |x, y| exact(x, y) / (omega * t).cos());
+            drum.start(&u0, &at(&drum, |_, _| 0.0)).unwrap();
+            drum.run(2 * n as u64).unwrap();
+            error(&drum, exact)
+        })
+        .collect();
+    let hs: Vec<f64> = sizes.iter().map(|&n| 1.0 / n as f64).collect();
+    assert_order("drum against the continuum", &hs, &errors, 2.0);
+}
+
+/// In time, each composition has its order against the travelling wave of the semi-discrete
+/// membrane, `cos(2x + y − ω_h t)`, which the grid carries exactly.
+#[test]
+fn each_composition_has_its_order_in_time() {
+    let (k, t) = ([2.0, 1.0], 1.0);
+    let sides = [(0.0, TAU), (0.0, TAU)];
+    let cells = [12, 8];
+    let spacing = [TAU / 12.0, TAU / 8.0];
+    let omega = membrane::semi_discrete_frequency(k, spacing);
+    let cases = [
+        (Composition::verlet(), [20, 40, 80]),
+        (Composition::suzuki(), [8, 16, 32]),
+        (Composition::kahan_li_8(), [5, 7, 10]),
+    ];
+    for (composition, steps) in cases {
+        let order = composition.order() as f64;
+        let name = composition.name();
+        let errors: Vec<f64> = steps
+            .iter()
+            .map(|&n| {
+                let dt = t / n as f64;
+                let periodic = [Boundary::Periodic; 2];
+                let mut wave = PlaneField::new(DRUM, sides, cells, periodic, dt)
+                    .unwrap()
+                    .with_composition(composition.clone());
+                let u0 = at(&wave, |x, y| (k[0] * x + k[1] * y).cos());
+                let ut0 = at(&wave, |x, y| omega * (k[0] * x + k[1] * y).sin());
+                wave.start(&u0, &ut0).unwrap();
+                wave.run(n).unwrap();
+                error(&wave, |x, y| (k[0] * x + k[1] * y - omega * t).cos())
+            })
+            .collect();
+        let hs: Vec<f64> = steps.iter().map(|&n| t / n as f64).collect();
+        assert_order(name, &hs, &errors, order);
+    }
+}
+
+/// A nonlinear, anisotropic medium of two components whose inertia and stiffness vary over the
+/// plane, with slopes coupled across directions and components:
+/// `U = ½ (1 + x) u_x² + ½ (2 + sin y) u_y² + 0.3 u_x u_y + ½ (w_x² + w_y²) + 0.2 u_x w_y
+///   + 0.05 w_x⁴ + (1 − cos u) + 0.1 u² w²`.
+#[derive(Clone)]
+struct Medium;
+impl PlaneDensity<2> for Medium {
+    fn inertia(&self, [x, y]: [f64; 2]) -> SVector<f64, 2> {
+        SVector::from([1.0 + x * x, 2.0 + y])
+    }
+    fn potential<S: Scalar>(
+        &self,
+        [x, y]: [f64; 2],
+        u: &SVector<S, 2>,
+        ux: &SVector<S, 2>,
+        uy: &SVector<S, 2>,
+    ) -> S {
+        let stiff = ux[0] * ux[0] * (0.5 * (1.0 + x)) + uy[0] * uy[0] * (0.5 * (2.0 + y.sin()));
+        let cross = ux[0] * uy[0] * 0.3 + ux[0] * uy[1] * 0.2;
+        let second = (ux[1] * ux[1] + uy[1] * uy[1]) * 0.5 + ux[1].powi(4) * 0.05;
+        let site = -u[0].cos() + 1.0 + u[0] * u[0] * u[1] * u[1] * 0.1;
+        stiff + cross + second + site
+    }
+}
+
+/// The medium's field and rates at `(x, y)`: smooth, not small, nothing special at the edges.
+fn medium_start(x: f64, y: f64) -> (SVector<f64, 2>, SVector<f64, 2>) {
+    let u = SVector::from([(1.3 * x + 0.4).sin() + 0.5 * y, (0.7 * y - x).cos()]);
+    (u, SVector::from([0.2 * (x - y), 0.1 * x * y]))
+}
+
+/// The medium started from [`medium_start`], on `[0, 1.2] × [0.5, 1.3]` in 6 × 4 cells.
+fn medium(boundary: [Boundary; 2], dt: f64) -> PlaneField<Medium, 2> {
+    let sides = [(0.0, 1.2), (0.5, 1.3)];
+    let mut field = PlaneField::new(Medium, sides, [6, 4], boundary, dt).unwrap();
+    let (u, mut ut): (Vec<_>, Vec<_>) = field
+        .points()
+        .into_iter()
+        .map(|[x, y]| medium_start(x, y))
+        .unzip();
+    // Nodes on a fixed edge do not move.
+    for (rate, moves) in ut.iter_mut().zip(moving(&field)) {
+        if !moves {
+            *rate = SVector::zeros();
+        }
+    }
+    field.start(&u, &ut).unwrap();
+    field
+}
+
+/// Which nodes move: those not on a fixed edge.
+fn moving<D: PlaneDensity<C>, const C: usize>(field: &PlaneField<D, C>) -> Vec<bool> {
+    let ([nx, ny], [bx, by]) = (field.nodes(), field.boundary());
+    let on_fixed = |i: usize, n: usize, b: Boundary| b == Boundary::Fixed && (i == 0 || i == n - 1);
+    (0..nx * ny)
+        .map(|k| !(on_fixed(k % nx, nx, bx) || on_fixed(k / nx, ny, by)))
+        .collect()
+}
+
+/// The force the step kicks with is `−∂Φ/∂u` of the potential that `energy` sums corner by
+/// corner (central differences of the energy, node by node and component by component), and it
+/// is zero on a fixed edge: for the nonlinear anisotropic medium, with free, periodic and fixed
+/// edges. A corner read at the wrong node, a slope of the wrong sign or a send to the wrong
+/// neighbour is off by order one.
+#[test]
+fn the_force_is_the_gradient_of_the_discrete_potential() {
+    let (free, fixed, periodic) = (Boundary::Free, Boundary::Fixed, Boundary::Periodic);
+    for boundary in [[free, periodic], [fixed, free], [periodic, fixed]] {
+        let field = medium(boundary, 0.01);
+        let (u, ut) = (field.u().unwrap().to_vec(), field.velocities().unwrap());
+        let force = field.force().unwrap().to_vec();
+        let moving = moving(&field);
+        let h = 1e-6;
+        let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
+        for (k, moves) in moving.iter().enumerate() {
+            for c in 0..2 {
+                let energy_at = |shift: f64| {
+                    let mut probe = field.clone();
+                    let mut v = u.clone();
+                    v[k][c] += shift;
+                    probe.start(&v, &ut).unwrap();
+                    probe.energy().unwrap()
+                };
+                let gradient = (energy_at(h) - energy_at(-h)) / (2.0 * h);
+                match moves {
+                    true => worst = worst.max((force[k][c] + gradient).abs()),
+                    false => assert_eq!(force[k][c], 0.0, "node {k} on a fixed edge"),
+                }
+                scale = scale.max(gradient.abs());
+            }
+        }
+        println!("{boundary:?}: force against −∂Φ/∂u, {worst:.1e} of {scale:.1e}");
+        assert!(
+            scale > 0.1 && worst < 1e-7 * scale,
+            "{boundary:?}: {worst:e} of {scale:e}"
+        );
+    }
+}
+
+/// The discrete multisymplectic conservation law, node by node and step by step. For a linear
+/// density any two solutions `U`, `W` are first variations of each other, and the five-point
+/// leapfrog keeps
+/// `(κ^{n+½} − κ^{n−½})/Δt = (φ_{i+½,j} − φ_{i−½,j})/Δx + (ψ_{i,j+½} − ψ_{i,j−½})/Δy` at every
+/// node, with `κ^{n+½} = (U^{n+1}·W^n − W^{n+1}·U^n)/Δt`,
+/// `φ_{i+½,j} = (U_{i+1,j}·W_{i,j} − W_{i+1,j}·U_{i,j})/Δx` and `ψ` alike along `y` (the springs'
+/// terms cancel between the two components). Two coupled membranes on a periodic grid of
+/// unequal spacings from unrelated rough data, 200 steps.
+#[test]
+fn the_multisymplectic_law_holds_node_by_node() {
+    let (cells, dt) = ([10, 8], 0.05);
+    let sides = [(0.0, TAU), (0.0, 3.0)];
+    let spacing = [TAU / 10.0, 3.0 / 8.0];
+    // A fixed sequence of pseudo-random numbers in [−1, 1).
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut random = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    };
+    let mut histories = Vec::new();
+    for _ in 0..2 {
+        let periodic = [Boundary::Periodic; 2];
+        let mut pair =
+            PlaneField::new(CoupledMembranes { k: 2.0 }, sides, cells, periodic, dt).unwrap();
+        let n = pair.points().len();
+        let mut values = || -> Vec<SVector<f64, 2>> {
+            (0..n)
+                .map(|_| SVector::from([random(), random()]))
+                .collect()
+        };
+        let (u0, ut0) = (values(), values());
+        pair.start(&u0, &ut0).unwrap();
+        let mut history = vec![pair.u().unwrap().to_vec()];
+        for _ in 0..200 {
+            pair.step().unwrap();
+            history.push(pair.u().unwrap().to_vec());
+        }
+        histories.push(history);
+    }
+    let (u, w) = (&histories[0], &histories[1]);
+    let [nx, ny] = cells;
+    let node = |i: usize, j: usize| (j % ny) * nx + i % nx;
+    let kappa = |m: usize, k: usize| (u[m + 1][k].dot(&w[m][k]) - w[m + 1][k].dot(&u[m][k])) / dt;
+    let flux = |m: usize, from: usize, to: usize, h: f64| {
+        (u[m][to].dot(&w[m][from]) - w[m][to].dot(&u[m][from])) / h
+    };
+    let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
+    for m in 1..u.len() - 1 {
+        for j in 0..ny {
+            for i in 0..nx {
+                let k = node(i, j);
+                let (left, right) = (node(i + nx - 1, j), node(i + 1, j));
+                let (below, above) = (node(i, j + ny - 1), node(i, j + 1));
+                let [dx, dy] = spacing;
+                let time = (kappa(m, k) - kappa(m - 1, k)) / dt;
+                let along_x = (flux(m, k, right, dx) - flux(m, left, k, dx)) / dx;
+                let along_y = (flux(m, k, above, dy) - flux(m, below, k, dy)) / dy;
+                worst = worst.max((time - along_x - along_y).abs());
+                scale = scale.max(time.abs() + along_x.abs() + along_y.abs());
+            }
+        }
+    }
+    println!("multisymplectic law: largest defect {worst:.2e} against terms of {scale:.2e}");
+    assert!(
+        scale > 1.0 && worst < 1e-13 * scale,
+        "{worst:e} of {scale:e}"
+    );
+}
+
+/// A periodic membrane of 130 × 70 nodes, whose passes take three blocks, follows a hand-written
+/// five-point leapfrog (`scenes::membrane::leapfrog_membrane`) to round-off over 100 steps, the
+/// blocks' edges and the wrap-around included.
+#[test]
+fn a_membrane_equals_a_hand_written_five_point_leapfrog() {
+    let (cells, dt) = ([130, 70], 0.02);
+    let sides = [(0.0, 6.5), (0.0, 4.2)];
+    let spacing = [0.05, 0.06];
+    let periodic = [Boundary::Periodic; 2];
+    let mut drum = PlaneField::new(DRUM, sides, cells, periodic, dt).unwrap();
+    let shape = |x: f64, y: f64| {
+        (TAU * x / 6.5).sin() * (TAU * 2.0 * y / 4.2).cos() + (x * y).sin().powi(3) * 0.1
+    };
+    let u0 = at(&drum, shape);
+    drum.start(&u0, &at(&drum, |x, _| (TAU * x / 6.5).cos()))
+        .unwrap();
+    let mut u: Vec<f64> = u0.iter().map(|u| u[0]).collect();
+    let mut p: Vec<f64> = drum.velocities().unwrap().iter().map(|v| v[0]).collect();
+    let mut force = vec![0.0; u.len()];
+    membrane::laplacian(&u, &mut force, cells[0], spacing);
+    drum.run(100).unwrap();
+    for _ in 0..100 {
+        membrane::leapfrog_membrane([&mut u, &mut p, &mut force], cells[0], spacing, dt);
+    }
+    let worst = (drum.u().unwrap().iter().zip(&u))
+        .map(|(a, b)| (a[0] - b).abs())
+        .fold(0.0, f64::max);
+    let scale = u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    println!("against the hand-written leapfrog: {worst:.1e} of {scale:.1e}");
+    assert!(scale > 0.5 && worst < 1e-12 * scale, "{worst:e}");
+}
+
+/// The nonlinear medium with free and periodic edges over 4 000 steps: the energy error
+/// oscillates within the same band at the end as in the first tenth, a band well above
+/// round-off (the step keeps a modified energy, not the energy itself).
+#[test]
+fn the_energy_error_stays_bounded() {
+    let mut field = medium([Boundary::Free, Boundary::Periodic], 0.02);
+    let mut energy = vec![field.energy().unwrap()];
+    for _ in 0..400 {
+        field.run(10).unwrap();
+        energy.push(field.energy().unwrap());
+    }
+    let (first, last) = energy_error_first_and_last_tenth(&energy);
+    println!("energy error: first tenth {first:.2e}, last tenth {last:.2e}");
+    assert!(first > 1e-9, "the band is round-off: {first:e}");
+    assert!(last < 1.5 * first, "drift: {first:e} then {last:e}");
+}
+
+/// Split across threads (160 × 120 cells, above the grain), the steps are the same bit for bit.
+#[test]
+fn parallel_and_sequential_membranes_step_alike() {
+    let runs = [false, true].map(|parallel| {
+        let edges = [Boundary::Free, Boundary::Fixed];
+        let sides = [(0.0, 1.6), (0.0, 1.2)];
+        let mut drum = PlaneField::new(DRUM, sides, [160, 120], edges, 0.004)
+            .unwrap()
+            .with_parallel(parallel);
+        let u0 = at(&drum, |x, y| {
+            (3.0 * x).cos() * (PI * y / 1.2).sin() + x * y * (1.2 - y)
+        });
+        drum.start(&u0, &at(&drum, |_, _| 0.0)).unwrap();
+        drum.run(5).unwrap();
+        drum
+    });
+    assert_eq!(runs[0].u().unwrap(), runs[1].u().unwrap());
+    assert_eq!(runs[0].momenta().unwrap(), runs[1].momenta().unwrap());
+    assert_eq!(runs[0].t(), runs[1].t());
+}
+
+/// `U = ½ (u_x² + u_y²) + 2√u`: finite for `u ≥ 0`, not below.
+struct Root;
+impl PlaneDensity<1> for Root {
+    fn inertia(&self, _at: [f64; 2]) -> SVector<f64, 1> {
+        SVector::from([1.0])
+    }
+    fn potential<S: Scalar>(
+        &self,
+        _at: [f64; 2],
+        u: &SVector<S, 1>,
+        ux: &SVector<S, 1>,
+        uy: &SVector<S, 1>,
+    ) -> S {
+        (ux[0] * ux[0] + uy[0] * uy[0]) * 0.5 + u[0].sqrt() * 2.0
+    }
+}
+
+/// What a plane field refuses, and a failed step that changes nothing.
+#[test]
+fn what_a_plane_field_refuses() {
+    let (fixed, periodic) = ([Boundary::Fixed; 2], [Boundary::Periodic; 2]);
+    let unit = [(0.0, 1.0); 2];
+    let new = |sides: [(f64, f64); 2], cells: [usize; 2], edges: [Boundary; 2], dt: f64| {
+        PlaneField::new(DRUM, sides, cells, edges, dt).err()
+    };
+    assert!(matches!(
+        new(unit, [4, 4], fixed, 0.0),
+        Some(DiracError::InvalidStep { .. })
+    ));
+    assert!(matches!(
+        new(unit, [4, 4], fixed, f64::NAN),
+        Some(DiracError::InvalidStep { .. })
+    ));
+    assert!(matches!(
+        new(unit, [4, 1], fixed, 0.1),
+        Some(DiracError::Dimension(_))
+    ));
+    assert!(matches!(
+        new(unit, [2, 4], periodic, 0.1),
+        Some(DiracError::Dimension(_))
+    ));
+    let flat = [(0.0, 1.0), (1.0, 1.0)];
+    assert!(matches!(
+        new(flat, [4, 4], fixed, 0.1),
+        Some(DiracError::InvalidRun(_))
+    ));
+    let endless = [(0.0, f64::INFINITY), (0.0, 1.0)];
+    assert!(matches!(
+        new(endless, [4, 4], fixed, 0.1),
+        Some(DiracError::InvalidRun(_))
+    ));
+    let massless = Membrane {
+        rho: 0.0,
+        kappa: 1.0,
+    };
+    let refused = PlaneField::new(massless, unit, [4, 4], fixed, 0.1);
+    assert!(matches!(refused, Err(DiracError::NonFinite { .. })));
+
+    let mut drum = PlaneField::new(DRUM, unit, [4, 3], fixed, 0.01).unwrap();
+    assert_eq!(drum.step(), Err(DiracError::NotStarted));
+    assert_eq!(drum.u().err(), Some(DiracError::NotStarted));
+    let n = drum.points().len();
+    let (zeros, short) = (vec![SVector::zeros(); n], vec![SVector::zeros(); n - 1]);
+    assert!(matches!(
+        drum.start(&short, &zeros),
+        Err(DiracError::Dimension(_))
+    ));
+    assert!(matches!(
+        drum.start(&zeros, &short),
+        Err(DiracError::Dimension(_))
+    ));
+    let mut bad = zeros.clone();
+    bad[7][0] = f64::INFINITY;
+    assert!(matches!(
+        drum.start(&bad, &zeros),
+        Err(DiracError::NonFinite { .. })
+    ));
+    // Node 2 is on the lower edge, which is fixed.
+    let mut moving_edge = zeros.clone();
+    moving_edge[2][0] = 1.0;
+    assert!(matches!(
+        drum.start(&zeros, &moving_edge),
+        Err(DiracError::InconsistentInitialState(_))
+    ));
+    assert_eq!(drum.u().err(), Some(DiracError::NotStarted));
+
+    // The field falls below zero, where `U = … + 2√u` is not defined: the step is refused and the
+    // state is that of the step before.
+    let free = [Boundary::Free; 2];
+    let mut root = PlaneField::new(Root, unit, [3, 3], free, 0.3).unwrap();
+    root.start(&at(&root, |_, _| 0.05), &at(&root, |_, _| -0.1))
+        .unwrap();
+    let state = |f: &PlaneField<Root, 1>| {
+        let (u, p) = (f.u().unwrap().to_vec(), f.momenta().unwrap().to_vec());
+        (u, p, f.t(), f.energy().unwrap())
+    };
+    let before = state(&root);
+    let failed = root.step();
+    assert!(
+        matches!(failed, Err(DiracError::NonFinite { .. })),
+        "{failed:?}"
+    );
+    assert_eq!(before, state(&root));
+}
