@@ -1038,6 +1038,48 @@ fn field(c: &mut Criterion) {
     group.finish();
 }
 
+/// One step of the membrane (Störmer–Verlet, square cells Δx = 0.01, Δt = 0.005, periodic,
+/// started from a standing wave) by number of nodes, 10⁴ to 10⁶: `PlaneField` one block of nodes
+/// after another and in parallel, against a hand-written five-point leapfrog of the same scheme
+/// (`scenes::membrane::leapfrog_membrane`).
+fn plane_field(c: &mut Criterion) {
+    use dirac::{Boundary, PlaneField};
+    use scenes::membrane::{DRUM, laplacian, leapfrog_membrane};
+    let mut group = c.benchmark_group("plane_field_step");
+    group.sample_size(10);
+    let (dx, dt) = (0.01, 0.005);
+    for side in [100, 316, 1000] {
+        let nodes = side * side;
+        let length = side as f64 * dx;
+        let u0: Vec<f64> = (0..nodes)
+            .map(|k| ((k % side) as f64 * dx).sin() * ((k / side) as f64 * dx).cos())
+            .collect();
+        for parallel in [false, true] {
+            let periodic = [Boundary::Periodic; 2];
+            let sides = [(0.0, length); 2];
+            let mut drum = PlaneField::new(DRUM, sides, [side, side], periodic, dt)
+                .expect("valid field")
+                .with_parallel(parallel);
+            let u: Vec<SVector<f64, 1>> = u0.iter().map(|&u| SVector::from([u])).collect();
+            drum.start(&u, &vec![SVector::zeros(); nodes])
+                .expect("finite start");
+            let name = if parallel { "parallel" } else { "sequential" };
+            group.bench_with_input(BenchmarkId::new(name, nodes), &nodes, |b, _| {
+                b.iter(|| black_box(drum.step()).expect("step"))
+            });
+        }
+        let (mut u, mut p, mut force) = (u0.clone(), vec![0.0; nodes], vec![0.0; nodes]);
+        laplacian(&u, &mut force, side, [dx, dx]);
+        group.bench_with_input(BenchmarkId::new("hand_written", nodes), &nodes, |b, _| {
+            b.iter(|| {
+                leapfrog_membrane([&mut u, &mut p, &mut force], side, [dx, dx], dt);
+                black_box(&u);
+            })
+        });
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
     explicit,
@@ -1045,6 +1087,7 @@ criterion_group!(
     forced,
     modular,
     field,
+    plane_field,
     interconnection,
     routes,
     lie_group,

@@ -96,6 +96,12 @@ const GROUPS: &[(&str, &str)] = &[
          monolithic step, and its cost by number of components.",
     ),
     (
+        "plane_field_step",
+        "One step of the membrane (Störmer–Verlet, square cells, periodic) by number of nodes: \
+         `PlaneField` one block of nodes after another and in parallel, against a hand-written \
+         five-point leapfrog of the same scheme.",
+    ),
+    (
         "field_step",
         "One step of the sine-Gordon field (Störmer–Verlet, Δx = 0.05, Δt = 0.02, periodic) by \
          number of cells: `Field` one cell after another and in parallel, against a hand-written \
@@ -200,6 +206,45 @@ fn time(ns: f64) -> String {
     }
 }
 
+/// For each series of benchmarks whose ids end in a size (`name/N`, at least three sizes over a
+/// decade or more), the exponent `a` of the least-squares fit `median ∝ Nᵃ`, one table row each.
+fn growth(results: &[&Result]) -> String {
+    let mut series: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    for r in results {
+        let (name, size) = r.id.rsplit_once('/').unwrap_or(("", &r.id));
+        if let Ok(size) = size.parse::<f64>() {
+            let points = series.entry(name.to_owned()).or_default();
+            points.push((size.ln(), r.median.ln()));
+        }
+    }
+    let mut rows = String::new();
+    for (name, points) in series {
+        let (low, high) = points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                (l.min(p.0), h.max(p.0))
+            });
+        if points.len() < 3 || high - low < std::f64::consts::LN_10 {
+            continue;
+        }
+        let n = points.len() as f64;
+        let (mx, my) = points
+            .iter()
+            .fold((0.0, 0.0), |(x, y), p| (x + p.0 / n, y + p.1 / n));
+        let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+        let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+        let name = if name.is_empty() { "all" } else { &name };
+        let _ = writeln!(
+            rows,
+            "| {name} | {:.2} | {:.0} to {:.0} |",
+            sxy / sxx,
+            low.exp(),
+            high.exp()
+        );
+    }
+    rows
+}
+
 /// The id of `id`'s twin under the pair `(from, to)`, if `id` names `from` as a path segment.
 fn twin(id: &str, from: &str, to: &str) -> Option<String> {
     let segments: Vec<&str> = id.split('/').collect();
@@ -301,6 +346,13 @@ fn write(
             let _ = writeln!(out, "\n| ratio | medians |\n|---|---|\n{ratios}");
         } else {
             out.push('\n');
+        }
+        let growth = growth(&sorted);
+        if !growth.is_empty() {
+            let _ = writeln!(
+                out,
+                "| growth with the size | fitted exponent | sizes |\n|---|---|---|\n{growth}"
+            );
         }
     }
     if let Some(study) = study {

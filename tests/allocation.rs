@@ -14,30 +14,42 @@ struct Counting;
 thread_local! {
     /// Allocations made on this thread (a `const` thread-local: reading it never allocates).
     static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+    /// Bytes allocated less bytes freed on this thread.
+    static HELD: Cell<isize> = const { Cell::new(0) };
 }
 
-fn count_one() {
+fn count_one(bytes: isize) {
     ALLOCATIONS.with(|count| count.set(count.get() + 1));
+    HELD.with(|held| held.set(held.get() + bytes));
 }
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count_one();
+        count_one(layout.size() as isize);
         unsafe { System.alloc(layout) }
     }
 
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        HELD.with(|held| held.set(held.get() - layout.size() as isize));
         unsafe { System.dealloc(ptr, layout) }
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count_one();
+        count_one(new_size as isize - layout.size() as isize);
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
+
+/// What `make` returns and the bytes it still holds on the heap (allocated on this thread and
+/// not freed when `make` returns).
+fn held<T>(make: impl FnOnce() -> T) -> (T, isize) {
+    let before = HELD.with(Cell::get);
+    let made = make();
+    (made, HELD.with(Cell::get) - before)
+}
 
 /// Allocations made by `f` on this thread.
 fn allocations(f: impl FnOnce()) -> usize {
@@ -211,4 +223,67 @@ fn plane_field_steps_allocate_nothing() {
     let count = allocations(|| drum.run(20).unwrap());
     assert_eq!(count, 0, "{count} allocations in 20 steps of a plane field");
     assert_eq!(drum.steps(), 21);
+}
+
+/// A field's memory is linear in its nodes: a started field of four times the nodes holds the
+/// same bytes a node, on the line (1-D sine-Gordon, 10⁴ and 4·10⁴ cells) and on the plane (the
+/// membrane, 100² and 200² periodic nodes, which holds `7 C` numbers a node, the state and the
+/// step being taken and the mass, and three rows of the force's shares per band of rows).
+#[test]
+fn a_fields_memory_is_linear_in_its_nodes() {
+    use dirac::{Boundary, Field, PlaneField};
+    let line = |cells: usize| {
+        let zeros = vec![SVector::<f64, 1>::zeros(); cells];
+        let u0: Vec<SVector<f64, 1>> = (0..cells)
+            .map(|j| SVector::from([(j as f64).sin()]))
+            .collect();
+        let (field, bytes) = held(|| {
+            let periodic = Boundary::Periodic;
+            let mut field = Field::new(
+                scenes::field::SineGordon,
+                (0.0, cells as f64),
+                cells,
+                periodic,
+                0.1,
+            )
+            .unwrap();
+            field.start(&u0, &zeros).unwrap();
+            field
+        });
+        assert_eq!(field.u().unwrap().len(), cells);
+        bytes as f64 / cells as f64
+    };
+    let plane = |side: usize| {
+        let nodes = side * side;
+        let zeros = vec![SVector::<f64, 1>::zeros(); nodes];
+        let u0: Vec<SVector<f64, 1>> = (0..nodes)
+            .map(|k| SVector::from([(k as f64).sin()]))
+            .collect();
+        let (field, bytes) = held(|| {
+            let (periodic, sides) = ([Boundary::Periodic; 2], [(0.0, side as f64); 2]);
+            let mut drum =
+                PlaneField::new(scenes::membrane::DRUM, sides, [side, side], periodic, 0.1)
+                    .unwrap();
+            drum.start(&u0, &zeros).unwrap();
+            drum
+        });
+        assert_eq!(field.u().unwrap().len(), nodes);
+        bytes as f64 / nodes as f64
+    };
+    let (small, large) = (line(10_000), line(40_000));
+    println!("line: {small:.2} and {large:.2} bytes a node");
+    assert!(
+        (large / small - 1.0).abs() < 0.01,
+        "{small} then {large} bytes a node"
+    );
+    let (small, large) = (plane(100), plane(200));
+    println!("plane: {small:.2} and {large:.2} bytes a node");
+    assert!(
+        (large / small - 1.0).abs() < 0.05,
+        "{small} then {large} bytes a node"
+    );
+    assert!(
+        (56.0..60.0).contains(&small),
+        "{small} bytes a node, not 7 f64 and the rows"
+    );
 }

@@ -31,15 +31,6 @@ pub(super) struct Level<const C: usize> {
     pub force: Vec<SVector<f64, C>>,
 }
 
-impl<const C: usize> Level<C> {
-    /// Copies `other` into these buffers of the same lengths (no allocation).
-    fn copy_from(&mut self, other: &Self) {
-        self.u.copy_from_slice(&other.u);
-        self.p.copy_from_slice(&other.p);
-        self.force.copy_from_slice(&other.force);
-    }
-}
-
 /// The state of a run, the buffers a step writes into before it is accepted, and the grid's
 /// own scratch for its force.
 #[derive(Debug, Clone)]
@@ -90,6 +81,25 @@ pub(super) trait Grid<const C: usize> {
             nodes.zip(forces).for_each(block);
         } else {
             block(((u, p), (f, self.mass())));
+        }
+    }
+
+    /// [`Grid::kick_and_drift`] from the state `from` into `to`'s field and momenta, in one
+    /// pass (no copy of `from` first); `to`'s force is left as it was.
+    fn kick_and_drift_from(&self, from: &Level<C>, to: &mut Level<C>, (kick, tau): (f64, f64)) {
+        let block =
+            |((u, p), ((u0, p0), (f, m)))| kick_and_drift_from(u, p, [u0, p0, f, m], kick, tau);
+        let (u, p) = (&mut to.u, &mut to.p);
+        if self.in_parallel() {
+            let nodes = u.par_chunks_mut(GRAIN).zip(p.par_chunks_mut(GRAIN));
+            let state = from.u.par_chunks(GRAIN).zip(from.p.par_chunks(GRAIN));
+            let forces = from
+                .force
+                .par_chunks(GRAIN)
+                .zip(self.mass().par_chunks(GRAIN));
+            nodes.zip(state.zip(forces)).for_each(block);
+        } else {
+            block(((u, p), ((&from.u, &from.p), (&from.force, self.mass()))));
         }
     }
 }
@@ -156,19 +166,22 @@ pub(super) fn advance<G: Grid<C>, const C: usize>(
     run: &mut Running<C, G::Scratch>,
 ) -> Result<(), DiracError> {
     let mut next = std::mem::take(&mut run.next);
-    next.copy_from(&run.now);
-    let Level { u, p, force: f } = &mut next;
     // Each stage a kick, a drift and a kick; a stage's closing kick and the next one's opening
-    // kick are one, by the sum of their halves.
+    // kick are one, by the sum of their halves. The first stage's kick and drift read the state
+    // and write the step being taken; every force is written before it is read.
     let coefficients = composition.coefficients();
     for (i, &gamma) in coefficients.iter().enumerate() {
         let tau = gamma * dt;
-        let opening = if i == 0 { 0.5 * tau } else { 0.0 };
-        grid.kick_and_drift(u, p, f, (opening, tau));
+        match i {
+            0 => grid.kick_and_drift_from(&run.now, &mut next, (0.5 * tau, tau)),
+            _ => grid.kick_and_drift(&mut next.u, &mut next.p, &next.force, (0.0, tau)),
+        }
         let later = coefficients.get(i + 1).map_or(0.0, |g| g * dt);
+        let Level { u, p, force: f } = &mut next;
         grid.force_and_kick(u, f, p, &mut run.scratch, 0.5 * (tau + later));
     }
-    let bad = [("field", &*u), ("momentum", &*p), ("force", &*f)]
+    let Level { u, p, force: f } = &next;
+    let bad = [("field", u), ("momentum", p), ("force", f)]
         .into_iter()
         .find_map(|(what, values)| first_not_finite(values).map(|(j, v)| (what, j, v)));
     if let Some((what, j, value)) = bad {
@@ -244,6 +257,25 @@ fn kick_and_drift<const C: usize>(
         if !is_zero(m) {
             *u += p.component_div(m) * tau;
         }
+    }
+}
+
+/// `p = p0 + kick · f` and `u = u0 + tau · p/m` at each node that moves (`u = u0` elsewhere),
+/// from `[u0, p0, f, m]`.
+fn kick_and_drift_from<const C: usize>(
+    u: &mut [SVector<f64, C>],
+    p: &mut [SVector<f64, C>],
+    [u0, p0, f, mass]: [&[SVector<f64, C>]; 4],
+    kick: f64,
+    tau: f64,
+) {
+    let from = u0.iter().zip(p0).zip(f.iter().zip(mass));
+    for ((u, p), ((u0, p0), (f, m))) in u.iter_mut().zip(p.iter_mut()).zip(from) {
+        *p = p0 + f * kick;
+        *u = match is_zero(m) {
+            true => *u0,
+            false => u0 + p.component_div(m) * tau,
+        };
     }
 }
 

@@ -245,7 +245,12 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
                     None => Ok(mass),
                 }
             })
-            .collect()
+            .collect::<Result<Vec<_>, _>>()
+            // Collected without a size hint: hold no spare capacity.
+            .map(|mut mass| {
+                mass.shrink_to_fit();
+                mass
+            })
     }
 
     /// The number of nodes: `N` when periodic, else `N + 1`.

@@ -53,7 +53,7 @@ use num_dual::{Derivative, DualSVec64, HyperDualSVec64};
 use rayon::prelude::*;
 
 use super::Boundary;
-use super::leapfrog::{self, GRAIN, Grid, PARALLEL_BLOCKS, Running, is_zero};
+use super::leapfrog::{self, GRAIN, Grid, Running, is_zero};
 use crate::base::error::DiracError;
 use crate::model::density::PlaneDensity;
 use crate::step::composition::Composition;
@@ -78,15 +78,28 @@ pub struct PlaneField<D, const C: usize> {
     origin: [f64; 2],
     spacing: [f64; 2],
     cells: [usize; 2],
+    /// The numbers of nodes `[n_x, n_y]`.
+    nodes: [usize; 2],
     boundary: [Boundary; 2],
     dt: f64,
     composition: Composition,
     parallel: bool,
     /// `m = w_x w_y ρ`, by node; zero at a node on a fixed edge (it does not move).
     mass: Vec<SVector<f64, C>>,
-    /// Every node's [`Sends`].
-    run: Option<Running<C, Vec<Sends<C>>>>,
+    /// Per band of rows, a [`Window`].
+    run: Option<Running<C, Vec<Window<C>>>>,
 }
+
+/// The [`Sends`] of three rows of nodes: the row below the one being gathered, that row, and
+/// the row above.
+type Window<const C: usize> = [Vec<Sends<C>>; 3];
+
+/// Nodes a band of rows holds at least when the passes are split across threads: each band
+/// evaluates the corners of the rows just outside it again, one row on each side.
+const BAND: usize = 4 * GRAIN;
+
+/// Bands a field needs for its passes to be split across threads.
+const PARALLEL_BANDS: usize = 2;
 
 /// Numbers that carry the derivatives along `u` and along `u_x` at once.
 type Pair<const C: usize> = HyperDualSVec64<C, C>;
@@ -146,6 +159,10 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
             origin: rectangle.map(|side| side.0),
             spacing,
             cells,
+            nodes: [0, 1].map(|axis| match boundary[axis] {
+                Boundary::Periodic => cells[axis],
+                Boundary::Fixed | Boundary::Free => cells[axis] + 1,
+            }),
             boundary,
             dt,
             composition: Composition::verlet(),
@@ -166,8 +183,8 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
     }
 
     /// Whether the passes of a step over the nodes are split across rayon's threads (by default
-    /// not), in blocks of 4 096 nodes. The steps are the same bit for bit; a field of fewer than
-    /// 16 384 nodes is stepped on one thread all the same. `cargo bench --bench step --
+    /// not), in bands of rows of at least 16 384 nodes. The steps are the same bit for bit; a
+    /// field of one band is stepped on one thread all the same. `cargo bench --bench step --
     /// plane_field_step` measures the gain.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = parallel;
@@ -214,15 +231,17 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
                     None => Ok(mass),
                 }
             })
-            .collect()
+            .collect::<Result<Vec<_>, _>>()
+            // Collected without a size hint: hold no spare capacity.
+            .map(|mut mass| {
+                mass.shrink_to_fit();
+                mass
+            })
     }
 
     /// The numbers of nodes `[n_x, n_y]`: along a periodic axis as many as cells, else one more.
     pub fn nodes(&self) -> [usize; 2] {
-        [0, 1].map(|axis| match self.boundary[axis] {
-            Boundary::Periodic => self.cells[axis],
-            Boundary::Fixed | Boundary::Free => self.cells[axis] + 1,
-        })
+        self.nodes
     }
 
     /// The numbers of cells `[N_x, N_y]`.
@@ -252,8 +271,12 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
 
     /// The position `[x_i, y_j]` of node `k = j n_x + i`.
     fn position(&self, k: usize) -> [f64; 2] {
-        let nx = self.nodes()[0];
-        let (i, j) = (k % nx, k / nx);
+        let nx = self.nodes[0];
+        self.point(k % nx, k / nx)
+    }
+
+    /// The position `[x_i, y_j]` of node `(i, j)`.
+    fn point(&self, i: usize, j: usize) -> [f64; 2] {
         [
             self.origin[0] + i as f64 * self.spacing[0],
             self.origin[1] + j as f64 * self.spacing[1],
@@ -277,7 +300,7 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
 
     /// The neighbour of index `i` along `axis`, a step `+1` or `−1` away, where there is one.
     fn neighbour(&self, axis: usize, i: usize, up: bool) -> Option<usize> {
-        let n = self.nodes()[axis];
+        let n = self.nodes[axis];
         let periodic = self.boundary[axis] == Boundary::Periodic;
         match (up, i) {
             (true, i) if i + 1 < n => Some(i + 1),
@@ -296,76 +319,111 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         u: &[SVector<f64, C>],
         ut: &[SVector<f64, C>],
     ) -> Result<(), DiracError> {
-        let sends = vec![[SVector::zeros(); 5]; self.mass.len()];
-        self.run = Some(leapfrog::start(self, u, ut, sends)?);
+        let row = vec![[SVector::zeros(); 5]; self.nodes[0]];
+        let windows = vec![[row.clone(), row.clone(), row]; self.bands().1];
+        self.run = Some(leapfrog::start(self, u, ut, windows)?);
         Ok(())
     }
 
     /// The shares of `∂Φ/∂u` that node `k`'s corners (`k` the node, `u` the field) give to it
     /// and to its neighbours.
-    fn sends(&self, k: usize, u: &[SVector<f64, C>]) -> Sends<C> {
-        let nx = self.nodes()[0];
-        let (i, j) = (k % nx, k / nx);
+    fn sends(&self, (k, i, j): (usize, usize, usize), u: &[SVector<f64, C>]) -> Sends<C> {
+        let nx = self.nodes[0];
         let [dx, dy] = self.spacing;
-        let at = self.position(k);
+        let at = self.point(i, j);
+        let here = &u[k];
+        // The slopes along the node's edges that exist, each with its `∂slope/∂u` at the far
+        // node and the send that goes there.
+        let edge = |far: Option<usize>, rate: f64, to: usize| {
+            far.map(|far| ((u[far] - here) * rate, rate, to))
+        };
+        let (right, left) = (self.neighbour(0, i, true), self.neighbour(0, i, false));
+        let (above, below) = (self.neighbour(1, j, true), self.neighbour(1, j, false));
+        let along_x = [
+            edge(right.map(|r| j * nx + r), 1.0 / dx, RIGHT),
+            edge(left.map(|l| j * nx + l), -1.0 / dx, LEFT),
+        ];
+        let along_y = [
+            edge(above.map(|a| a * nx + i), 1.0 / dy, UP),
+            edge(below.map(|b| b * nx + i), -1.0 / dy, DOWN),
+        ];
         let mut sends = [SVector::zeros(); 5];
-        for (sx, to_x) in [(1.0, RIGHT), (-1.0, LEFT)] {
-            let Some(across) = self.neighbour(0, i, sx > 0.0) else {
-                continue;
-            };
-            let ux = (u[j * nx + across] - u[k]) * (sx / dx);
-            for (sy, to_y) in [(1.0, UP), (-1.0, DOWN)] {
-                let Some(above) = self.neighbour(1, j, sy > 0.0) else {
-                    continue;
-                };
-                let uy = (u[above * nx + i] - u[k]) * (sy / dy);
-                let (by_u, by_ux, by_uy) = self.potential_gradient(at, &u[k], &ux, &uy);
-                let (along_x, along_y) = (by_ux * (sx / dx), by_uy * (sy / dy));
-                sends[OWN] += by_u - along_x - along_y;
-                sends[to_x] += along_x;
-                sends[to_y] += along_y;
+        for (ux, rate_x, to_x) in along_x.iter().flatten() {
+            for (uy, rate_y, to_y) in along_y.iter().flatten() {
+                let (by_u, by_ux, by_uy) = self.potential_gradient(at, here, ux, uy);
+                let (to_far_x, to_far_y) = (by_ux * *rate_x, by_uy * *rate_y);
+                sends[OWN] += by_u - to_far_x - to_far_y;
+                sends[*to_x] += to_far_x;
+                sends[*to_y] += to_far_y;
             }
         }
         let weight = 0.25 * dx * dy;
         sends.map(|s| s * weight)
     }
 
-    /// `∂Φ/∂u` at node `k` from every node's [`Sends`].
-    fn gathered(&self, k: usize, sends: &[Sends<C>]) -> SVector<f64, C> {
-        let nx = self.nodes()[0];
-        let (i, j) = (k % nx, k / nx);
-        let mut sum = sends[k][OWN];
-        let from = [
-            (self.neighbour(0, i, false).map(|l| j * nx + l), RIGHT),
-            (self.neighbour(0, i, true).map(|r| j * nx + r), LEFT),
-            (self.neighbour(1, j, false).map(|d| d * nx + i), UP),
-            (self.neighbour(1, j, true).map(|a| a * nx + i), DOWN),
-        ];
-        for (node, what) in from {
-            if let Some(node) = node {
-                sum += sends[node][what];
-            }
-        }
-        sum
+    /// The rows in a band of the passes split across threads, and the number of bands.
+    fn bands(&self) -> (usize, usize) {
+        let [nx, ny] = self.nodes;
+        let rows = BAND.div_ceil(nx).clamp(8, ny.max(8));
+        (rows, ny.div_ceil(rows))
     }
 
-    /// The forces `f` on a block of nodes from `first` on, gathered from every node's
-    /// [`Sends`], and the kick `p += kick · f`.
-    fn gather(
+    /// The [`Sends`] of every node of row `j` into `row`.
+    fn send_row(&self, j: usize, u: &[SVector<f64, C>], row: &mut [Sends<C>]) {
+        let nx = self.nodes[0];
+        for (i, sends) in row.iter_mut().enumerate() {
+            *sends = self.sends((j * nx + i, i, j), u);
+        }
+    }
+
+    /// The forces `f` on the rows of a band from row `first` on, gathered from the [`Sends`]
+    /// of their nodes and their neighbours (rolled through `window` row by row), and the kick
+    /// `p += kick · f`.
+    fn band(
         &self,
         first: usize,
-        f: &mut [SVector<f64, C>],
-        p: &mut [SVector<f64, C>],
-        sends: &[Sends<C>],
+        u: &[SVector<f64, C>],
+        (f, p): (&mut [SVector<f64, C>], &mut [SVector<f64, C>]),
+        window: &mut Window<C>,
         kick: f64,
     ) {
-        for (k, (f, p)) in f.iter_mut().zip(p.iter_mut()).enumerate() {
-            let node = first + k;
-            *f = match is_zero(&self.mass[node]) {
-                true => SVector::zeros(),
-                false => -self.gathered(node, sends),
-            };
-            *p += *f * kick;
+        let nx = self.nodes[0];
+        let rows = f.len() / nx;
+        if let Some(below) = self.neighbour(1, first, false) {
+            self.send_row(below, u, &mut window[0]);
+        }
+        self.send_row(first, u, &mut window[1]);
+        let rows_of_nodes = f.chunks_mut(nx).zip(p.chunks_mut(nx));
+        for (j, (f, p)) in (first..first + rows).zip(rows_of_nodes) {
+            let above = self.neighbour(1, j, true);
+            if let Some(above) = above {
+                self.send_row(above, u, &mut window[2]);
+            }
+            let below = self.neighbour(1, j, false);
+            let [from_below, here, from_above] = &*window;
+            for (i, (f, p)) in f.iter_mut().zip(p.iter_mut()).enumerate() {
+                let k = j * nx + i;
+                if is_zero(&self.mass[k]) {
+                    *f = SVector::zeros();
+                    continue;
+                }
+                let mut sum = here[i][OWN];
+                if let Some(left) = self.neighbour(0, i, false) {
+                    sum += here[left][RIGHT];
+                }
+                if let Some(right) = self.neighbour(0, i, true) {
+                    sum += here[right][LEFT];
+                }
+                if below.is_some() {
+                    sum += from_below[i][UP];
+                }
+                if above.is_some() {
+                    sum += from_above[i][DOWN];
+                }
+                *f = -sum;
+                *p += *f * kick;
+            }
+            window.rotate_left(1);
         }
     }
 
@@ -416,7 +474,7 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         taken
     }
 
-    fn running(&self) -> Result<&Running<C, Vec<Sends<C>>>, DiracError> {
+    fn running(&self) -> Result<&Running<C, Vec<Window<C>>>, DiracError> {
         self.run.as_ref().ok_or(DiracError::NotStarted)
     }
 
@@ -480,45 +538,35 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
 }
 
 impl<D: PlaneDensity<C>, const C: usize> Grid<C> for PlaneField<D, C> {
-    type Scratch = Vec<Sends<C>>;
+    type Scratch = Vec<Window<C>>;
 
     fn mass(&self) -> &[SVector<f64, C>] {
         &self.mass
     }
 
     fn in_parallel(&self) -> bool {
-        self.parallel && self.mass.len() >= PARALLEL_BLOCKS * GRAIN
+        self.parallel && self.bands().1 >= PARALLEL_BANDS
     }
 
-    /// Two passes over the nodes, each a block of [`GRAIN`] nodes at a time: every node's
-    /// [`Sends`], then each node's gathered force and kick.
+    /// A band of rows at a time (the whole field when not split across threads), row by row:
+    /// the [`Sends`] of the row above, then the gathered forces and kicks of the row.
     fn force_and_kick(
         &self,
         u: &[SVector<f64, C>],
         f: &mut [SVector<f64, C>],
         p: &mut [SVector<f64, C>],
-        sends: &mut Self::Scratch,
+        windows: &mut Self::Scratch,
         kick: f64,
     ) {
-        let send = |(b, block): (usize, &mut [Sends<C>])| {
-            for (k, s) in block.iter_mut().enumerate() {
-                *s = self.sends(b * GRAIN + k, u);
-            }
-        };
         if self.in_parallel() {
-            sends.par_chunks_mut(GRAIN).enumerate().for_each(send);
+            let nodes = self.bands().0 * self.nodes[0];
+            let bands = f.par_chunks_mut(nodes).zip(p.par_chunks_mut(nodes));
+            let bands = bands.zip(windows.par_iter_mut()).enumerate();
+            bands.for_each(|(b, (band, window))| {
+                self.band(b * self.bands().0, u, band, window, kick)
+            });
         } else {
-            sends.chunks_mut(GRAIN).enumerate().for_each(send);
-        }
-        let sends = &*sends;
-        if self.in_parallel() {
-            let blocks = f.par_chunks_mut(GRAIN).zip(p.par_chunks_mut(GRAIN));
-            let gather = |(b, (f, p))| self.gather(b * GRAIN, f, p, sends, kick);
-            blocks.enumerate().for_each(gather);
-        } else {
-            let blocks = f.chunks_mut(GRAIN).zip(p.chunks_mut(GRAIN));
-            let gather = |(b, (f, p))| self.gather(b * GRAIN, f, p, sends, kick);
-            blocks.enumerate().for_each(gather);
+            self.band(0, u, (f, p), &mut windows[0], kick);
         }
     }
 }
