@@ -98,8 +98,8 @@ const GROUPS: &[(&str, &str)] = &[
     (
         "plane_field_step",
         "One step of the membrane (Störmer–Verlet, square cells, periodic) by number of nodes: \
-         `PlaneField` one block of nodes after another and in parallel, against a hand-written \
-         five-point leapfrog of the same scheme.",
+         `PlaneField` row by row on one thread and (from 10⁵ nodes) in parallel, against a \
+         hand-written five-point leapfrog of the same scheme.",
     ),
     (
         "field_step",

@@ -7,12 +7,14 @@
 //! refusal of the ill-posed LC circuit is shown. Pictures: `output/convergence.png`,
 //! `output/energy_error.png`, `output/knife_edge.png`, `output/lc_circuit.png`,
 //! `output/cart_pole_lqr.png`, `output/long_horizon_energy.png`, `output/heavy_top.png`,
-//! `output/heavy_top_invariants.png`, `output/rigid_chain.png`, `output/humanoid.png`. Models
+//! `output/heavy_top_invariants.png`, `output/rigid_chain.png`, `output/humanoid.png`,
+//! `output/membrane.png`. Models
 //! on rotations and unit vectors: the heavy top (both
 //! retractions), the 3D pendulum against a quaternion reference, the spherical pendulum on `S²`
 //! beside the Cartesian one, the rolling ball at each constraint point, a satellite's slew, and
 //! a satellite with reaction wheels held by LQR on the step map's derivatives. Mechanisms of
-//! bodies joined by joints: a four-bar linkage, a slider-crank and a tumbling humanoid.
+//! bodies joined by joints: a four-bar linkage, a slider-crank and a tumbling humanoid. Fields:
+//! the sine-Gordon kink–antikink collision on a line, a drum in two of its modes on a plane.
 //!
 //! `cargo run --release --example tour`
 

@@ -3,6 +3,8 @@
 //! membranes joined by springs (a Klein–Gordon mode beside a wave); a hand-written five-point
 //! leapfrog for the bench; the struck drum of the tour.
 
+use std::f64::consts::PI;
+
 use dirac::nalgebra::SVector;
 use dirac::{Boundary, DiracError, PlaneDensity, PlaneField, Scalar};
 
@@ -130,7 +132,6 @@ pub fn drum(cells_x: usize) -> Result<PlaneField<Membrane, 1>, DiracError> {
 /// The drum's modes `(2, 1)` and `(1, 3)`, `sin(mπx/1.5) sin(nπy)`, at rest, their amplitudes
 /// 1 and ½: the field at `point` and the wave numbers.
 pub fn two_modes(point: [f64; 2]) -> ([f64; 2], [[f64; 2]; 2]) {
-    use std::f64::consts::PI;
     let k = [[2.0 * PI / 1.5, PI], [PI / 1.5, 3.0 * PI]];
     let shape = |k: [f64; 2]| (k[0] * point[0]).sin() * (k[1] * point[1]).sin();
     ([shape(k[0]), 0.5 * shape(k[1])], k)
@@ -182,14 +183,18 @@ pub fn report() -> Result<super::Report, DiracError> {
 }
 
 /// The drum (120 × 80 cells) at rest, struck at `(0.5, 0.5)` (a narrow Gaussian kick of the
-/// velocity) and run to `t`: the node axes and the field, row by row.
+/// velocity, zero on the fixed edges) and run to `t`: the node axes and the field, row by row.
 pub fn struck(t: f64) -> Result<([Vec<f64>; 2], Vec<f64>), DiracError> {
     let mut drum = drum(120)?;
-    let kick = |[x, y]: [f64; 2]| {
+    let [nx, ny] = drum.nodes();
+    let on_edge = |k: usize| k % nx == 0 || k % nx == nx - 1 || k / nx == 0 || k / nx == ny - 1;
+    // A Gaussian, zero on the fixed edges (which do not move).
+    let kick = |(k, [x, y]): (usize, [f64; 2])| {
         let r2 = (x - 0.5).powi(2) + (y - 0.5).powi(2);
-        SVector::from([(-r2 / 0.005).exp()])
+        let rate = if on_edge(k) { 0.0 } else { (-r2 / 0.005).exp() };
+        SVector::from([rate])
     };
-    let ut0: Vec<SVector<f64, 1>> = drum.points().into_iter().map(kick).collect();
+    let ut0: Vec<SVector<f64, 1>> = drum.points().into_iter().enumerate().map(kick).collect();
     drum.start(&vec![SVector::zeros(); ut0.len()], &ut0)?;
     drum.run((t / drum.dt()).round() as u64)?;
     Ok((drum.axes(), drum.u()?.iter().map(|u| u[0]).collect()))

@@ -31,11 +31,11 @@ fn error<D: PlaneDensity<1>>(field: &PlaneField<D, 1>, exact: impl Fn(f64, f64) 
 }
 
 /// The leapfrog's modes of the five-point membrane are exact solutions of the step, whatever
-/// holds the edges: standing waves `sin·sin` on a drum fixed all round and `cos·sin` with two
-/// free edges (whose half and quarter cells keep `cos` an eigenvector), a wave `cos(k_x x − ωt)`
-/// travelling round a periodic axis over a `cos` of free edges. Each is followed to round-off
-/// over 2 000 steps at `sin(ωΔt/2) = (Δt/2) ω_h`, where the continuum's `ω = |k|` is off by
-/// order one.
+/// holds the edges: standing waves `sin·sin` on a drum fixed all round, `cos·sin` with two free
+/// edges (whose half cells keep `cos` an eigenvector) and `cos·cos` free all round (the corners'
+/// quarter cells too), a wave `cos(k_x x − ωt)` travelling round a periodic axis over a `cos` of
+/// free edges. Each is followed to round-off over 2 000 steps at `sin(ωΔt/2) = (Δt/2) ω_h`,
+/// where the continuum's `ω = |k|` is off by order one.
 #[test]
 fn the_membrane_keeps_its_discrete_dispersion_relation() {
     let (sides, cells, dt) = ([(0.0, 2.0), (0.0, 1.5)], [20, 12], 0.05);
@@ -43,9 +43,11 @@ fn the_membrane_keeps_its_discrete_dispersion_relation() {
     type Shape = fn(f64, f64, [f64; 2]) -> f64;
     let sin_sin: Shape = |x, y, k| (k[0] * x).sin() * (k[1] * y).sin();
     let cos_sin: Shape = |x, y, k| (k[0] * x).cos() * (k[1] * y).sin();
-    let cases: [([Boundary; 2], [f64; 2], Shape); 3] = [
+    let cos_cos: Shape = |x, y, k| (k[0] * x).cos() * (k[1] * y).cos();
+    let cases: [([Boundary; 2], [f64; 2], Shape); 4] = [
         ([fixed, fixed], [PI, 2.0 * PI / 1.5], sin_sin),
         ([free, fixed], [1.5 * PI, 2.0 * PI / 1.5], cos_sin),
+        ([free, free], [PI, PI / 1.5], cos_cos),
         ([periodic, free], [TAU, PI / 1.5], |x, y, k| {
             (k[0] * x).cos() * (k[1] * y).cos()
         }),
@@ -312,9 +314,9 @@ fn the_multisymplectic_law_holds_node_by_node() {
     );
 }
 
-/// A periodic membrane of 130 × 70 nodes, whose passes take three blocks, follows a hand-written
-/// five-point leapfrog (`scenes::membrane::leapfrog_membrane`) to round-off over 100 steps, the
-/// blocks' edges and the wrap-around included.
+/// A periodic membrane of 130 × 70 nodes follows a hand-written five-point leapfrog
+/// (`scenes::membrane::leapfrog_membrane`) to round-off over 100 steps, the wrap-around on both
+/// axes included.
 #[test]
 fn a_membrane_equals_a_hand_written_five_point_leapfrog() {
     let (cells, dt) = ([130, 70], 0.02);
@@ -361,25 +363,64 @@ fn the_energy_error_stays_bounded() {
     assert!(last < 1.5 * first, "drift: {first:e} then {last:e}");
 }
 
-/// Split across threads (160 × 120 cells, above the grain), the steps are the same bit for bit.
+/// Split across threads, the steps are the same bit for bit: 201 × 181 nodes with free and fixed
+/// edges, and 200 × 200 periodic nodes (the first band reading the last row below it, the last
+/// the first row above it); two bands of rows each. A run may be split across threads midway.
 #[test]
 fn parallel_and_sequential_membranes_step_alike() {
-    let runs = [false, true].map(|parallel| {
-        let edges = [Boundary::Free, Boundary::Fixed];
-        let sides = [(0.0, 1.6), (0.0, 1.2)];
-        let mut drum = PlaneField::new(DRUM, sides, [160, 120], edges, 0.004)
-            .unwrap()
-            .with_parallel(parallel);
-        let u0 = at(&drum, |x, y| {
-            (3.0 * x).cos() * (PI * y / 1.2).sin() + x * y * (1.2 - y)
+    let cases = [
+        ([Boundary::Free, Boundary::Fixed], [200, 180]),
+        ([Boundary::Periodic; 2], [200, 200]),
+    ];
+    for (edges, cells) in cases {
+        // On one thread, on several, and on one then several from the third step on.
+        let runs = [(false, false), (true, true), (false, true)].map(|(first, then)| {
+            let sides = [(0.0, 1.6), (0.0, 1.2)];
+            let mut drum = PlaneField::new(DRUM, sides, cells, edges, 0.003)
+                .unwrap()
+                .with_parallel(first);
+            let u0 = at(&drum, |x, y| {
+                (TAU * x / 1.6).cos() * (PI * y / 1.2).sin() + (x * y * (1.2 - y)).sin()
+            });
+            drum.start(&u0, &at(&drum, |_, _| 0.0)).unwrap();
+            drum.run(2).unwrap();
+            let mut drum = drum.with_parallel(then);
+            drum.run(3).unwrap();
+            drum
         });
-        drum.start(&u0, &at(&drum, |_, _| 0.0)).unwrap();
-        drum.run(5).unwrap();
-        drum
-    });
-    assert_eq!(runs[0].u().unwrap(), runs[1].u().unwrap());
-    assert_eq!(runs[0].momenta().unwrap(), runs[1].momenta().unwrap());
-    assert_eq!(runs[0].t(), runs[1].t());
+        for run in &runs[1..] {
+            assert_eq!(runs[0].u().unwrap(), run.u().unwrap(), "{edges:?}");
+            assert_eq!(runs[0].momenta().unwrap(), run.momenta().unwrap());
+            assert_eq!(runs[0].t(), run.t());
+        }
+    }
+}
+
+/// Each node weighs `w_x w_y ρ(x, y)`: the whole cell inside, half of it on a free edge, a
+/// quarter at a free corner, nothing on a fixed edge. The momenta of the medium's start (whose
+/// inertia varies over the plane) are those weights times the rates, component by component.
+#[test]
+fn each_node_weighs_its_share_of_the_cells() {
+    let (free, fixed) = (Boundary::Free, Boundary::Fixed);
+    let field = medium([free, fixed], 0.01);
+    let ([nx, ny], [dx, dy]) = (field.nodes(), field.spacing());
+    let momenta = field.momenta().unwrap();
+    let mut worst = 0.0_f64;
+    for (k, (p, [x, y])) in momenta.iter().zip(field.points()).enumerate() {
+        let (i, j) = (k % nx, k / nx);
+        let wx = if i == 0 || i == nx - 1 { 0.5 * dx } else { dx };
+        let wy = if j == 0 || j == ny - 1 { 0.0 } else { dy };
+        let expected = medium_start(x, y).1.component_mul(&Medium.inertia([x, y])) * (wx * wy);
+        worst = worst.max((p - expected).amax());
+    }
+    assert!(worst < 1e-15, "{worst:e}");
+    // A free corner: a quarter cell.
+    let corners = medium([free, free], 0.01);
+    let p = corners.momenta().unwrap()[0];
+    let rate = medium_start(0.0, 0.5)
+        .1
+        .component_mul(&Medium.inertia([0.0, 0.5]));
+    assert!((p - rate * (0.25 * dx * dy)).amax() < 1e-15, "{p:?}");
 }
 
 /// `U = ½ (u_x² + u_y²) + 2√u`: finite for `u ≥ 0`, not below.

@@ -133,7 +133,8 @@ pub fn space_chart(
 /// Draws a field over space and time as a map, 900×600, to the PNG file `path`: `x` along the
 /// horizontal axis, time up, the field's value `snapshots[k].1[j]` at `(x[j], snapshots[k].0)`
 /// in colour from blue (its least value) through white to red (its largest), the range in the
-/// title. At most 600 columns and 400 rows are drawn (evenly picked). An error where a snapshot
+/// title; where the values take both signs, white is zero and the range is symmetric about it.
+/// A field over a plane is drawn the same way, its rows `(y, values)` as the snapshots. At most 600 columns and 400 rows are drawn (evenly picked). An error where a snapshot
 /// does not have one value per position, where the positions or the times are not finite or do
 /// not increase, where there are fewer than two positions or snapshots, and as
 /// [`line_chart`]'s.
@@ -312,6 +313,11 @@ fn draw_space_time(
     }
     let values = snapshots.iter().flat_map(|(_, v)| v.iter().map(|&u| [u]));
     let [(low, high)] = bounds(values).unwrap_or([(-1.0, 1.0)]);
+    // Values of both signs: white at zero, the range symmetric about it.
+    let (low, high) = match low < 0.0 && high > 0.0 {
+        true => (-high.max(-low), high.max(-low)),
+        false => (low, high),
+    };
     let picked = |count: usize, most: usize| -> Vec<usize> {
         let step = count.div_ceil(most).max(1);
         (0..count).step_by(step).collect()

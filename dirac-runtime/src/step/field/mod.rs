@@ -55,7 +55,8 @@ use leapfrog::{GRAIN, Grid, PARALLEL_BLOCKS, Running, is_zero};
 mod leapfrog;
 pub mod plane;
 
-/// How the ends of a field's interval are held.
+/// How the ends of a field's interval are held, or the edges of a rectangle along one axis
+/// ([`PlaneField`](plane::PlaneField)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Boundary {
     /// `u(t, b) = u(t, a)`: `N` nodes, the last cell joining node `N − 1` to node 0; the density

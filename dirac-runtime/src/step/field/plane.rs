@@ -154,15 +154,24 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
                 )));
             }
         }
+        let nodes = [0, 1].map(|axis| match boundary[axis] {
+            Boundary::Periodic => Some(cells[axis]),
+            Boundary::Fixed | Boundary::Free => cells[axis].checked_add(1),
+        });
+        let nodes = match nodes {
+            [Some(nx), Some(ny)] if nx.checked_mul(ny).is_some() => [nx, ny],
+            _ => {
+                return Err(DiracError::Dimension(format!(
+                    "{cells:?} cells make more nodes than can be counted"
+                )));
+            }
+        };
         let mut field = Self {
             density,
             origin: rectangle.map(|side| side.0),
             spacing,
             cells,
-            nodes: [0, 1].map(|axis| match boundary[axis] {
-                Boundary::Periodic => cells[axis],
-                Boundary::Fixed | Boundary::Free => cells[axis] + 1,
-            }),
+            nodes,
             boundary,
             dt,
             composition: Composition::verlet(),
@@ -183,8 +192,8 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
     }
 
     /// Whether the passes of a step over the nodes are split across rayon's threads (by default
-    /// not), in bands of rows of at least 16 384 nodes. The steps are the same bit for bit; a
-    /// field of one band is stepped on one thread all the same. `cargo bench --bench step --
+    /// not), in bands of rows of about 16 384 nodes. The steps are the same bit for bit; a field
+    /// of fewer than 32 768 nodes (one band) is stepped on one thread all the same. `cargo bench --bench step --
     /// plane_field_step` measures the gain.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = parallel;
@@ -320,7 +329,12 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         ut: &[SVector<f64, C>],
     ) -> Result<(), DiracError> {
         let row = vec![[SVector::zeros(); 5]; self.nodes[0]];
-        let windows = vec![[row.clone(), row.clone(), row]; self.bands().1];
+        let bands = if self.in_parallel() {
+            self.bands().1
+        } else {
+            1
+        };
+        let windows = vec![[row.clone(), row.clone(), row]; bands];
         self.run = Some(leapfrog::start(self, u, ut, windows)?);
         Ok(())
     }
@@ -361,10 +375,13 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         sends.map(|s| s * weight)
     }
 
-    /// The rows in a band of the passes split across threads, and the number of bands.
+    /// The rows in a band of the passes split across threads (the last band may hold fewer), and
+    /// the number of bands.
     fn bands(&self) -> (usize, usize) {
         let [nx, ny] = self.nodes;
-        let rows = BAND.div_ceil(nx).clamp(8, ny.max(8));
+        // As many bands as `BAND`s of nodes, of 8 rows at least, their rows shared out evenly.
+        let bands = (nx * ny / BAND).clamp(1, ny.div_ceil(8));
+        let rows = ny.div_ceil(bands);
         (rows, ny.div_ceil(rows))
     }
 
@@ -559,12 +576,15 @@ impl<D: PlaneDensity<C>, const C: usize> Grid<C> for PlaneField<D, C> {
         kick: f64,
     ) {
         if self.in_parallel() {
-            let nodes = self.bands().0 * self.nodes[0];
+            let (rows, bands) = self.bands();
+            if windows.len() < bands {
+                // Split across threads during a run: a window for every band, once.
+                windows.resize(bands, windows[0].clone());
+            }
+            let nodes = rows * self.nodes[0];
             let bands = f.par_chunks_mut(nodes).zip(p.par_chunks_mut(nodes));
             let bands = bands.zip(windows.par_iter_mut()).enumerate();
-            bands.for_each(|(b, (band, window))| {
-                self.band(b * self.bands().0, u, band, window, kick)
-            });
+            bands.for_each(|(b, (band, window))| self.band(b * rows, u, band, window, kick));
         } else {
             self.band(0, u, (f, p), &mut windows[0], kick);
         }
