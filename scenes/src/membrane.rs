@@ -187,7 +187,10 @@ pub fn report() -> Result<super::Report, DiracError> {
 pub fn struck(t: f64) -> Result<([Vec<f64>; 2], Vec<f64>), DiracError> {
     let mut drum = drum(120)?;
     let [nx, ny] = drum.nodes();
-    let on_edge = |k: usize| k % nx == 0 || k % nx == nx - 1 || k / nx == 0 || k / nx == ny - 1;
+    let on_edge = |k: usize| {
+        let (i, j) = (k % nx, k / nx);
+        i == 0 || i == nx - 1 || j == 0 || j == ny - 1
+    };
     // A Gaussian, zero on the fixed edges (which do not move).
     let kick = |(k, [x, y]): (usize, [f64; 2])| {
         let r2 = (x - 0.5).powi(2) + (y - 0.5).powi(2);
