@@ -304,7 +304,7 @@ fn lagrange(points: &[f64], j: usize, c: f64) -> f64 {
 }
 
 /// Derivative of `ℓ_j` at `c`.
-fn lagrange_derivative(points: &[f64], j: usize, c: f64) -> f64 {
+pub(crate) fn lagrange_derivative(points: &[f64], j: usize, c: f64) -> f64 {
     let tj = points[j];
     (0..points.len())
         .filter(|&l| l != j)
