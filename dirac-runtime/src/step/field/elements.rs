@@ -72,6 +72,19 @@ mod tests {
         assert_eq!(one.points, vec![0.0, 1.0]);
         assert_eq!(one.weights, vec![0.5, 0.5]);
         assert_eq!(one.derivative, vec![-1.0, 1.0, -1.0, 1.0]);
+        // Degree 3: the points ½ ± ½√(1/5) inside, the weights 1/12 and 5/12.
+        let three = Elements::new(3).unwrap();
+        let inner = 0.5 * (0.2_f64).sqrt();
+        for (c, exact) in three
+            .points
+            .iter()
+            .zip([0.0, 0.5 - inner, 0.5 + inner, 1.0])
+        {
+            assert!((c - exact).abs() < 1e-15);
+        }
+        for (w, exact) in three.weights.iter().zip([1.0, 5.0, 5.0, 1.0]) {
+            assert!((w - exact / 12.0).abs() < 1e-15);
+        }
         for degree in 1..=MOST_DEGREE {
             let cell = Elements::new(degree).unwrap();
             let sum: f64 = cell.weights.iter().sum();
