@@ -464,20 +464,27 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
         if inside == r {
             values[r] = u[0];
         }
-        let (values, out) = (&values[..=r], &mut out[..=r]);
-        out.fill(SVector::zeros());
-        for (q, (d, &weight)) in cell.derivative.chunks(r + 1).zip(&cell.weights).enumerate() {
-            let slope = values
+        // At each point, the derivatives in the field and in the slope, weighted.
+        let mut own = [SVector::zeros(); MOST_DEGREE + 1];
+        let mut flux = [SVector::zeros(); MOST_DEGREE + 1];
+        let rows = cell.derivative.chunks(r + 1).zip(&cell.weights);
+        for (q, (d, &weight)) in rows.enumerate() {
+            let slope = values[..=r]
                 .iter()
                 .zip(d)
                 .fold(SVector::zeros(), |s, (v, d)| s + v * *d);
             let slope = slope / self.dx;
             let (by_u, by_slope) = self.potential_gradient(self.point(e, q), &values[q], &slope);
-            out[q] += by_u * (weight * self.dx);
-            let flux = by_slope * weight;
-            for (out, d) in out.iter_mut().zip(d) {
-                *out += flux * *d;
-            }
+            own[q] = by_u * (weight * self.dx);
+            flux[q] = by_slope * weight;
+        }
+        // Each point's share: its own term and every point's flux through `D`'s column.
+        for (m, out) in out[..=r].iter_mut().enumerate() {
+            let column = (0..=r).map(|q| cell.derivative[q * (r + 1) + m]);
+            *out = flux[..=r]
+                .iter()
+                .zip(column)
+                .fold(own[m], |s, (f, d)| s + f * d);
         }
     }
 
