@@ -444,8 +444,8 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     fn cell_gradient(&self, e: usize, u: &[SVector<f64, C>], out: &mut [SVector<f64, C>]) {
         let (cell, r) = (&self.elements, self.degree());
         if r == 1 {
-            // The trapezoidal cell, its sums written out (the general loop below costs 2.5 times
-            // as much at this degree, measured).
+            // The trapezoidal cell, its sums written out: the general loop below costs 1.4 times
+            // as much at this degree (32 against 23 ns a node, 10⁵ sine-Gordon cells).
             let (left, right) = (&u[e], &u[(e + 1) % u.len()]);
             let slope = (right - left) / self.dx;
             let (u_left, slope_left) = self.potential_gradient(self.point(e, 0), left, &slope);
