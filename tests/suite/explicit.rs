@@ -348,7 +348,7 @@ struct Massless;
     forces(-0.1 * dot(x) * dx),
 )]
 #[derive(Debug, Clone, Copy)]
-struct Damped;
+pub(crate) struct Damped;
 
 /// A Duffing oscillator driven by `u cos t`, its cubic spring written as a force: forces of the
 /// position, the time and an input.

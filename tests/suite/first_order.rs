@@ -521,7 +521,7 @@ fn point_vortices_keep_their_hamiltonian_and_impulses() {
     lagrangian = 0.5 * (x * dot(y) - y * dot(x)) - 0.5 * (x * x + y * y),
 )]
 #[derive(Debug, Clone, Copy)]
-struct MagneticDrift;
+pub(crate) struct MagneticDrift;
 
 /// The drift against its closed form at T = 10: orders 2, 4, 6, and the potential (the
 /// Hamiltonian, quadratic here) kept to round-off by every Gauss rule.

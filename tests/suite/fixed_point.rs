@@ -1,13 +1,15 @@
-//! Galerkin steps of separable Lagrangians solved by fixed-point iteration
-//! (`Stepper::with_fixed_point`): the same roots as Newton's method, without a Jacobian; orders
-//! up to 16 measured against closed forms; the energy's round-off over long runs; the steps
-//! handed to Newton's method and the models refused.
+//! Galerkin steps solved by fixed-point iteration (`Stepper::with_fixed_point`): on the tables
+//! of a separable Lagrangian, and on the assembled rows of any other unconstrained one on `Rⁿ`.
+//! The same roots as Newton's method, without a Jacobian; orders up to 16 measured against
+//! closed forms; the energy's round-off over long runs; momentum maps; the steps handed to
+//! Newton's method and the models refused.
 
-use crate::explicit::{Charge, Duffing, FalseForce, Shifted};
-use crate::support::assert_order;
+use crate::explicit::{Charge, Damped, Duffing, FalseForce, Shifted};
+use crate::first_order::MagneticDrift;
+use crate::support::{assert_order, energy_error_first_and_last_tenth};
 
 use dirac::prelude::*;
-use scenes::{double_pendulum, knife_edge, oscillator, pendulum};
+use scenes::{double_pendulum, knife_edge, oscillator, pendulum, satellite};
 
 /// `½ vᵀ M v + bᵀ v − V(q)` with a full constant `M`, `b ≠ 0` and a coupled nonlinear
 /// potential `V = −cos x + ½ y² + x y²/5`, written by hand.
@@ -303,6 +305,14 @@ fn steps_the_iteration_cannot_settle_are_newtons() {
     );
     assert!(count > 0 && why.is_some_and(|w| w.contains("iteration")));
     assert!((newton.q() - iterated.q()).amax() < 1e-13);
+    // The double pendulum at a step where the iteration on its rows stops contracting in the
+    // fast swings: those steps are handed over, and they are Newton's.
+    let start = (double_pendulum::q0(), double_pendulum::v0());
+    let (newton, iterated) = run_both(double_pendulum::SCENE, galerkin(3), 0.1, start, 50);
+    let (count, why) = iterated.handed_over();
+    println!("double pendulum h = 0.1: {count} of 50 handed over: {why:?}");
+    assert!(count > 0 && why.is_some_and(|w| w.contains("iteration")));
+    assert!((newton.q() - iterated.q()).amax() < 1e-12);
     // A false claim about the forces: the rows' residual refuses each iterated solution.
     let start = (vector![1.0], vector![0.5]);
     let (newton, iterated) = run_both(FalseForce, galerkin(2), 0.05, start, 50);
@@ -327,27 +337,126 @@ fn models_the_iteration_does_not_cover_are_refused() {
         Err(DiracError::Unsupported(why)) => why,
         other => panic!("not refused: {other:?}"),
     };
-    let moving = double_pendulum::stepper(Quadrature::galerkin(2).unwrap(), 0.01)
-        .unwrap()
-        .with_fixed_point()
-        .map(|_| ());
-    assert!(refusal(moving).contains("separable"));
     let constrained = knife_edge::stepper(ConstraintPoint::Midpoint, 0.1)
         .unwrap()
         .with_fixed_point()
         .map(|_| ());
     assert!(refusal(constrained).contains("constraints"));
+    let turning = Stepper::on_manifold(
+        satellite::SCENE,
+        Product::cayley(),
+        Quadrature::midpoint(),
+        0.1,
+    )
+    .unwrap()
+    .with_fixed_point()
+    .map(|_| ());
+    assert!(refusal(turning).contains("fixed-point"));
+    // A degenerate Lagrangian (linear in the velocities): its run is handed over at its first
+    // step, and Newton's method takes it from there.
+    let start = (vector![1.0, 0.0], vector![0.0, 1.0]);
+    let (newton, iterated) = run_both(
+        MagneticDrift,
+        Quadrature::galerkin(2).unwrap(),
+        0.1,
+        start,
+        5,
+    );
+    assert_eq!((newton.q(), newton.p()), (iterated.q(), iterated.p()));
+    let (count, why) = iterated.handed_over();
+    assert_eq!(count, 1);
+    assert!(why.is_some_and(|w| w.contains("degenerate")), "{why:?}");
+    // Without the iteration asked for, Newton's method solves the steps.
+    let stepper = Stepper::new(pendulum::SCENE, Quadrature::galerkin(4).unwrap(), 0.5).unwrap();
+    assert!(matches!(stepper.solver(), Solver::Newton(_)));
+}
+
+/// Models that are not separable are iterated on their assembled rows: a mass matrix that moves
+/// with the position (the double pendulum), a velocity coupled to the position (a charge in a
+/// magnetic field), a force that reads the velocity (a damper). Every step is iterated, without
+/// a Jacobian, to Newton's root.
+#[test]
+fn the_rows_of_models_that_are_not_separable_are_iterated_to_newtons_roots() {
+    let galerkin = |s| Quadrature::galerkin(s).unwrap();
+    let start = (double_pendulum::q0(), double_pendulum::v0());
+    for s in 1..=6 {
+        let (gap, _) = against_newton(
+            double_pendulum::SCENE,
+            galerkin(s),
+            0.02,
+            start,
+            100,
+            |_, _| {},
+        );
+        println!("double pendulum galerkin({s}), h = 0.02, 100 steps: {gap:.1e}");
+        assert!(gap < 1e-12, "galerkin({s}): {gap:e}");
+    }
     let charge = Charge {
         m: 1.0,
         b: 0.5,
         k: 1.0,
     };
-    let coupled = Stepper::new(charge, Quadrature::midpoint(), 0.1)
+    let start = (vector![1.0, 0.0], vector![0.0, 0.7]);
+    let (gap, _) = against_newton(charge, galerkin(3), 0.1, start, 400, |_, _| {});
+    println!("charge galerkin(3): {gap:.1e}");
+    assert!(gap < 1e-12, "charge: {gap:e}");
+    let (gap, work) = against_newton(
+        Damped,
+        galerkin(2),
+        0.1,
+        (vector![1.0], vector![0.0]),
+        400,
+        |_, _| {},
+    );
+    println!("damper galerkin(2): states {gap:.1e}, work {work:.1e}");
+    assert!(gap < 1e-12 && work < 1e-12, "damper: {gap:e}, {work:e}");
+}
+
+/// The invariants of the iterated rows. The charge's Lagrangian is invariant under rotations
+/// about the origin, so its discrete angular momentum `x p_y − y p_x` is kept to round-off,
+/// and its energy, a quadratic invariant of a linear flow, is kept by Gauss steps to
+/// round-off too (10⁴ steps; measured 1.1e-15 and 1.2e-15, where an iteration stopped at
+/// `4 ε |ξ|` without its last correction drifted them to 1.7e-13 and 6.7e-14). The double
+/// pendulum's energy error stays bounded over 2·10⁴ steps: no larger in the last tenth of the
+/// run than in the first (measured 1.1e-3, then 1.2e-3).
+#[test]
+fn the_iterated_rows_keep_the_momentum_map_and_bound_the_energy() {
+    let charge = Charge {
+        m: 1.0,
+        b: 0.5,
+        k: 1.0,
+    };
+    let mut stepper = Stepper::new(charge, Quadrature::galerkin(2).unwrap(), 0.1)
         .unwrap()
         .with_fixed_point()
-        .map(|_| ());
-    assert!(refusal(coupled).contains("separable"));
-    // Without the iteration asked for, Newton's method solves the steps.
-    let stepper = Stepper::new(pendulum::SCENE, Quadrature::galerkin(4).unwrap(), 0.5).unwrap();
-    assert!(matches!(stepper.solver(), Solver::Newton(_)));
+        .unwrap();
+    stepper
+        .start_from_velocity(vector![1.0, 0.0], vector![0.3, 0.7])
+        .unwrap();
+    let momentum = |s: &Stepper<Charge, 2>| s.q()[0] * s.p()[1] - s.q()[1] * s.p()[0];
+    let (j0, e0) = (momentum(&stepper), stepper.energy().unwrap());
+    let (mut dj, mut de): (f64, f64) = (0.0, 0.0);
+    for _ in 0..10_000 {
+        stepper.step().unwrap();
+        dj = dj.max((momentum(&stepper) - j0).abs());
+        de = de.max((stepper.energy().unwrap() - e0).abs());
+    }
+    println!("charge, 1e4 steps: |ΔJ| ≤ {dj:.1e} (J = {j0:.3}), |ΔE| ≤ {de:.1e}");
+    assert_eq!(stepper.handed_over().0, 0);
+    assert!(dj < 1e-13 && de < 1e-13, "{dj:e} {de:e}");
+    let mut stepper = double_pendulum::stepper(Quadrature::galerkin(2).unwrap(), 0.02)
+        .unwrap()
+        .with_fixed_point()
+        .unwrap();
+    let mut energy = vec![stepper.energy().unwrap()];
+    for _ in 0..20_000 {
+        stepper.step().unwrap();
+        energy.push(stepper.energy().unwrap());
+    }
+    let (first, last) = energy_error_first_and_last_tenth(&energy);
+    println!(
+        "double pendulum galerkin(2), h = 0.02, 2e4 steps: |ΔE| ≤ {first:.1e}, then {last:.1e}"
+    );
+    assert_eq!(stepper.handed_over().0, 0);
+    assert!(first > 0.0 && last <= 1.5 * first, "{first:e} {last:e}");
 }

@@ -850,19 +850,26 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
         Ok(self)
     }
 
-    /// Solves each step by fixed-point iteration, without a Jacobian, where the model is
+    /// Solves each step by fixed-point iteration, without a Jacobian, for a model on `Rⁿ`
+    /// without constraints (see [`fixed_point`](crate::step::fixed_point)). Where the model is
     /// separable (`L = ½ vᵀ M v + bᵀ v − V(q)` with constant `M` and `b`,
-    /// [`DiracSystem::SEPARABLE`]) on `Rⁿ`, without constraints, its forces (if any) free of the
-    /// velocity: the positions at the rule's nodes are iterated from the extrapolation of the
-    /// last steps until the update vanishes or stops shrinking (see
-    /// [`fixed_point`](crate::step::fixed_point)), each iteration one gradient of `L` per
-    /// node. The solution is the same discrete Euler–Lagrange equations' root as Newton's, to
-    /// round-off, and is checked by its residual. A step where the iteration does not settle
-    /// (an update that grows twice running, 40 iterations, a residual left) is solved by
-    /// Newton's method instead: [`handed_over`](Self::handed_over) counts those steps and says
-    /// why the last one was. A run whose mass matrix is not constant or not invertible is
-    /// handed over at its first step, and stepped by Newton's method from there. Fails with
-    /// `Unsupported`, saying why, for other models.
+    /// [`DiracSystem::SEPARABLE`]) and its forces (if any) are free of the velocity, the
+    /// positions at the rule's nodes are iterated, each iteration one gradient of `L` per node;
+    /// a run whose mass matrix is not constant or not invertible is handed over at its first
+    /// step. Other models (a mass matrix `M(q)`, a velocity coupled to the position, forces of
+    /// the velocity) are iterated on their assembled rows with the mass matrix of the step,
+    /// accelerated by the iteration's history, also one gradient of `L` per node an iteration;
+    /// a degenerate Lagrangian is handed over at its first step. Either way the iteration runs
+    /// from the extrapolation of the last steps until its update is at round-off, so the
+    /// solution is the same discrete Euler–Lagrange equations' root as Newton's, to round-off,
+    /// without a bias that would drift the invariants, and is checked by its residual. A step
+    /// where the iteration does not settle (an update that grows, or on the rows more than half
+    /// the one before; 40 iterations; a residual left) is solved by Newton's method instead:
+    /// [`handed_over`](Self::handed_over) counts those steps and says why the last one was.
+    /// Which is cheaper depends on the model: the iteration wins where a Jacobian costs many
+    /// gradients (many coordinates, high degree), Newton's method where its few iterations
+    /// cost little (the double pendulum below degree 6). Fails with `Unsupported`, saying why,
+    /// on a manifold, with constraints, or for a component of an interconnection.
     ///
     /// ```
     /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Solver, Stepper};
@@ -880,6 +887,17 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// stepper.run(10)?;
     /// assert_eq!(stepper.handed_over(), (0, None));
     /// assert_eq!(stepper.last_report().map(|r| r.jacobians), Some(0));
+    /// // A bead whose mass moves with its position: iterated on its rows.
+    /// struct Bead;
+    /// impl DiracSystem<1> for Bead {
+    ///     fn lagrangian<D: Scalar>(&self, q: &SVector<D, 1>, v: &SVector<D, 1>) -> D {
+    ///         (q[0] * q[0] + 1.0) * v[0] * v[0] * 0.5 - q[0] * q[0] * 0.5
+    ///     }
+    /// }
+    /// let mut bead = Stepper::new(Bead, Quadrature::galerkin(4)?, 0.1)?.with_fixed_point()?;
+    /// bead.start_from_velocity(vector![1.0], vector![0.0])?;
+    /// bead.run(20)?;
+    /// assert_eq!(bead.handed_over(), (0, None));
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn with_fixed_point(mut self) -> Result<Self, DiracError> {

@@ -515,6 +515,19 @@ pub(crate) fn hessian<F: PhaseFunction<N>, const N: usize>(
     }
 }
 
+/// `∂²L/∂v²` at `(q, v)`: in closed form where known, else by one hyper-dual pass.
+#[inline]
+pub(crate) fn velocity_hessian<F: PhaseFunction<N>, const N: usize>(
+    lagrangian: &F,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+) -> SMatrix<f64, N, N> {
+    match lagrangian.closed_hessian(q, v) {
+        Some(h) => h.vv,
+        None => seeded_by_duals(lagrangian, q, v, Seed::VELOCITY, Seed::VELOCITY).mixed,
+    }
+}
+
 /// The side of the square blocks in which [`seeded_by_duals`] takes a mixed second derivative
 /// of more than this many coordinates.
 ///

@@ -764,24 +764,20 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         Ok(next)
     }
 
-    /// Whether the model's kind allows the fixed-point iteration (the part of
+    /// Whether the model's kind allows a fixed-point iteration (the part of
     /// [`refuse_fixed_point`](Self::refuse_fixed_point) known when it is compiled).
-    const MAY_ITERATE: bool = S::SEPARABLE
-        && C::TRANSLATION
-        && S::ONE_FORMS + S::HOLONOMIC == 0
-        && (!S::FORCES || S::FORCES_FREE_OF_VELOCITY);
+    const MAY_ITERATE: bool = C::TRANSLATION && S::ONE_FORMS + S::HOLONOMIC == 0;
+
+    /// Whether the iteration runs on the tables of a separable model, one gradient of `L` a node
+    /// an iteration (its forces, if any, free of the velocity), rather than on the assembled
+    /// rows (see [`fixed_point`](crate::step::fixed_point)).
+    const ITERATES_TABLES: bool = S::SEPARABLE && (!S::FORCES || S::FORCES_FREE_OF_VELOCITY);
 
     fn refuse_fixed_point(&self) -> Result<(), String> {
-        let why = if !S::SEPARABLE {
-            "the Lagrangian is not known to be separable (L = ½ vᵀ M v + bᵀ v − V(q) with \
-             constant M and b: DiracSystem::SEPARABLE)"
-        } else if !C::TRANSLATION {
+        let why = if !C::TRANSLATION {
             "the configuration space is not a vector space"
         } else if S::ONE_FORMS + S::HOLONOMIC > 0 {
             "the model has constraints (their multipliers are not iterated)"
-        } else if S::FORCES && !S::FORCES_FREE_OF_VELOCITY {
-            "the model's forces may read the velocity (DiracSystem::FORCES_FREE_OF_VELOCITY is \
-             not declared)"
         } else if self.coupling.is_some() {
             "the model is a component of an interconnection"
         } else {
@@ -791,7 +787,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
     }
 
     /// The run's fixed-point tables, set up from `state` at its first step, or why there are
-    /// none (kept for the run).
+    /// none (kept for the run): for a separable model with its constant kinetic terms, checked;
+    /// for another with its mass matrix at `state` (replaced at every step), where the run's
+    /// Lagrangian is regular there.
     fn iteration_tables(&mut self, state: &State<N>) -> Result<FixedPoint<N>, String> {
         if let Some(why) = &self.iteration_refused {
             return Err(why.clone());
@@ -799,20 +797,175 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         if let Some(tables) = self.iteration.take() {
             return Ok(tables);
         }
-        let tables = Kinetic::of(self.discrete.system(), &state.q, &state.velocity)
-            .map_err(|e| format!("the run's kinetic terms: {e}"))
-            .and_then(|kinetic| {
-                FixedPoint::new(self.discrete.quadrature(), kinetic).ok_or_else(|| {
-                    format!(
-                        "{} has no fixed-point tables",
-                        self.discrete.quadrature().name()
-                    )
-                })
-            });
+        let system = self.discrete.system();
+        let kinetic = if Self::ITERATES_TABLES {
+            Kinetic::of(system, &state.q, &state.velocity)
+                .map_err(|e| format!("the run's kinetic terms: {e}"))
+        } else if self.projected() || !self.collocated.is_empty() || self.hidden().count() > 0 {
+            Err(
+                "the run's Lagrangian is degenerate (some coordinates carry no kinetic energy \
+                 of their own): its rows are not iterated"
+                    .to_string(),
+            )
+        } else {
+            Kinetic::frozen(derivatives::velocity_hessian(
+                system,
+                &state.q,
+                &state.velocity,
+            ))
+            .ok_or_else(|| "the mass matrix ∂²L/∂v² at the start has no finite inverse".to_string())
+        };
+        let tables = kinetic.and_then(|kinetic| {
+            FixedPoint::new(self.discrete.quadrature(), kinetic).ok_or_else(|| {
+                format!(
+                    "{} has no fixed-point tables",
+                    self.discrete.quadrature().name()
+                )
+            })
+        });
         if let Err(why) = &tables {
             self.iteration_refused = Some(why.clone());
         }
         tables
+    }
+
+    /// Solves the step from `state` by iterating on its assembled rows from the predictor in
+    /// `x`, `ξ ← ξ − h (K⁻¹ ⊗ M⁻¹) R(ξ)` with the mass matrix `M` at the middle of the predicted
+    /// step (see [`fixed_point`](crate::step::fixed_point)), until the update is at round-off;
+    /// the solution is left in `x` with its rows assembled, and its residual checked against
+    /// `tolerance` times the size of its terms.
+    fn iterate_on_rows(
+        &mut self,
+        state: &State<N>,
+        x: &mut DVector<f64>,
+        tolerance: f64,
+    ) -> Result<NewtonReport, String> {
+        let mut tables = self.iteration_tables(state)?;
+        let (h, layout, s) = (self.discrete.h(), self.layout, self.increments.len());
+        let end = x.fixed_rows::<N>(layout.point(s)).into_owned();
+        let mass = derivatives::velocity_hessian(
+            self.discrete.system(),
+            &(state.q + end * 0.5),
+            &(end / h),
+        );
+        let Some(kinetic) = Kinetic::frozen(mass) else {
+            self.iteration = Some(tables);
+            return Err(
+                "the mass matrix ∂²L/∂v² at the middle of the predicted step has no finite \
+                 inverse"
+                    .to_string(),
+            );
+        };
+        tables.set_kinetic(kinetic);
+        tables.restart_acceleration();
+        let gain = tables.correction_gain(h);
+        let mut residual = std::mem::take(&mut self.iterated_residual);
+        if residual.len() != x.len() {
+            residual = DVector::zeros(x.len());
+        }
+        let mut previous: Option<f64> = None;
+        let mut contraction = 0.0f64;
+        let mut settled = Err(format!(
+            "the iteration on the rows did not settle in {} iterations",
+            fixed_point::MAX_ITERATIONS
+        ));
+        for iteration in 1..=fixed_point::MAX_ITERATIONS {
+            let scale = self.assemble(state, x, &mut residual, None);
+            // `amax` skips a NaN that a later entry follows.
+            if !residual.iter().all(|r| r.is_finite()) {
+                settled = Err(format!(
+                    "the iteration on the rows left the finite numbers at iteration {iteration}"
+                ));
+                break;
+            }
+            let update = tables.correct(h, |j| {
+                residual.fixed_rows::<N>(layout.point(j + 1)).into_owned()
+            });
+            let ratio = previous
+                .filter(|&before| before > 0.0)
+                .map(|before| update / before);
+            contraction = contraction.max(ratio.unwrap_or(0.0));
+            // The update's round-off: the increments' own, the positions' carried by the
+            // contraction, and the rows' terms' through `h (K⁻¹ ⊗ M⁻¹)`.
+            let size = (1..=s)
+                .map(|m| x.fixed_rows::<N>(layout.point(m)).amax())
+                .fold(0.0, f64::max);
+            let floor =
+                4.0 * f64::EPSILON * (size + contraction.min(1.0) * state.q.amax() + gain * scale);
+            // An update that did not shrink: the iteration is at its round-off.
+            let stalled = previous.is_some_and(|before| update >= before);
+            let apply = |x: &mut DVector<f64>, tables: &FixedPoint<N>| {
+                for (m, correction) in tables.correction().iter().enumerate() {
+                    let mut rows = x.fixed_rows_mut::<N>(layout.point(m + 1));
+                    rows -= correction;
+                }
+            };
+            if update <= f64::EPSILON * size || (stalled && update <= 64.0 * floor) {
+                // The last correction is taken too: left out, it would bias every step alike
+                // (an update stopped at 4 ε |ξ| drifted the charge's angular momentum by
+                // 1.7e-17 a step). Without forces the step's covectors are the discrete
+                // Lagrangian's alone, which `advance` takes at the corrected point, and the
+                // rows checked are those just assembled, a correction at round-off away; with
+                // forces the rows are assembled again there.
+                apply(x, &tables);
+                if S::FORCES {
+                    settled = Ok((iteration, self.assemble(state, x, &mut residual, None)));
+                } else {
+                    for (j, z) in self.increments.iter_mut().enumerate() {
+                        z.copy_from(&x.fixed_rows::<N>(layout.point(j + 1)));
+                    }
+                    self.covectors = StepCovectors::zero();
+                    self.covectors_pending = true;
+                    settled = Ok((iteration, scale));
+                }
+                break;
+            }
+            // Above round-off, every update at most half the one before: the root is then the
+            // iteration's only fixed point within twice the first update of the predictor.
+            let slow = ratio
+                .filter(|&ratio| ratio > fixed_point::MAX_ROW_CONTRACTION && update > 64.0 * floor);
+            if let Some(ratio) = slow {
+                settled = Err(format!(
+                    "the iteration on the rows contracts too slowly to vouch for its root: an \
+                     update {ratio:.2} times the one before (at most {}) at iteration \
+                     {iteration}",
+                    fixed_point::MAX_ROW_CONTRACTION
+                ));
+                break;
+            }
+            tables.accelerate(&mut x.as_mut_slice()[..s * N]);
+            previous = Some(update);
+        }
+        let (iterations, scale) = match settled {
+            Ok(settled) => settled,
+            Err(why) => {
+                self.iteration = Some(tables);
+                self.iterated_residual = residual;
+                return Err(why);
+            }
+        };
+        for (j, z) in self.increments.iter_mut().enumerate() {
+            z.copy_from(&x.fixed_rows::<N>(layout.point(j + 1)));
+        }
+        let terms = scale
+            .max(state.p.amax())
+            .max(tables.momentum_size(h, &self.increments));
+        self.iteration = Some(tables);
+        let size = residual.amax();
+        self.iterated_residual = residual;
+        if exceeds(size, tolerance * terms) {
+            return Err(format!(
+                "the iteration's solution leaves a residual of {size:.1e} against a tolerance \
+                 of {:.1e}",
+                tolerance * terms
+            ));
+        }
+        Ok(NewtonReport {
+            iterations,
+            jacobians: 0,
+            residual: size,
+            contraction,
+        })
     }
 
     /// Solves the step from `state` by the fixed-point iteration from the predictor in `x`
@@ -1775,7 +1928,10 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         {
             return None;
         }
-        Some(self.iterate(state, x, tolerance))
+        Some(match Self::ITERATES_TABLES {
+            true => self.iterate(state, x, tolerance),
+            false => self.iterate_on_rows(state, x, tolerance),
+        })
     }
 
     fn fixed_point_refusal(&self) -> Result<(), String> {

@@ -35,15 +35,39 @@
 //! them: `ξ ← ξ − h (K⁻¹ ⊗ M⁻¹) R(ξ)`, once where the iteration contracts below `10⁻³`, twice above, and the rows assembled
 //! at the last point must be a root to the solver's tolerance. The root is then Newton's to
 //! round-off.
+//!
+//! **Models that are not separable** (a mass matrix `M(q)` that moves with the position, a
+//! velocity coupled to the position, forces that read the velocity), unconstrained on `Rⁿ`, are
+//! iterated on their assembled rows instead: `ξ ← ξ − h (K⁻¹ ⊗ M̄⁻¹) R(ξ)`, with `M̄ = ∂²L/∂v²`
+//! taken once per step at the middle of the predicted step, each iteration one assembly of the
+//! rows (a gradient of `L` per node) and no Jacobian. `h (K⁻¹ ⊗ M̄⁻¹)` inverts the rows' part
+//! `(1/h) (K ⊗ M̄) ξ`, so the iteration contracts by how far the rest moves with `ξ`: the
+//! change of `M` over the step and the velocity in `∂L/∂q` give `O(h |v| |∂M/∂q| / |M|)`, the
+//! potential `O(h² |M⁻¹ ∇²V|)`. On the double pendulum at h = 0.02 that is about 0.02, seven
+//! iterations a step from the predictor. It runs until its update is at round-off; an update
+//! above round-off more than half the one before hands the step to Newton's method
+//! ([`MAX_ROW_CONTRACTION`]), and so does a degenerate Lagrangian (the whole run: `M̄` has no
+//! inverse where coordinates carry no kinetic energy of their own). The solution's rows are
+//! checked against the solver's tolerance, as Newton's are.
 
 use nalgebra::{DMatrix, SVector};
 
 use crate::quadrature::Quadrature;
+use crate::solve::anderson::Anderson;
 use crate::step::verlet::Kinetic;
 
 /// Most iterations of one step before it is handed to Newton's method: at a contraction of
 /// ½ an iteration, enough to reach round-off from a predictor off by `10⁻³` of the increments.
 pub(crate) const MAX_ITERATIONS: usize = 40;
+
+/// Largest ratio of successive updates above round-off at which the iteration on the rows goes
+/// on: a Banach bound, the root then the iteration's only fixed point within twice the first
+/// update of the predictor. Slower, the step is handed to Newton's method (which is then also
+/// the cheaper).
+pub(crate) const MAX_ROW_CONTRACTION: f64 = 0.5;
+
+/// Differences of past iterates the iteration on the rows mixes into each update.
+pub(crate) const ACCELERATION_DEPTH: usize = 3;
 
 /// Refinements of a solution on the assembled rows (see [`FixedPoint::correct`]) where the
 /// iteration contracts by `θ`: each removes all but `θ` of what is left of the tables'
@@ -76,6 +100,9 @@ pub(crate) struct FixedPoint<const N: usize> {
     offsets: Vec<SVector<f64, N>>,
     /// `M⁻¹ G_i` at the last offsets.
     pulls: Vec<SVector<f64, N>>,
+    /// The acceleration of the iteration on the rows, and its `f`, the last correction negated.
+    acceleration: Anderson,
+    update: Vec<f64>,
 }
 
 /// How a solve went: its iterations and the largest ratio of successive updates.
@@ -141,6 +168,8 @@ impl<const N: usize> FixedPoint<N> {
             inverse: inverse.transpose().as_slice().to_vec(),
             offsets: vec![SVector::zeros(); r],
             pulls: vec![SVector::zeros(); r],
+            acceleration: Anderson::new(ACCELERATION_DEPTH),
+            update: vec![0.0; s * N],
         })
     }
 
@@ -164,6 +193,51 @@ impl<const N: usize> FixedPoint<N> {
             self.offsets[m] = correction;
         }
         size
+    }
+
+    /// The last [`correct`](Self::correct)ion, one entry per increment `ξ_1, …, ξ_s`.
+    pub(crate) fn correction(&self) -> &[SVector<f64, N>] {
+        &self.offsets[..self.beta.len()]
+    }
+
+    /// Begins the acceleration of an iteration on the rows afresh (a new step).
+    pub(crate) fn restart_acceleration(&mut self) {
+        self.acceleration.reset(self.update.len());
+    }
+
+    /// The increments `ξ_1, …, ξ_s` (`x`, in order) moved by the last
+    /// [`correct`](Self::correct)ion, accelerated by the iteration's history (see
+    /// [`anderson`](crate::solve::anderson)).
+    pub(crate) fn accelerate(&mut self, x: &mut [f64]) {
+        for (f, c) in self.update.iter_mut().zip(
+            self.offsets[..self.beta.len()]
+                .iter()
+                .flat_map(|c| c.iter()),
+        ) {
+            *f = -c;
+        }
+        self.acceleration.advance(x, &self.update);
+    }
+
+    /// Puts `kinetic` in the place of the run's kinetic terms: the mass matrix of the step
+    /// being iterated on its rows.
+    pub(crate) fn set_kinetic(&mut self, kinetic: Kinetic<N>) {
+        self.kinetic = kinetic;
+    }
+
+    /// How much [`correct`](Self::correct) may enlarge the round-off of the rows: `h ‖K⁻¹‖
+    /// ‖M⁻¹‖` in the norm of the largest row sum.
+    pub(crate) fn correction_gain(&self, h: f64) -> f64 {
+        let s = self.beta.len();
+        let rows = (0..s)
+            .map(|m| {
+                self.inverse[m * s..(m + 1) * s]
+                    .iter()
+                    .map(|x| x.abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max);
+        h * rows * self.kinetic.inverse_mass_norm()
     }
 
     /// Subtracts the last [`correct`](Self::correct)ion from `increments`.

@@ -235,6 +235,37 @@ impl<const N: usize> Kinetic<N> {
         })
     }
 
+    /// The kinetic terms of a mass matrix `mass` taken at one point (`b = 0`), for the
+    /// iteration on the rows of a model that is not separable; `None` where `mass` has no finite
+    /// inverse.
+    pub(crate) fn frozen(mass: SMatrix<f64, N, N>) -> Option<Self> {
+        let inverse_mass = mass
+            .try_inverse()
+            .filter(|inverse| inverse.iter().all(|x| x.is_finite()))?;
+        Some(Kinetic {
+            unit: false,
+            mass,
+            inverse_mass,
+            offset: SVector::zeros(),
+        })
+    }
+
+    /// The largest row sum of `|M⁻¹|`: how much `M⁻¹` may enlarge a vector's round-off.
+    pub(crate) fn inverse_mass_norm(&self) -> f64 {
+        match self.unit {
+            true => 1.0,
+            false => (0..N)
+                .map(|i| {
+                    self.inverse_mass
+                        .row(i)
+                        .iter()
+                        .map(|x| x.abs())
+                        .sum::<f64>()
+                })
+                .fold(0.0, f64::max),
+        }
+    }
+
     /// `v = M⁻¹ (p − b)` and the kinetic energy `T(p) = ½ vᵀ M v = ½ v · (p − b)`.
     #[inline]
     pub(crate) fn velocity_and_energy(&self, p: &SVector<f64, N>) -> (SVector<f64, N>, f64) {

@@ -1,7 +1,8 @@
 //! The trade between speed and accuracy, measured for the user's own model: a grid of
 //! methods (quadratures, also by their step map where the step equations are linear with
-//! constant coefficients, and for a separable model by fixed-point iteration and the explicit
-//! compositions, at a fixed step or time-transformed) × steps run to a horizon, each run's error against a reference, its energy error,
+//! constant coefficients and by fixed-point iteration where the model is unconstrained on `Rⁿ`;
+//! for a separable model the explicit compositions, at a fixed step or time-transformed) ×
+//! steps run to a horizon, each run's error against a reference, its energy error,
 //! constraint violation, Newton iterations and wall time per unit of simulated time; and the
 //! cheapest run meeting a target.
 //!
@@ -350,36 +351,38 @@ impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
                 let stepper = || self.stepper(quadrature, h);
                 record(quadrature.name(), h, self.measure(&stepper, h, &reference));
             }
-            // The same steps solved otherwise, named by `how`.
-            let mut solved_by =
-                |how: &str, make: &dyn Fn(f64) -> Result<Stepper<S, N>, DiracError>| {
-                    for &h in &self.steps {
-                        let name = format!("{}, {how}", quadrature.name());
-                        let measured = self.measure(&|| make(h), h, &reference);
-                        let named = measured.map(|m| Measurement {
-                            quadrature: name.clone(),
-                            ..m
-                        });
-                        record(name, h, named);
-                    }
-                };
-            // Where the model is separable, by fixed-point iteration (left out, without
-            // failures, where the model is refused or its first step is handed to Newton's
-            // method: a mass matrix that is singular, as a circuit's).
+            // The same steps solved otherwise, named by `how`, at the steps `keep` takes.
+            let mut solved_by = |how: &str,
+                                 make: &dyn Fn(f64) -> Result<Stepper<S, N>, DiracError>,
+                                 keep: &dyn Fn(f64) -> bool| {
+                for &h in self.steps.iter().filter(|&&h| keep(h)) {
+                    let name = format!("{}, {how}", quadrature.name());
+                    let measured = self.measure(&|| make(h), h, &reference);
+                    let named = measured.map(|m| Measurement {
+                        quadrature: name.clone(),
+                        ..m
+                    });
+                    record(name, h, named);
+                }
+            };
+            // By fixed-point iteration, at each step whose first step the iteration settles (left
+            // out, without failures, where the model is refused or that step is handed to
+            // Newton's method: a mass matrix that is singular, as a circuit's, or a step too
+            // large for the iteration to contract).
             let iterated = |h| {
                 self.stepper(quadrature, h)
                     .and_then(Stepper::with_fixed_point)
             };
-            let settles = iterated(self.steps[0])
-                .is_ok_and(|mut trial| trial.step().is_ok() && trial.handed_over().0 == 0);
-            if settles {
-                solved_by("fixed point", &iterated);
-            }
+            let settles = |h| {
+                iterated(h)
+                    .is_ok_and(|mut trial| trial.step().is_ok() && trial.handed_over().0 == 0)
+            };
+            solved_by("fixed point", &iterated, &settles);
             // Where the model's step equations are linear with constant coefficients, by their
             // step map (left out, without failures, where they are not).
             let mapped = |h| self.stepper(quadrature, h).and_then(Stepper::with_step_map);
             if mapped(self.steps[0]).is_ok() {
-                solved_by("step map", &mapped);
+                solved_by("step map", &mapped, &|_| true);
             }
         }
         // The default compositions are left out, without failures, for a separable model the
