@@ -71,6 +71,50 @@ fn quadratures(c: &mut Criterion) {
     group.finish();
 }
 
+/// Gauss steps of models that are not separable, solved by Newton's method (`implicit`) and by
+/// fixed-point iteration on their rows (`fixed_point`, `Stepper::with_fixed_point`): the double
+/// pendulum (h = 0.02) at degrees 2, 4 and 6 and the 8-link chain (h = 0.01) at degree 3, each
+/// timed over the first 500 steps from its start (as `chain_step`), per step.
+fn fixed_point_rows(c: &mut Criterion) {
+    let mut group = c.benchmark_group("fixed_point_step");
+    group.sample_size(20);
+    fn solved<S: DiracSystem<N>, const N: usize>(
+        stepper: Stepper<S, N>,
+        iterated: bool,
+    ) -> Stepper<S, N> {
+        match iterated {
+            true => stepper
+                .with_fixed_point()
+                .expect("an unconstrained model on Rⁿ"),
+            false => stepper,
+        }
+    }
+    for s in [2, 4, 6] {
+        for (how, iterated) in [("implicit", false), ("fixed_point", true)] {
+            let quadrature = Quadrature::galerkin(s).expect("valid rule");
+            let started = solved(
+                double_pendulum::stepper(quadrature, 0.02).expect("valid scene"),
+                iterated,
+            );
+            group.bench_function(format!("double_pendulum_galerkin{s}/{how}"), |b| {
+                over_stretches(b, 8, || started.clone(), |stepper| stepper.step());
+            });
+        }
+    }
+    for (how, iterated) in [("implicit", false), ("fixed_point", true)] {
+        let quadrature = Quadrature::galerkin(3).expect("valid rule");
+        let mut stepper = Stepper::new(chain::SCENE8, quadrature, 0.01).expect("valid scene");
+        stepper
+            .start_from_velocity(chain::initial(), SVector::zeros())
+            .expect("finite start");
+        let started = solved(stepper, iterated);
+        group.bench_function(format!("chain8_galerkin3/{how}"), |b| {
+            over_stretches(b, 8, || started.clone(), |stepper| stepper.step());
+        });
+    }
+    group.finish();
+}
+
 /// One chain size in trep's scene: unit links and masses, g = 9.81, midpoint, h = 0.01, straight
 /// and horizontal at rest. Like trep's script, a measurement steps from the start for
 /// `max(200, 4000 / n)` steps (starting over from a copy of the started stepper), so that every
@@ -1087,6 +1131,7 @@ fn plane_field(c: &mut Criterion) {
 criterion_group!(
     benches,
     explicit,
+    fixed_point_rows,
     time_transformed,
     forced,
     modular,

@@ -80,6 +80,12 @@ const GROUPS: &[(&str, &str)] = &[
          and by fixed-point iteration, on Kepler's problem (h = 0.01).",
     ),
     (
+        "fixed_point_step",
+        "Gauss steps of models that are not separable (the double pendulum at h = 0.02, the \
+         8-link chain at h = 0.01), solved by Newton's method and by fixed-point iteration on \
+         their rows, over the first 500 steps from the start.",
+    ),
+    (
         "time_transformed_step",
         "One time-transformed step (dt/ds = |q|, the logarithmic Hamiltonian) on Kepler's orbit \
          of eccentricity 0.9, 32 fictive steps a revolution, against the same composition \

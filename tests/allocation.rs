@@ -160,6 +160,11 @@ fn constrained_and_galerkin_steps_allocate_nothing() {
     iterated
         .start_from_momentum(scenes::kepler::q0(), scenes::kepler::p0())
         .unwrap();
+    // A model that is not separable, iterated on its rows with their acceleration.
+    let rows = scenes::double_pendulum::stepper(Quadrature::galerkin(4).unwrap(), 0.01)
+        .unwrap()
+        .with_fixed_point()
+        .unwrap();
     let mut lc = Stepper::new(scenes::circuit::LC, Quadrature::midpoint(), 0.01).unwrap();
     lc.start_from_velocity(scenes::circuit::q0(), SVector::zeros())
         .unwrap();
@@ -173,6 +178,7 @@ fn constrained_and_galerkin_steps_allocate_nothing() {
         after_a_step("Cartesian pendulum, SHAKE", pendulum),
         after_a_step("Kepler, galerkin(3)", kepler),
         after_a_step("Kepler, galerkin(4), fixed point", iterated),
+        after_a_step("double pendulum, galerkin(4), fixed point", rows),
     ];
     for (name, count) in counts {
         assert_eq!(count, 0, "{name}: {count} allocations in 100 steps");

@@ -4,7 +4,7 @@
 
 use dirac::prelude::*;
 use dirac::work_precision::Study;
-use scenes::{knife_edge, pendulum};
+use scenes::{double_pendulum, knife_edge, pendulum};
 
 /// Unit oscillator, `x = cos t`, `p = −sin t`.
 #[dirac_system(coordinates(x), lagrangian = 0.5 * dot(x).powi(2) - 0.5 * x * x)]
@@ -158,22 +158,30 @@ fn the_chooser_picks_the_cheapest_run_that_truly_meets_the_target() {
 struct Pushed;
 
 /// A fixed-point run's steps that its iteration hands to Newton's method are counted: on the
-/// oscillator the midpoint rule's iteration contracts by `(ω h)²/4`, so at h = 2.5 it hands
-/// over every step and at h = 0.1 none (the run at the first step decides that the iteration
-/// is measured at all); the steps handed over are still the midpoint rule's.
+/// double pendulum at h = 0.1 the iteration on the rows stops contracting in a few of the fast
+/// swings of `galerkin(3)`'s 50 steps, and the study counts as many as the run itself does; at
+/// h = 0.02 none. The steps handed over are still the rule's: the errors are Newton's. On the
+/// oscillator at h = 2.5 the midpoint rule's iteration (contracting by `(ω h)²/4`) hands over
+/// its first step, and that run is left out, without a failure, while h = 0.1 is measured.
 #[test]
 fn the_steps_a_fixed_point_run_hands_over_are_counted() {
-    let horizon = 10.0;
-    let study = Study::new(Oscillator, horizon, |s| {
-        s.start_from_velocity(vector![1.0], vector![0.0])
-    })
-    .quadratures([Quadrature::midpoint()])
-    .compositions([])
-    .steps([0.1, 2.5])
-    .repetitions(1)
-    .reference(oscillator_at(horizon))
-    .run()
-    .unwrap();
+    let (horizon, galerkin) = (5.0, Quadrature::galerkin(3).unwrap());
+    let start =
+        |s: &mut Stepper<_, 2>| s.start_from_velocity(double_pendulum::q0(), double_pendulum::v0());
+    let mut reference = double_pendulum::stepper(Quadrature::galerkin(6).unwrap(), 0.01).unwrap();
+    reference.run(500).unwrap();
+    let study = Study::new(double_pendulum::SCENE, horizon, start)
+        .quadratures([galerkin.clone()])
+        .steps([0.1, 0.02])
+        .repetitions(1)
+        .reference(Sample {
+            t: reference.t(),
+            q: reference.q(),
+            v: reference.v().unwrap(),
+            p: reference.p(),
+        })
+        .run()
+        .unwrap();
     let find = |name: &str, h: f64| {
         study
             .measurements
@@ -181,15 +189,39 @@ fn the_steps_a_fixed_point_run_hands_over_are_counted() {
             .find(|m| m.quadrature == name && m.h == h)
             .unwrap_or_else(|| panic!("no {name} at h = {h}: {study:?}"))
     };
-    for h in [0.1, 2.5] {
-        let (newton, iterated) = (find("midpoint", h), find("midpoint, fixed point", h));
-        let expected = if h > 2.0 { iterated.steps } else { 0 };
+    for h in [0.1, 0.02] {
+        let mut run = double_pendulum::stepper(galerkin.clone(), h)
+            .unwrap()
+            .with_fixed_point()
+            .unwrap();
+        run.run((horizon / h).round() as u64).unwrap();
+        let expected = run.handed_over().0;
+        assert_eq!(expected > 0, h > 0.05, "h = {h}: {expected}");
+        let (newton, iterated) = (find("galerkin(3)", h), find("galerkin(3), fixed point", h));
         assert_eq!(iterated.handed_over, expected, "{iterated:?}");
         assert!(
             (iterated.error - newton.error).abs() <= 1e-12 * newton.error.max(1.0),
             "{iterated:?} against {newton:?}"
         );
     }
+    let study = Study::new(Oscillator, 10.0, |s| {
+        s.start_from_velocity(vector![1.0], vector![0.0])
+    })
+    .quadratures([Quadrature::midpoint()])
+    .compositions([])
+    .steps([0.1, 2.5])
+    .repetitions(1)
+    .reference(oscillator_at(10.0))
+    .run()
+    .unwrap();
+    let iterated = |h: f64| {
+        study
+            .measurements
+            .iter()
+            .any(|m| m.quadrature == "midpoint, fixed point" && m.h == h)
+    };
+    assert!(iterated(0.1) && !iterated(2.5));
+    assert!(study.failures.is_empty());
 }
 
 /// The explicit runs and those by fixed-point iteration hold the inputs the start function

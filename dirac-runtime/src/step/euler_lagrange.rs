@@ -865,17 +865,15 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         }
         let mut previous: Option<f64> = None;
         let mut contraction = 0.0f64;
-        let mut settled = Err(format!(
-            "the iteration on the rows did not settle in {} iterations",
-            fixed_point::MAX_ITERATIONS
-        ));
+        // Formatted where it is the outcome: a step that settles allocates nothing.
+        let mut settled = Err(None);
         for iteration in 1..=fixed_point::MAX_ITERATIONS {
             let scale = self.assemble(state, x, &mut residual, None);
             // `amax` skips a NaN that a later entry follows.
             if !residual.iter().all(|r| r.is_finite()) {
-                settled = Err(format!(
+                settled = Err(Some(format!(
                     "the iteration on the rows left the finite numbers at iteration {iteration}"
-                ));
+                )));
                 break;
             }
             let update = tables.correct(h, |j| {
@@ -925,12 +923,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             let slow = ratio
                 .filter(|&ratio| ratio > fixed_point::MAX_ROW_CONTRACTION && update > 64.0 * floor);
             if let Some(ratio) = slow {
-                settled = Err(format!(
+                settled = Err(Some(format!(
                     "the iteration on the rows contracts too slowly to vouch for its root: an \
                      update {ratio:.2} times the one before (at most {}) at iteration \
                      {iteration}",
                     fixed_point::MAX_ROW_CONTRACTION
-                ));
+                )));
                 break;
             }
             tables.accelerate(&mut x.as_mut_slice()[..s * N]);
@@ -941,7 +939,12 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             Err(why) => {
                 self.iteration = Some(tables);
                 self.iterated_residual = residual;
-                return Err(why);
+                return Err(why.unwrap_or_else(|| {
+                    format!(
+                        "the iteration on the rows did not settle in {} iterations",
+                        fixed_point::MAX_ITERATIONS
+                    )
+                }));
             }
         };
         for (j, z) in self.increments.iter_mut().enumerate() {
