@@ -120,6 +120,8 @@ fn constrained_and_galerkin_steps_allocate_nothing() {
                 stepper.step().unwrap();
             }
         });
+        // A run by fixed-point iteration iterated every step (none handed to Newton's method).
+        assert_eq!(stepper.handed_over(), (0, None), "{name}");
         (name.to_string(), count)
     }
     let knife = |quadrature: Quadrature| {

@@ -863,8 +863,10 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     /// from the extrapolation of the last steps until its update is at round-off, so the
     /// solution is the same discrete Euler–Lagrange equations' root as Newton's, to round-off,
     /// without a bias that would drift the invariants, and is checked by its residual. A step
-    /// where the iteration does not settle (an update that grows, or on the rows more than half
-    /// the one before; 40 iterations; a residual left) is solved by Newton's method instead:
+    /// where the iteration does not settle (an update that grows twice running; on the rows a
+    /// second update above half the first, or two running that shrink by less than half; 40
+    /// iterations; a residual left) is solved by
+    /// Newton's method instead:
     /// [`handed_over`](Self::handed_over) counts those steps and says why the last one was.
     /// Which is cheaper depends on the model: the iteration wins where a Jacobian costs many
     /// gradients (many coordinates, high degree), Newton's method where its few iterations
@@ -1555,8 +1557,9 @@ impl<E: StepEquations<N>, const N: usize> Stepper<E::System, N, E> {
     }
 
     /// How the steps are solved: explicit steps in closed form; the steps of a stepper
-    /// [`with_step_map`](Self::with_step_map) by the step map; every other step by Newton's
-    /// method, with why there is no step map (or that one can be asked for).
+    /// [`with_step_map`](Self::with_step_map) by the step map, of one
+    /// [`with_fixed_point`](Self::with_fixed_point) by fixed-point iteration; every other step
+    /// by Newton's method, with why there is no step map (or that one can be asked for).
     ///
     /// ```
     /// # use dirac_runtime::{DiracSystem, Quadrature, Scalar, Solver, Stepper};

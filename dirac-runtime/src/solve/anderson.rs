@@ -13,9 +13,8 @@
 //! iterations plus one; on a nonlinear map whose Jacobian moves little over the iteration it
 //! converges superlinearly. Where `θ` is not small but the error lies in a few modes (a
 //! preconditioner that misses a term of size `O(h)`), a depth of 2 or 3 removes those modes at
-//! once. The least-squares problem is solved by modified Gram–Schmidt on `ΔF`; a column that
-//! depends on the ones before it (to `10⁻⁸` of its size) is left out, so a history of updates
-//! at round-off mixes nothing in.
+//! once. The least-squares problem is solved by modified Gram–Schmidt on `ΔF`, newest column
+//! first; an older column that depends on the newer ones (to `10⁻⁸` of its size) is left out.
 
 /// The history of an accelerated iteration on `n` unknowns, at most `depth` differences deep.
 /// Its buffers are made once (by [`reset`](Self::reset)) and reused: an iteration allocates
@@ -93,9 +92,10 @@ impl Anderson {
         self.last_x.copy_from_slice(x);
         self.last_f.copy_from_slice(f);
         self.started = true;
-        // Modified Gram–Schmidt on the held columns of ΔF, oldest first.
+        // Modified Gram–Schmidt on the held columns of ΔF, newest first: an older column that
+        // the newer ones span is left out.
         self.kept.clear();
-        for age in (0..self.held).rev() {
+        for age in 0..self.held {
             let column = (self.next + self.depth - 1 - age) % self.depth;
             let source = &self.df[column * n..(column + 1) * n];
             let slot = self.kept.len();
@@ -153,10 +153,8 @@ impl Anderson {
 mod tests {
     use super::*;
 
-    /// On a linear contraction of 4 unknowns, depth 4 reaches the fixed point to round-off in
-    /// 6 iterations where the plain iteration is still 1e-3 off.
-    #[test]
-    fn a_linear_map_is_solved_in_as_many_iterations_as_unknowns() {
+    /// A linear contraction of 4 unknowns, `x ← A x + b`.
+    fn linear(x: &[f64]) -> Vec<f64> {
         let a = [
             [0.5, 0.2, 0.0, 0.1],
             [-0.3, 0.4, 0.1, 0.0],
@@ -164,30 +162,64 @@ mod tests {
             [0.1, 0.0, 0.2, 0.5],
         ];
         let b = [1.0, -2.0, 0.5, 3.0];
-        let g = |x: &[f64]| -> Vec<f64> {
-            (0..4)
-                .map(|i| (0..4).map(|j| a[i][j] * x[j]).sum::<f64>() + b[i])
-                .collect()
-        };
-        let run = |depth: Option<usize>, iterations: usize| {
-            let mut x = vec![0.0; 4];
-            let mut anderson = Anderson::new(depth.unwrap_or(1));
-            anderson.reset(4);
-            for _ in 0..iterations {
-                let f: Vec<f64> = g(&x).iter().zip(&x).map(|(gx, x)| gx - x).collect();
-                match depth {
-                    Some(_) => anderson.advance(&mut x, &f),
-                    None => x.iter_mut().zip(&f).for_each(|(x, f)| *x += f),
-                }
+        (0..4)
+            .map(|i| (0..4).map(|j| a[i][j] * x[j]).sum::<f64>() + b[i])
+            .collect()
+    }
+
+    /// `|G(x) − x|∞` after `iterations` of `x ← G(x)` from 0, accelerated at `depth` (plain
+    /// where `None`), with `anderson` (reset first).
+    fn left(anderson: &mut Anderson, depth: Option<usize>, iterations: usize) -> f64 {
+        let mut x = vec![0.0; 4];
+        anderson.reset(4);
+        for _ in 0..iterations {
+            let f: Vec<f64> = linear(&x).iter().zip(&x).map(|(g, x)| g - x).collect();
+            match depth {
+                Some(_) => anderson.advance(&mut x, &f),
+                None => x.iter_mut().zip(&f).for_each(|(x, f)| *x += f),
             }
-            let gx = g(&x);
-            gx.iter()
-                .zip(&x)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max)
-        };
-        let (accelerated, plain) = (run(Some(4), 6), run(None, 6));
-        assert!(accelerated < 1e-13, "{accelerated:e}");
-        assert!(plain > 1e-3, "{plain:e}");
+        }
+        let g = linear(&x);
+        g.iter()
+            .zip(&x)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// Depth 4 on 4 unknowns is GMRES: the fixed point to round-off in 6 iterations (the plain
+    /// first and the 4 that fill the history, and one), where the plain iteration is 0.18 off.
+    /// Depth 2, which cannot span the error, still ends 30 times closer than the plain iteration
+    /// after 12 iterations (3.2e-4 against 1.1e-2), its history wrapping around the ring; a
+    /// reset history repeats the same iterates bit for bit.
+    #[test]
+    fn the_acceleration_solves_a_linear_map_and_restarts_clean() {
+        let (mut deep, mut shallow) = (Anderson::new(4), Anderson::new(2));
+        let accelerated = left(&mut deep, Some(4), 6);
+        let plain = left(&mut deep, None, 6);
+        assert!(
+            accelerated < 1e-13 && plain > 0.1,
+            "{accelerated:e} {plain:e}"
+        );
+        let (shallow_left, plain) = (
+            left(&mut shallow, Some(2), 12),
+            left(&mut shallow, None, 12),
+        );
+        assert!(shallow_left < 0.1 * plain, "{shallow_left:e} {plain:e}");
+        assert_eq!(left(&mut shallow, Some(2), 12), shallow_left);
+    }
+
+    /// A history whose differences are parallel (the same update direction each time) keeps one
+    /// column: the least squares stay well posed and the step finite.
+    #[test]
+    fn a_dependent_column_is_left_out() {
+        let mut anderson = Anderson::new(3);
+        anderson.reset(2);
+        let mut x = vec![0.0, 0.0];
+        for k in 0..4 {
+            let f = vec![1.0 / (k + 1) as f64, 2.0 / (k + 1) as f64];
+            anderson.advance(&mut x, &f);
+            assert!(x.iter().all(|v| v.is_finite()), "{x:?}");
+        }
+        assert_eq!(anderson.kept.len(), 1);
     }
 }

@@ -744,9 +744,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             .discrete
             .space()
             .pull_back(&state.q, &SVector::zeros(), &state.p);
-        for (j, z) in self.increments.iter_mut().enumerate() {
-            z.copy_from(&x.fixed_rows::<N>(self.layout.point(j + 1)));
-        }
+        self.read_increments(x);
         self.constraint_impulse = constraint_impulse;
         let xi = self.end_increment(x);
         let (space, system) = (self.discrete.space(), self.discrete.system());
@@ -859,12 +857,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         tables.set_kinetic(kinetic);
         tables.restart_acceleration();
         let gain = tables.correction_gain(h);
-        let mut residual = std::mem::take(&mut self.iterated_residual);
-        if residual.len() != x.len() {
-            residual = DVector::zeros(x.len());
-        }
+        let mut residual = self.residual_buffer(x.len());
         let mut previous: Option<f64> = None;
-        let mut contraction = 0.0f64;
+        let (mut contraction, mut slow_before) = (0.0f64, false);
         // Formatted where it is the outcome: a step that settles allocates nothing.
         let mut settled = Err(None);
         for iteration in 1..=fixed_point::MAX_ITERATIONS {
@@ -879,10 +874,6 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             let update = tables.correct(h, |j| {
                 residual.fixed_rows::<N>(layout.point(j + 1)).into_owned()
             });
-            let ratio = previous
-                .filter(|&before| before > 0.0)
-                .map(|before| update / before);
-            contraction = contraction.max(ratio.unwrap_or(0.0));
             // The update's round-off: the increments' own, the positions' carried by the
             // contraction, and the rows' terms' through `h (K⁻¹ ⊗ M⁻¹)`.
             let size = (1..=s)
@@ -892,45 +883,45 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 4.0 * f64::EPSILON * (size + contraction.min(1.0) * state.q.amax() + gain * scale);
             // An update that did not shrink: the iteration is at its round-off.
             let stalled = previous.is_some_and(|before| update >= before);
-            let apply = |x: &mut DVector<f64>, tables: &FixedPoint<N>| {
-                for (m, correction) in tables.correction().iter().enumerate() {
-                    let mut rows = x.fixed_rows_mut::<N>(layout.point(m + 1));
-                    rows -= correction;
-                }
-            };
             if update <= f64::EPSILON * size || (stalled && update <= 64.0 * floor) {
-                // The last correction is taken too: left out, it would bias every step alike
-                // (an update stopped at 4 ε |ξ| drifted the charge's angular momentum by
-                // 1.7e-17 a step). Without forces the step's covectors are the discrete
-                // Lagrangian's alone, which `advance` takes at the corrected point, and the
-                // rows checked are those just assembled, a correction at round-off away; with
-                // forces the rows are assembled again there.
-                apply(x, &tables);
-                if S::FORCES {
-                    settled = Ok((iteration, self.assemble(state, x, &mut residual, None)));
-                } else {
-                    for (j, z) in self.increments.iter_mut().enumerate() {
-                        z.copy_from(&x.fixed_rows::<N>(layout.point(j + 1)));
-                    }
-                    self.covectors = StepCovectors::zero();
-                    self.covectors_pending = true;
-                    settled = Ok((iteration, scale));
-                }
+                // The last correction is taken too, and the rows assembled there (for
+                // `advance` and the check): left out, it would bias every step alike (an
+                // update stopped at 4 ε |ξ| drifted the charge's angular momentum by 1.7e-17 a
+                // step).
+                self.read_increments(x);
+                tables.apply(&mut self.increments);
+                self.write_increments(x);
+                let scale = self.assemble(state, x, &mut residual, None);
+                settled = Ok((iteration, scale));
                 break;
             }
-            // Above round-off, every update at most half the one before: the root is then the
-            // iteration's only fixed point within twice the first update of the predictor.
-            let slow = ratio
-                .filter(|&ratio| ratio > fixed_point::MAX_ROW_CONTRACTION && update > 64.0 * floor);
-            if let Some(ratio) = slow {
+            // The contraction as the updates above round-off show it. Two running above ½ hand
+            // the step over (the mixed updates need not shrink monotonically).
+            let ratio = previous
+                .filter(|&before| before > 64.0 * floor && update > 64.0 * floor)
+                .map(|before| update / before);
+            contraction = contraction.max(ratio.unwrap_or(0.0));
+            let slow = ratio.filter(|&ratio| ratio > fixed_point::MAX_ROW_CONTRACTION);
+            // The first ratio is the plain iteration's (the second update follows one
+            // unmixed): above ½ the predictor is not where the iteration vouches for a root
+            // near it, and the step is Newton's, whose contraction test then decides.
+            if let (Some(ratio), 2) = (slow, iteration) {
                 settled = Err(Some(format!(
-                    "the iteration on the rows contracts too slowly to vouch for its root: an \
-                     update {ratio:.2} times the one before (at most {}) at iteration \
-                     {iteration}",
+                    "the iteration on the rows contracts too slowly from the predictor: its \
+                     second update {ratio:.2} times its first (at most {})",
                     fixed_point::MAX_ROW_CONTRACTION
                 )));
                 break;
             }
+            if let (Some(ratio), true) = (slow, slow_before) {
+                settled = Err(Some(format!(
+                    "the iteration on the rows contracts too slowly: its update shrank by less \
+                     than {} twice running, {ratio:.2} at iteration {iteration}",
+                    fixed_point::MAX_ROW_CONTRACTION
+                )));
+                break;
+            }
+            slow_before = slow.is_some();
             tables.accelerate(&mut x.as_mut_slice()[..s * N]);
             previous = Some(update);
         }
@@ -947,27 +938,71 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 }));
             }
         };
-        for (j, z) in self.increments.iter_mut().enumerate() {
-            z.copy_from(&x.fixed_rows::<N>(layout.point(j + 1)));
+        let settled = Settled {
+            iterations,
+            contraction,
+        };
+        self.checked_iteration(state, tables, residual, scale, tolerance, settled, "")
+    }
+
+    /// The buffer for the rows of an iterated solution, of `n` rows.
+    fn residual_buffer(&mut self, n: usize) -> DVector<f64> {
+        let residual = std::mem::take(&mut self.iterated_residual);
+        match residual.len() == n {
+            true => residual,
+            false => DVector::zeros(n),
         }
+    }
+
+    /// The increments `ξ_1, …, ξ_s` of the point `x`, into `increments`.
+    fn read_increments(&mut self, x: &DVector<f64>) {
+        for (j, z) in self.increments.iter_mut().enumerate() {
+            z.copy_from(&x.fixed_rows::<N>(self.layout.point(j + 1)));
+        }
+    }
+
+    /// `increments` into the point `x`.
+    fn write_increments(&self, x: &mut DVector<f64>) {
+        for (j, z) in self.increments.iter().enumerate() {
+            x.fixed_rows_mut::<N>(self.layout.point(j + 1)).copy_from(z);
+        }
+    }
+
+    /// The iterated solution in `increments`, whose rows `residual` were assembled last
+    /// (`scale` the size of their terms), checked as Newton's roots are: its residual against
+    /// `tolerance` times the rows' terms (the assembly's count, and at least `p_k` and
+    /// `M ξ_s / h`), `why` added to a refusal. Puts the tables and the buffer back.
+    #[allow(clippy::too_many_arguments)]
+    fn checked_iteration(
+        &mut self,
+        state: &State<N>,
+        tables: FixedPoint<N>,
+        residual: DVector<f64>,
+        scale: f64,
+        tolerance: f64,
+        settled: Settled,
+        why: &str,
+    ) -> Result<NewtonReport, String> {
         let terms = scale
             .max(state.p.amax())
-            .max(tables.momentum_size(h, &self.increments));
+            .max(tables.momentum_size(self.discrete.h(), &self.increments));
         self.iteration = Some(tables);
         let size = residual.amax();
+        // `amax` skips a NaN that a later entry follows.
+        let finite = residual.iter().all(|x| x.is_finite());
         self.iterated_residual = residual;
-        if exceeds(size, tolerance * terms) {
+        if !finite || exceeds(size, tolerance * terms) {
             return Err(format!(
                 "the iteration's solution leaves a residual of {size:.1e} against a tolerance \
-                 of {:.1e}",
+                 of {:.1e}{why}",
                 tolerance * terms
             ));
         }
         Ok(NewtonReport {
-            iterations,
+            iterations: settled.iterations,
             jacobians: 0,
             residual: size,
-            contraction,
+            contraction: settled.contraction,
         })
     }
 
@@ -981,9 +1016,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         tolerance: f64,
     ) -> Result<NewtonReport, String> {
         let mut tables = self.iteration_tables(state)?;
-        for (j, z) in self.increments.iter_mut().enumerate() {
-            z.copy_from(&x.fixed_rows::<N>(self.layout.point(j + 1)));
-        }
+        self.read_increments(x);
         let (system, inputs) = (self.discrete.system(), &self.inputs);
         let at_rest = SVector::zeros();
         let pull = |y: &SVector<f64, N>, t: f64| {
@@ -995,20 +1028,14 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         };
         let h = self.discrete.h();
         let settled = tables.solve(&state.q, &state.p, state.t, h, &mut self.increments, pull);
-        let Settled {
-            iterations,
-            contraction,
-        } = match settled {
+        let settled = match settled {
             Ok(settled) => settled,
             Err(why) => {
                 self.iteration = Some(tables);
                 return Err(why);
             }
         };
-        let mut residual = std::mem::take(&mut self.iterated_residual);
-        if residual.len() != x.len() {
-            residual = DVector::zeros(x.len());
-        }
+        let mut residual = self.residual_buffer(x.len());
         // The tables' solution refined on the assembled rows (each correction taken, at
         // round-off too: a correction left out biases every step alike, and the energy's
         // round-off drifts faster), the rows assembled at the last point (for `advance`).
@@ -1016,11 +1043,9 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
         let mut scale;
         let mut refinements = 0;
         loop {
-            for (j, z) in self.increments.iter().enumerate() {
-                x.fixed_rows_mut::<N>(self.layout.point(j + 1)).copy_from(z);
-            }
+            self.write_increments(x);
             scale = self.assemble(state, x, &mut residual, None);
-            if refinements == fixed_point::refinements(contraction) {
+            if refinements == fixed_point::refinements(settled.contraction) {
                 break;
             }
             let layout = self.layout;
@@ -1030,28 +1055,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
             tables.apply(&mut self.increments);
             refinements += 1;
         }
-        // The rows' terms: the assembly's count, and at least `p_k` and `M ξ_s / h`.
-        let terms = scale
-            .max(state.p.amax())
-            .max(tables.momentum_size(h, &self.increments));
-        self.iteration = Some(tables);
-        let size = residual.amax();
-        // `amax` skips a NaN that a later entry follows.
-        let finite = residual.iter().all(|x| x.is_finite());
-        self.iterated_residual = residual;
-        if !finite || exceeds(size, tolerance * terms) {
-            return Err(format!(
-                "the iteration's solution leaves a residual of {size:.1e} against a tolerance \
-                 of {:.1e}: the model may not be separable as it declares",
-                tolerance * terms
-            ));
-        }
-        Ok(NewtonReport {
-            iterations,
-            jacobians: 0,
-            residual: size,
-            contraction,
-        })
+        let why = ": the model may not be separable as it declares";
+        self.checked_iteration(state, tables, residual, scale, tolerance, settled, why)
     }
 
     /// Second derivatives of the step from `state` solved by `x` with respect to `(q_k, p_k)`,
@@ -1765,9 +1770,7 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 return scale;
             }
         }
-        for (j, z) in self.increments.iter_mut().enumerate() {
-            z.copy_from(&x.fixed_rows::<N>(self.layout.point(j + 1)));
-        }
+        self.read_increments(x);
         let n = x.len();
         if self.scratch.shape() != (n, n) {
             self.scratch = DMatrix::zeros(n, n);

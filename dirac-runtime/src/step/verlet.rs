@@ -30,7 +30,7 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 use crate::base::error::DiracError;
-use crate::base::float::{folded, two_sum_add};
+use crate::base::float::{folded, row_sum_norm, two_sum_add};
 use crate::discrete::discrete_lagrangian::DiscreteLagrangian;
 use crate::discrete::state::State;
 use crate::model::derivatives::{self, Seed};
@@ -254,15 +254,7 @@ impl<const N: usize> Kinetic<N> {
     pub(crate) fn inverse_mass_norm(&self) -> f64 {
         match self.unit {
             true => 1.0,
-            false => (0..N)
-                .map(|i| {
-                    self.inverse_mass
-                        .row(i)
-                        .iter()
-                        .map(|x| x.abs())
-                        .sum::<f64>()
-                })
-                .fold(0.0, f64::max),
+            false => row_sum_norm(&self.inverse_mass, &mut [0.0; N]),
         }
     }
 

@@ -147,7 +147,9 @@ pub struct WorkPrecision<const N: usize> {
 
 impl<'a, S: DiracSystem<N> + Clone, const N: usize> Study<'a, S, N> {
     /// A study of `system` to time `horizon`, each stepper started by `start`; by default
-    /// `midpoint`, `galerkin(2)` and `galerkin(3)`, and for a separable model without
+    /// `midpoint`, `galerkin(2)` and `galerkin(3)` (for a model on `Rⁿ` without constraints each
+    /// also by fixed-point iteration, at every step whose first step the iteration settles;
+    /// by the step map where the step equations are linear), and for a separable model without
     /// constraints or forces that read the velocity ([`DiracSystem::SEPARABLE`]) the explicit compositions of orders 2,
     /// 4, 6 and 8 ([`Composition::of_order`]), at `h = horizon/16, /32, /64, /128`, three timing
     /// repetitions, and a converged reference. An explicit step starts from the state and the
