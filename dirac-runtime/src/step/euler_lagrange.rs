@@ -922,6 +922,8 @@ impl<S: DiracSystem<N>, C: ConfigurationSpace<N, Manifold = Vectors>, const N: u
                 break;
             }
             slow_before = slow.is_some();
+            // The increments lead the unknowns (an unconstrained step without projection).
+            debug_assert_eq!(layout.point(1), 0);
             tables.accelerate(&mut x.as_mut_slice()[..s * N]);
             previous = Some(update);
         }

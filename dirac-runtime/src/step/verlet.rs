@@ -211,31 +211,26 @@ impl<const N: usize> Kinetic<N> {
                  {v2:?})"
             )));
         }
-        let inverse_mass = mass
-            .try_inverse()
-            .filter(|inverse| inverse.iter().all(|x| x.is_finite()))
-            .ok_or_else(|| {
-                DiracError::Unsupported(format!(
-                    "the explicit step of a model whose mass matrix ∂²L/∂v² is singular ({} \
-                     carries no kinetic energy of its own); Stepper::new steps it with a \
-                     quadrature",
-                    (0..N)
-                        .find(|&i| mass.row(i).iter().all(|&x| x == 0.0))
-                        .map_or_else(
-                            || "some combination of the velocities".to_string(),
-                            |i| system.coordinate_name(i)
-                        )
-                ))
-            })?;
+        let kinetic = Self::frozen(mass).ok_or_else(|| {
+            DiracError::Unsupported(format!(
+                "the explicit step of a model whose mass matrix ∂²L/∂v² is singular ({} carries \
+                 no kinetic energy of its own); Stepper::new steps it with a quadrature",
+                (0..N)
+                    .find(|&i| mass.row(i).iter().all(|&x| x == 0.0))
+                    .map_or_else(
+                        || "some combination of the velocities".to_string(),
+                        |i| system.coordinate_name(i)
+                    )
+            ))
+        })?;
         Ok(Kinetic {
             unit: mass == SMatrix::<f64, N, N>::identity() && offset == SVector::<f64, N>::zeros(),
-            mass,
-            inverse_mass,
             offset,
+            ..kinetic
         })
     }
 
-    /// The kinetic terms of a mass matrix `mass` taken at one point (`b = 0`), for the
+    /// The kinetic terms of a mass matrix `mass` (`b = 0`): also those of one step, for the
     /// iteration on the rows of a model that is not separable; `None` where `mass` has no finite
     /// inverse.
     pub(crate) fn frozen(mass: SMatrix<f64, N, N>) -> Option<Self> {
