@@ -780,43 +780,54 @@ fn the_method_of_lines_integrates_the_fields_semi_discrete_equations() {
     }
 }
 
-/// The string's standing wave `sin(3πx) cos(3πt)` (fixed ends) at `t = 0.5` on cells of degree
-/// 1 to 4 (Kahan–Li 8 in time at `Δt = Δx/(3r²)`, whose own error is far below): on 4, 8 and
-/// 16 cells each degree converges at order `r + 1` or better (measured 1.82, 4.01, 5.59, 6.80),
-/// and each degree is at least ten times closer than the one below on 16 cells. Free ends are
-/// held as well: the bar's mode `cos 3πx` on 16 cells of degree 3.
+/// The string's standing wave `sin(3πx) cos(3πt)` (fixed ends) over `0 < t ≤ 0.5` on cells of
+/// degree 1 to 5 (Kahan–Li 8 in time at `Δt = Δx/(3r²)`, whose own error is far below): the
+/// largest error over the run falls on 8, 16 and 32 cells at order `2` for degree 1 and `r + 2`
+/// for degrees 2 to 5 (measured 2.00, 4.03, 5.01, 6.01, 6.86), and each degree is at least ten
+/// times closer than the one below on 32 cells. The error at one time is no measure of the
+/// order: the start excites the cells' high branches, whose oscillations it samples at an
+/// arbitrary phase (at `t = 0.5` alone the slopes run from 3.2 to 7.5). Free ends are held as
+/// well: the bar's mode `cos 3πx` on 16 cells of degree 3.
 #[test]
 fn lobatto_cells_converge_faster_with_their_degree() {
     let k = 3.0 * PI;
-    let cells = [4usize, 8, 16];
+    let cells = [8usize, 16, 32];
     let mut finest = f64::INFINITY;
-    for degree in 1..=4usize {
+    for degree in 1..=5usize {
         let errors: Vec<f64> = cells
             .iter()
             .map(|&n| {
                 let r = degree as f64;
                 let steps = (0.5 * 3.0 * r * r * n as f64).ceil() as u64;
-                let mut string =
-                    Field::new(WAVE, (0.0, 1.0), n, Boundary::Fixed, 0.5 / steps as f64)
-                        .unwrap()
-                        .with_degree(degree)
-                        .unwrap()
-                        .with_composition(Composition::kahan_li_8());
+                let dt = 0.5 / steps as f64;
+                let mut string = Field::new(WAVE, (0.0, 1.0), n, Boundary::Fixed, dt)
+                    .unwrap()
+                    .with_degree(degree)
+                    .unwrap()
+                    .with_composition(Composition::kahan_li_8());
                 let x = string.positions();
                 string
                     .start(&at(&x, |x| (k * x).sin()), &at(&x, |_| 0.0))
                     .unwrap();
-                string.run(steps).unwrap();
-                error(&string, |x| {
-                    SVector::from([(k * x).sin() * (0.5 * k).cos()])
-                })
+                (1..=steps)
+                    .map(|step| {
+                        string.run(1).unwrap();
+                        let t = step as f64 * dt;
+                        error(&string, |x| SVector::from([(k * x).sin() * (k * t).cos()]))
+                    })
+                    .fold(0.0, f64::max)
             })
             .collect();
         let hs: Vec<f64> = cells.iter().map(|&n| 1.0 / n as f64).collect();
         let order = slope(&hs, &errors);
         println!("degree {degree}: order {order:.2}, {errors:?}");
+        let expected = if degree == 1 {
+            2.0
+        } else {
+            degree as f64 + 2.0
+        };
         assert!(
-            order > degree as f64 + 0.7,
+            order > expected - 0.3,
             "degree {degree}: order {order}, {errors:?}"
         );
         assert!(errors[2] < 0.1 * finest, "degree {degree}: {errors:?}");
