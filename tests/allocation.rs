@@ -231,6 +231,21 @@ fn plane_field_steps_allocate_nothing() {
     let count = allocations(|| drum.run(20).unwrap());
     assert_eq!(count, 0, "{count} allocations in 20 steps of a plane field");
     assert_eq!(drum.steps(), 21);
+    // Cells of degree 3: their scratch is on the stack.
+    let mut cells = PlaneField::new(scenes::membrane::DRUM, sides, [6, 4], edges, 0.002)
+        .unwrap()
+        .with_degree(3)
+        .unwrap();
+    let u0: Vec<SVector<f64, 1>> = (cells.points().into_iter())
+        .map(|[x, y]| SVector::from([x.cos() * (std::f64::consts::PI * y).sin()]))
+        .collect();
+    cells.start(&u0, &vec![SVector::zeros(); u0.len()]).unwrap();
+    cells.step().unwrap();
+    let count = allocations(|| cells.run(20).unwrap());
+    assert_eq!(
+        count, 0,
+        "{count} allocations in 20 steps of cells of degree 3"
+    );
 }
 
 /// A field's memory is linear in its nodes: a started field of four times the nodes holds the

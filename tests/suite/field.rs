@@ -1057,4 +1057,12 @@ fn lobatto_cells_keep_energy_and_refuse_what_they_cannot_be() {
         string().with_degree(past),
         Err(DiracError::Unsupported(_))
     ));
+    // More nodes than can be counted, or held.
+    for (cells, what) in [(usize::MAX, "counted"), (usize::MAX / 2, "memory")] {
+        let huge = Field::new(WAVE, (0.0, 1.0), cells, Boundary::Fixed, 0.001);
+        assert!(
+            matches!(&huge, Err(DiracError::Dimension(why)) if why.contains(what)),
+            "{huge:?}"
+        );
+    }
 }

@@ -104,6 +104,24 @@ pub(super) trait Grid<const C: usize> {
     }
 }
 
+/// The masses `mass(k)` of `count` nodes, held in a vector of exactly that many: `Dimension`
+/// where so many cannot be held, else the first error of `mass`.
+pub(super) fn node_masses<const C: usize>(
+    count: usize,
+    mut mass: impl FnMut(usize) -> Result<SVector<f64, C>, DiracError>,
+) -> Result<Vec<SVector<f64, C>>, DiracError> {
+    let mut masses = Vec::new();
+    masses.try_reserve_exact(count).map_err(|_| {
+        DiracError::Dimension(format!(
+            "a field of {count} nodes: more than memory can hold"
+        ))
+    })?;
+    for k in 0..count {
+        masses.push(mass(k)?);
+    }
+    Ok(masses)
+}
+
 /// Checks a start's field `u` and rates `u_t` (one value per node, finite, at rest where the
 /// mass is zero) and makes its state: momenta `m u_t` and the force at `u`. Refused with nothing
 /// changed: `Dimension`, `NonFinite`, `InconsistentInitialState` (a node held fixed that moves).

@@ -142,6 +142,7 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
                  finite"
             )));
         }
+        node_count(cells, boundary, 1)?;
         let mut field = Self {
             density,
             start: a,
@@ -267,7 +268,9 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     /// # Ok::<(), dirac_runtime::DiracError>(())
     /// ```
     pub fn with_degree(mut self, degree: usize) -> Result<Self, DiracError> {
-        self.elements = Elements::new(degree)?;
+        let elements = Elements::new(degree)?;
+        node_count(self.cells, self.boundary, degree)?;
+        self.elements = elements;
         self.mass = self.masses()?;
         self.run = None;
         Ok(self)
@@ -284,49 +287,39 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
         let nodes = self.nodes();
         let r = self.degree();
         let inside = |j: usize| self.elements.weights[j % r] * self.dx;
-        (0..nodes)
-            .map(|j| {
-                let x = self.position(j);
-                let rho = self.density.inertia(x);
-                if let Some(&bad) = rho.iter().find(|r| !(**r > 0.0 && r.is_finite())) {
-                    return Err(DiracError::NonFinite {
-                        what: format!("the inertia at x = {x} (it must be positive and finite)"),
-                        value: bad,
-                    });
+        leapfrog::node_masses(nodes, |j| {
+            let x = self.position(j);
+            let rho = self.density.inertia(x);
+            if let Some(&bad) = rho.iter().find(|r| !(**r > 0.0 && r.is_finite())) {
+                return Err(DiracError::NonFinite {
+                    what: format!("the inertia at x = {x} (it must be positive and finite)"),
+                    value: bad,
+                });
+            }
+            let end = j == 0 || j == nodes - 1;
+            let mass = match (self.boundary, end) {
+                (Boundary::Periodic, _) | (_, false) if j % r == 0 => rho * (2.0 * inside(j)),
+                (Boundary::Periodic, _) | (_, false) => rho * inside(j),
+                (Boundary::Fixed, true) => return Ok(SVector::zeros()),
+                (Boundary::Free, true) => {
+                    let end_mass = self.end_masses[usize::from(j > 0)];
+                    (rho * inside(j)).add_scalar(end_mass)
                 }
-                let end = j == 0 || j == nodes - 1;
-                let mass = match (self.boundary, end) {
-                    (Boundary::Periodic, _) | (_, false) if j % r == 0 => rho * (2.0 * inside(j)),
-                    (Boundary::Periodic, _) | (_, false) => rho * inside(j),
-                    (Boundary::Fixed, true) => return Ok(SVector::zeros()),
-                    (Boundary::Free, true) => {
-                        let end_mass = self.end_masses[usize::from(j > 0)];
-                        (rho * inside(j)).add_scalar(end_mass)
-                    }
-                };
-                match mass.iter().find(|m| !(**m > 0.0 && m.is_finite())) {
-                    Some(&bad) => Err(DiracError::NonFinite {
-                        what: format!("the mass of node {j} (ρ Δx must be positive and finite)"),
-                        value: bad,
-                    }),
-                    None => Ok(mass),
-                }
-            })
-            .collect::<Result<Vec<_>, _>>()
-            // Collected without a size hint: hold no spare capacity.
-            .map(|mut mass| {
-                mass.shrink_to_fit();
-                mass
-            })
+            };
+            match mass.iter().find(|m| !(**m > 0.0 && m.is_finite())) {
+                Some(&bad) => Err(DiracError::NonFinite {
+                    what: format!("the mass of node {j} (ρ Δx must be positive and finite)"),
+                    value: bad,
+                }),
+                None => Ok(mass),
+            }
+        })
     }
 
     /// The number of nodes: `N r` when periodic, else `N r + 1`, for cells of degree `r`.
     pub fn nodes(&self) -> usize {
-        let points = self.cells * self.degree();
-        match self.boundary {
-            Boundary::Periodic => points,
-            Boundary::Fixed | Boundary::Free => points + 1,
-        }
+        // Counted when the cells and their degree were set.
+        node_count(self.cells, self.boundary, self.degree()).unwrap_or(usize::MAX)
     }
 
     /// The number of cells `N`.
@@ -623,4 +616,19 @@ impl<D: SeparableDensity<C>, const C: usize> Grid<C> for Field<D, C> {
             });
         }
     }
+}
+
+/// The number of nodes of `cells` of degree `r`: `N r` when periodic, else `N r + 1`;
+/// `Dimension` where it cannot be counted.
+fn node_count(cells: usize, boundary: Boundary, r: usize) -> Result<usize, DiracError> {
+    let points = cells.checked_mul(r);
+    let nodes = match boundary {
+        Boundary::Periodic => points,
+        Boundary::Fixed | Boundary::Free => points.and_then(|n| n.checked_add(1)),
+    };
+    nodes.ok_or_else(|| {
+        DiracError::Dimension(format!(
+            "{cells} cells of degree {r} make more nodes than can be counted"
+        ))
+    })
 }

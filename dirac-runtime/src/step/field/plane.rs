@@ -53,6 +53,7 @@ use num_dual::{Derivative, DualSVec64, HyperDualSVec64};
 use rayon::prelude::*;
 
 use super::Boundary;
+use super::elements::{Elements, MOST_DEGREE};
 use super::leapfrog::{self, GRAIN, Grid, Running, is_zero};
 use crate::base::error::DiracError;
 use crate::model::density::PlaneDensity;
@@ -84,6 +85,8 @@ pub struct PlaneField<D, const C: usize> {
     dt: f64,
     composition: Composition,
     parallel: bool,
+    /// The Gauss–Lobatto points of the cells along each axis (degree 1: the box cell's corners).
+    elements: Elements,
     /// `m = w_x w_y ρ`, by node; zero at a node on a fixed edge (it does not move).
     mass: Vec<SVector<f64, C>>,
     /// Per band of rows, a [`Window`].
@@ -154,18 +157,7 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
                 )));
             }
         }
-        let nodes = [0, 1].map(|axis| match boundary[axis] {
-            Boundary::Periodic => Some(cells[axis]),
-            Boundary::Fixed | Boundary::Free => cells[axis].checked_add(1),
-        });
-        let nodes = match nodes {
-            [Some(nx), Some(ny)] if nx.checked_mul(ny).is_some() => [nx, ny],
-            _ => {
-                return Err(DiracError::Dimension(format!(
-                    "{cells:?} cells make more nodes than can be counted"
-                )));
-            }
-        };
+        let nodes = node_counts(cells, boundary, 1)?;
         let mut field = Self {
             density,
             origin: rectangle.map(|side| side.0),
@@ -176,6 +168,7 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
             dt,
             composition: Composition::verlet(),
             parallel: false,
+            elements: Elements::new(1)?,
             mass: Vec::new(),
             run: None,
         };
@@ -193,59 +186,107 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
 
     /// Whether the passes of a step over the nodes are split across rayon's threads (by default
     /// not), in bands of rows of about 16 384 nodes. The steps are the same bit for bit; a field
-    /// of fewer than 32 768 nodes (one band) is stepped on one thread all the same. `cargo bench --bench step --
-    /// plane_field_step` measures the gain.
+    /// of fewer than 32 768 nodes (one band) is stepped on one thread all the same, and so are
+    /// cells of degree 2 and above ([`with_degree`](Self::with_degree)). `cargo bench --bench
+    /// step -- plane_field_step` measures the gain.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = parallel;
         self
     }
 
-    /// The weights `w` of the nodes along `axis`: the cell width, half of it at a free edge,
-    /// zero at a fixed one.
-    fn weights(&self, axis: usize) -> Vec<f64> {
-        let n = self.nodes()[axis];
-        let width = self.spacing[axis];
-        (0..n)
-            .map(|i| match (self.boundary[axis], i == 0 || i == n - 1) {
-                (Boundary::Periodic, _) | (_, false) => width,
-                (Boundary::Fixed, true) => 0.0,
-                (Boundary::Free, true) => 0.5 * width,
-            })
-            .collect()
+    /// The same field with cells of degree `degree` along each axis (1 to [`MOST_DEGREE`]; by
+    /// default 1, the box cell): each cell carries the field at the `(degree + 1)²` points of the
+    /// tensor-product Gauss–Lobatto rule, the field inside it is the polynomial of that degree in
+    /// `x` and in `y` through them, and its action is integrated by that rule, the kinetic energy
+    /// lumped on the points (spectral elements on quadrilaterals). Degree 1 is the box cell.
+    /// The nodes are the cells' points: `N r` along a periodic axis, else `N r + 1`.
+    /// `Unsupported` for a degree outside 1 to [`MOST_DEGREE`], `Dimension` for more nodes than
+    /// can be counted, `NonFinite` as [`PlaneField::new`] for the new nodes' masses. Ends a run.
+    ///
+    /// As on a line, the points crowd the cells' edges and the stability limit on `Δt` falls
+    /// about as `1/r²`. Cells of degree 2 and above are stepped on one thread. The measured
+    /// orders in space are in `docs/mathematics.md`.
+    ///
+    /// ```
+    /// use dirac_runtime::nalgebra::SVector;
+    /// use dirac_runtime::{Boundary, PlaneDensity, PlaneField, Scalar};
+    ///
+    /// struct Membrane;
+    /// impl PlaneDensity<1> for Membrane {
+    ///     fn inertia(&self, _at: [f64; 2]) -> SVector<f64, 1> {
+    ///         SVector::from([1.0])
+    ///     }
+    ///     fn potential<S: Scalar>(&self, _at: [f64; 2], _u: &SVector<S, 1>, ux: &SVector<S, 1>, uy: &SVector<S, 1>) -> S {
+    ///         (ux[0] * ux[0] + uy[0] * uy[0]) * 0.5
+    ///     }
+    /// }
+    /// // The square drum on 4 × 4 cells of degree 4: 17 × 17 nodes.
+    /// let fixed = [Boundary::Fixed; 2];
+    /// let mut drum = PlaneField::new(Membrane, [(0.0, 1.0), (0.0, 1.0)], [4, 4], fixed, 0.005)?
+    ///     .with_degree(4)?;
+    /// assert_eq!(drum.nodes(), [17, 17]);
+    /// let pi = std::f64::consts::PI;
+    /// let mode = |[x, y]: [f64; 2]| SVector::from([(pi * x).sin() * (pi * y).sin()]);
+    /// let u0: Vec<_> = drum.points().into_iter().map(mode).collect();
+    /// drum.start(&u0, &vec![SVector::zeros(); u0.len()])?;
+    /// let period = 2f64.sqrt(); // of the first mode, ω = √2 π
+    /// drum.run((period / 0.005).round() as u64)?;
+    /// let error = drum.u()?.iter().zip(&u0).map(|(u, u0)| (u - u0).amax()).fold(0.0, f64::max);
+    /// assert!(error < 1e-4, "{error}"); // the step's error in time
+    /// # Ok::<(), dirac_runtime::DiracError>(())
+    /// ```
+    pub fn with_degree(mut self, degree: usize) -> Result<Self, DiracError> {
+        let elements = Elements::new(degree)?;
+        self.nodes = node_counts(self.cells, self.boundary, degree)?;
+        self.elements = elements;
+        self.mass = self.masses()?;
+        self.run = None;
+        Ok(self)
+    }
+
+    /// The degree of the cells in space.
+    pub fn degree(&self) -> usize {
+        self.elements.degree()
+    }
+
+    /// The weight `w` of the nodes of index `i` along `axis`: `w_m Δx` at point `m` inside a
+    /// cell, twice `w_0 Δx` where two cells meet, `w_0 Δx` at a free edge, zero at a fixed one.
+    /// For the box cell: the cell width, half of it at a free edge.
+    fn weight(&self, axis: usize, i: usize) -> f64 {
+        let n = self.nodes[axis];
+        let (r, width) = (self.degree(), self.spacing[axis]);
+        let w = &self.elements.weights;
+        match (self.boundary[axis], i == 0 || i == n - 1, i % r) {
+            (Boundary::Fixed, true, _) => 0.0,
+            (Boundary::Free, true, _) => w[0] * width,
+            (_, _, 0) => 2.0 * w[0] * width,
+            (_, _, m) => w[m] * width,
+        }
     }
 
     /// The node masses `w_x w_y ρ`, checked.
     fn masses(&self) -> Result<Vec<SVector<f64, C>>, DiracError> {
-        let (wx, wy) = (self.weights(0), self.weights(1));
-        let nx = wx.len();
-        (0..nx * wy.len())
-            .map(|k| {
-                let at = self.position(k);
-                let rho = self.density.inertia(at);
-                if let Some(&bad) = rho.iter().find(|r| !(**r > 0.0 && r.is_finite())) {
-                    return Err(DiracError::NonFinite {
-                        what: format!("the inertia at {at:?} (it must be positive and finite)"),
-                        value: bad,
-                    });
-                }
-                let mass = rho * (wx[k % nx] * wy[k / nx]);
-                let fixed = wx[k % nx] == 0.0 || wy[k / nx] == 0.0;
-                match mass.iter().find(|m| !(fixed || **m > 0.0 && m.is_finite())) {
-                    Some(&bad) => Err(DiracError::NonFinite {
-                        what: format!(
-                            "the mass of node {k} (ρ w_x w_y must be positive and finite)"
-                        ),
-                        value: bad,
-                    }),
-                    None => Ok(mass),
-                }
-            })
-            .collect::<Result<Vec<_>, _>>()
-            // Collected without a size hint: hold no spare capacity.
-            .map(|mut mass| {
-                mass.shrink_to_fit();
-                mass
-            })
+        let [nx, ny] = self.nodes;
+        leapfrog::node_masses(nx * ny, |k| {
+            let at = self.position(k);
+            let rho = self.density.inertia(at);
+            if let Some(&bad) = rho.iter().find(|r| !(**r > 0.0 && r.is_finite())) {
+                return Err(DiracError::NonFinite {
+                    what: format!("the inertia at {at:?} (it must be positive and finite)"),
+                    value: bad,
+                });
+            }
+            let (wx, wy) = (self.weight(0, k % nx), self.weight(1, k / nx));
+            let mass = rho * (wx * wy);
+            let fixed = wx == 0.0 || wy == 0.0;
+            match mass.iter().find(|m| !(fixed || **m > 0.0 && m.is_finite())) {
+                Some(&bad) => Err(DiracError::NonFinite {
+                    what: format!("the mass of node {k} (ρ w_x w_y must be positive and finite)"),
+                    value: bad,
+                }),
+                None => Ok(mass),
+            }
+        })
     }
 
     /// The numbers of nodes `[n_x, n_y]`: along a periodic axis as many as cells, else one more.
@@ -286,10 +327,15 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
 
     /// The position `[x_i, y_j]` of node `(i, j)`.
     fn point(&self, i: usize, j: usize) -> [f64; 2] {
-        [
-            self.origin[0] + i as f64 * self.spacing[0],
-            self.origin[1] + j as f64 * self.spacing[1],
-        ]
+        [self.coordinate(0, i), self.coordinate(1, j)]
+    }
+
+    /// The coordinate along `axis` of the nodes of index `i` along it, point `m = i mod r` of
+    /// cell `e = i / r`: `a + (e + c_m) Δx`.
+    fn coordinate(&self, axis: usize, i: usize) -> f64 {
+        let r = self.degree();
+        let (e, m) = (i / r, i % r);
+        self.origin[axis] + (e as f64 + self.elements.points[m]) * self.spacing[axis]
     }
 
     /// The positions `[x, y]` of the nodes, row by row.
@@ -301,10 +347,7 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
     /// The positions `x_i` and `y_j` of the nodes along each axis.
     pub fn axes(&self) -> [Vec<f64>; 2] {
         let nodes = self.nodes();
-        [0, 1].map(|a| {
-            let at = |i: usize| self.origin[a] + i as f64 * self.spacing[a];
-            (0..nodes[a]).map(at).collect()
-        })
+        [0, 1].map(|a| (0..nodes[a]).map(|i| self.coordinate(a, i)).collect())
     }
 
     /// The neighbour of index `i` along `axis`, a step `+1` or `−1` away, where there is one.
@@ -328,7 +371,8 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         u: &[SVector<f64, C>],
         ut: &[SVector<f64, C>],
     ) -> Result<(), DiracError> {
-        let row = vec![[SVector::zeros(); 5]; self.nodes[0]];
+        // Cells of higher degree keep their scratch on the stack, cell by cell.
+        let row = vec![[SVector::zeros(); 5]; if self.degree() == 1 { self.nodes[0] } else { 0 }];
         let bands = if self.in_parallel() {
             self.bands().1
         } else {
@@ -549,8 +593,161 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
             }
             sum
         };
+        if self.degree() > 1 {
+            return Ok(kinetic + self.cells_potential(u));
+        }
         let potential: f64 = (0..u.len()).map(corners).sum();
         Ok(kinetic + 0.25 * dx * dy * potential)
+    }
+
+    /// The values of cell `(e_x, e_y)` at its points, `[n][m]` for point `(c_m, c_n)`, and the
+    /// slopes there, `u_x = Σ_l D_ml u_ln / Δx` and `u_y = Σ_l D_nl u_ml / Δy`.
+    fn cell_values(&self, [ex, ey]: [usize; 2], u: &[SVector<f64, C>]) -> CellValues<C> {
+        let (r, [nx, ny]) = (self.degree(), self.nodes);
+        let d = |q: usize, m: usize| self.elements.d(q, m);
+        let mut cell = CellValues {
+            u: [[SVector::zeros(); MOST_DEGREE + 1]; MOST_DEGREE + 1],
+            ux: [[SVector::zeros(); MOST_DEGREE + 1]; MOST_DEGREE + 1],
+            uy: [[SVector::zeros(); MOST_DEGREE + 1]; MOST_DEGREE + 1],
+        };
+        for n in 0..=r {
+            // The last cell's last points are the first nodes along a periodic axis.
+            let row = ((ey * r + n) % ny) * nx;
+            for m in 0..=r {
+                cell.u[n][m] = u[row + (ex * r + m) % nx];
+            }
+        }
+        let [dx, dy] = self.spacing;
+        for n in 0..=r {
+            for m in 0..=r {
+                let (mut ux, mut uy) = (SVector::zeros(), SVector::zeros());
+                for l in 0..=r {
+                    ux += cell.u[n][l] * d(m, l);
+                    uy += cell.u[l][m] * d(n, l);
+                }
+                cell.ux[n][m] = ux / dx;
+                cell.uy[n][m] = uy / dy;
+            }
+        }
+        cell
+    }
+
+    /// The position of point `(c_m, c_n)` of cell `(e_x, e_y)`.
+    fn cell_point(&self, [ex, ey]: [usize; 2], m: usize, n: usize) -> [f64; 2] {
+        let r = self.degree();
+        [
+            self.coordinate(0, ex * r + m),
+            self.coordinate(1, ey * r + n),
+        ]
+    }
+
+    /// `Φ(u) = ΔxΔy Σ_cells Σ_{m,n} w_m w_n U(x_mn, u_mn, u_x, u_y)` for cells of degree 2 and
+    /// above.
+    fn cells_potential(&self, u: &[SVector<f64, C>]) -> f64 {
+        let (r, w) = (self.degree(), &self.elements.weights);
+        let [dx, dy] = self.spacing;
+        let mut sum = 0.0;
+        for ey in 0..self.cells[1] {
+            for ex in 0..self.cells[0] {
+                let cell = self.cell_values([ex, ey], u);
+                for n in 0..=r {
+                    for m in 0..=r {
+                        let at = self.cell_point([ex, ey], m, n);
+                        let (v, ux, uy) = (&cell.u[n][m], &cell.ux[n][m], &cell.uy[n][m]);
+                        sum += w[m] * w[n] * self.density.potential(at, v, ux, uy);
+                    }
+                }
+            }
+        }
+        sum * dx * dy
+    }
+
+    /// Subtracts from `f` cell `(e_x, e_y)`'s share of `∂Φ/∂u` at each of its points `(a, b)`:
+    /// `ΔxΔy [w_a w_b ∂U/∂u + Σ_m w_m w_b ∂U/∂u_x(m, b) D_ma/Δx + Σ_n w_a w_n ∂U/∂u_y(a, n) D_nb/Δy]`.
+    fn cell_force(&self, at: [usize; 2], u: &[SVector<f64, C>], f: &mut [SVector<f64, C>]) {
+        let (r, w) = (self.degree(), &self.elements.weights);
+        let ([dx, dy], [nx, ny]) = (self.spacing, self.nodes);
+        let cell = self.cell_values(at, u);
+        // At each point: the weighted derivatives in the field and in the two slopes.
+        let mut own = [[SVector::<f64, C>::zeros(); MOST_DEGREE + 1]; MOST_DEGREE + 1];
+        let mut flux_x = own;
+        let mut flux_y = own;
+        for n in 0..=r {
+            for m in 0..=r {
+                let point = self.cell_point(at, m, n);
+                let (v, ux, uy) = (&cell.u[n][m], &cell.ux[n][m], &cell.uy[n][m]);
+                let (by_u, by_ux, by_uy) = self.potential_gradient(point, v, ux, uy);
+                let weight = w[m] * w[n];
+                own[n][m] = by_u * (weight * dx * dy);
+                flux_x[n][m] = by_ux * (weight * dy);
+                flux_y[n][m] = by_uy * (weight * dx);
+            }
+        }
+        let [ex, ey] = at;
+        for b in 0..=r {
+            let row = ((ey * r + b) % ny) * nx;
+            for a in 0..=r {
+                let mut share = own[b][a];
+                for l in 0..=r {
+                    share +=
+                        flux_x[b][l] * self.elements.d(l, a) + flux_y[l][a] * self.elements.d(l, b);
+                }
+                f[row + (ex * r + a) % nx] -= share;
+            }
+        }
+    }
+
+    /// `f = −∂Φ/∂u` by cells of degree 2 and above, one cell at a time, then `p += kick · f` at
+    /// every node that moves.
+    fn cells_force_and_kick(
+        &self,
+        u: &[SVector<f64, C>],
+        f: &mut [SVector<f64, C>],
+        p: &mut [SVector<f64, C>],
+        kick: f64,
+    ) {
+        f.fill(SVector::zeros());
+        for ey in 0..self.cells[1] {
+            for ex in 0..self.cells[0] {
+                self.cell_force([ex, ey], u, f);
+            }
+        }
+        for ((f, p), mass) in f.iter_mut().zip(p.iter_mut()).zip(&self.mass) {
+            if is_zero(mass) {
+                *f = SVector::zeros();
+            } else {
+                *p += *f * kick;
+            }
+        }
+    }
+}
+
+/// A cell's values at its points and the slopes there, `[n][m]` for point `(c_m, c_n)`.
+struct CellValues<const C: usize> {
+    u: [[SVector<f64, C>; MOST_DEGREE + 1]; MOST_DEGREE + 1],
+    ux: [[SVector<f64, C>; MOST_DEGREE + 1]; MOST_DEGREE + 1],
+    uy: [[SVector<f64, C>; MOST_DEGREE + 1]; MOST_DEGREE + 1],
+}
+
+/// The numbers of nodes `[n_x, n_y]` of `cells` of degree `r` held by `boundary`: `N r` along a
+/// periodic axis, else `N r + 1`; `Dimension` where they cannot be counted.
+fn node_counts(
+    cells: [usize; 2],
+    boundary: [Boundary; 2],
+    r: usize,
+) -> Result<[usize; 2], DiracError> {
+    let nodes = [0, 1].map(|axis| {
+        let points = cells[axis].checked_mul(r)?;
+        match boundary[axis] {
+            Boundary::Periodic => Some(points),
+            Boundary::Fixed | Boundary::Free => points.checked_add(1),
+        }
+    });
+    match nodes {
+        [Some(nx), Some(ny)] if nx.checked_mul(ny).is_some() => Ok([nx, ny]),
+        _ => Err(DiracError::Dimension(format!(
+            "{cells:?} cells of degree {r} make more nodes than can be counted"
+        ))),
     }
 }
 
@@ -562,7 +759,7 @@ impl<D: PlaneDensity<C>, const C: usize> Grid<C> for PlaneField<D, C> {
     }
 
     fn in_parallel(&self) -> bool {
-        self.parallel && self.bands().1 >= PARALLEL_BANDS
+        self.parallel && self.degree() == 1 && self.bands().1 >= PARALLEL_BANDS
     }
 
     /// A band of rows at a time (the whole field when not split across threads), row by row:
@@ -575,7 +772,9 @@ impl<D: PlaneDensity<C>, const C: usize> Grid<C> for PlaneField<D, C> {
         windows: &mut Self::Scratch,
         kick: f64,
     ) {
-        if self.in_parallel() {
+        if self.degree() > 1 {
+            self.cells_force_and_kick(u, f, p, kick);
+        } else if self.in_parallel() {
             let (rows, bands) = self.bands();
             if windows.len() < bands {
                 // Split across threads during a run: a window for every band, once.
