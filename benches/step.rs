@@ -1046,8 +1046,9 @@ impl HandLogH {
 }
 
 /// One step of the sine-Gordon field (Störmer–Verlet, Δx = 0.05, Δt = 0.02, periodic, started
-/// from `u = sin x`) by number of cells: `Field` one cell after another and in parallel, against
-/// a hand-written leapfrog of the same scheme (`scenes::field::leapfrog_sine_gordon`).
+/// from `u = sin x`) by number of cells: `Field` one cell after another and in parallel, and
+/// cells of degree 3 with as many nodes, against a hand-written leapfrog of the same scheme
+/// (`scenes::field::leapfrog_sine_gordon`).
 fn field(c: &mut Criterion) {
     use dirac::{Boundary, Field};
     use scenes::field::{SineGordon, leapfrog_sine_gordon, sine_gordon_force};
@@ -1070,6 +1071,22 @@ fn field(c: &mut Criterion) {
                 b.iter(|| black_box(field.step()).expect("step"))
             });
         }
+        if (10_000..=100_000).contains(&cells) {
+            // Cells of degree 3 with as many nodes (a third as many cells, three times as wide).
+            let mut field =
+                Field::new(SineGordon, (0.0, length), cells / 3, Boundary::Periodic, dt)
+                    .and_then(|field| field.with_degree(3))
+                    .expect("valid field");
+            let u: Vec<SVector<f64, 1>> = (field.positions().iter())
+                .map(|&x| SVector::from([x.sin()]))
+                .collect();
+            field
+                .start(&u, &vec![SVector::zeros(); u.len()])
+                .expect("finite start");
+            group.bench_with_input(BenchmarkId::new("degree_3", cells), &cells, |b, _| {
+                b.iter(|| black_box(field.step()).expect("step"))
+            });
+        }
         let (mut u, mut p, mut force) = (u0.clone(), vec![0.0; cells], vec![0.0; cells]);
         sine_gordon_force(&u, &mut force, dx);
         group.bench_with_input(BenchmarkId::new("hand_written", cells), &cells, |b, _| {
@@ -1084,7 +1101,8 @@ fn field(c: &mut Criterion) {
 
 /// One step of the membrane (Störmer–Verlet, square cells Δx = 0.01, Δt = 0.005, periodic,
 /// started from a standing wave) by number of nodes, 10⁴ to 10⁶: `PlaneField` row by row on one
-/// thread and, from 10⁵ nodes (several bands of rows), in parallel, against a hand-written
+/// thread and, from 10⁵ nodes (several bands of rows), in parallel, and cells of degree 3 (10⁴
+/// and 10⁵ nodes, at a fifth of the step, below their stability limit), against a hand-written
 /// five-point leapfrog of the same scheme (`scenes::membrane::leapfrog_membrane`).
 fn plane_field(c: &mut Criterion) {
     use dirac::{Boundary, PlaneField};
@@ -1113,6 +1131,25 @@ fn plane_field(c: &mut Criterion) {
                 .expect("finite start");
             let name = if parallel { "parallel" } else { "sequential" };
             group.bench_with_input(BenchmarkId::new(name, nodes), &nodes, |b, _| {
+                b.iter(|| black_box(drum.step()).expect("step"))
+            });
+        }
+        if side <= 316 {
+            // Cells of degree 3 with about as many nodes (3 × 3 points a cell), the step below
+            // their stability limit.
+            let periodic = [Boundary::Periodic; 2];
+            let cells = side / 3;
+            let mut drum =
+                PlaneField::new(DRUM, [(0.0, length); 2], [cells, cells], periodic, 0.2 * dt)
+                    .and_then(|drum| drum.with_degree(3))
+                    .expect("valid field");
+            let u: Vec<SVector<f64, 1>> = (drum.points().into_iter())
+                .map(|[x, y]| SVector::from([x.sin() * y.cos()]))
+                .collect();
+            drum.start(&u, &vec![SVector::zeros(); u.len()])
+                .expect("finite start");
+            let nodes = u.len();
+            group.bench_with_input(BenchmarkId::new("degree_3", nodes), &nodes, |b, _| {
                 b.iter(|| black_box(drum.step()).expect("step"))
             });
         }

@@ -20,7 +20,9 @@
 //! Laplacian, whose standing and travelling waves the step keeps with the leapfrog's discrete
 //! dispersion relation exactly. Being the flow of a discrete action on cells, the step keeps
 //! the discrete multisymplectic form formula; its order is 2 in space, and in time that of the
-//! [`Composition`].
+//! [`Composition`]. Cells of higher degree ([`PlaneField::with_degree`]: the field at the
+//! tensor-product Gauss–Lobatto points of each cell, the action by that rule) raise the order
+//! in space.
 //!
 //! ```
 //! use dirac_runtime::nalgebra::SVector;
