@@ -107,7 +107,8 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     /// `boundary`, stepped by Störmer–Verlet with step `dt`. Refused: `InvalidStep` for a `dt`
     /// that is not positive and finite, `Dimension` for fewer than 2 cells (3 when periodic),
     /// `InvalidRun` for an interval that is empty or not finite, or cells of a width that is not,
-    /// `NonFinite` for an inertia or a node's mass that is not positive and finite.
+    /// `NonFinite` for an inertia or a node's mass that is not positive and finite, `Dimension`
+    /// for more nodes than can be counted or held in memory.
     ///
     /// The step is explicit, so it is stable only below a limit on `dt` that depends on the
     /// density: about `Δx √(ρ/κ)` for a string of tension `κ` (the leapfrog's CFL condition),
@@ -234,7 +235,8 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     /// points, and its action is integrated by that rule (spectral elements with the mass
     /// lumped on the points, a variational discretisation). The nodes are the cells' points,
     /// `N · degree` of them when periodic, else one more. `Unsupported` for a degree outside
-    /// 1 to [`MOST_DEGREE`], `NonFinite` as [`Field::new`] for the new nodes' masses. Ends a
+    /// 1 to [`MOST_DEGREE`], `Dimension` for more nodes than can be counted or held,
+    /// `NonFinite` as [`Field::new`] for the new nodes' masses. Ends a
     /// run.
     ///
     /// The points crowd a cell's ends (the closest are 0.17 Δx apart at degree 4, 0.05 Δx at
@@ -318,8 +320,8 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
 
     /// The number of nodes: `N r` when periodic, else `N r + 1`, for cells of degree `r`.
     pub fn nodes(&self) -> usize {
-        // Counted when the cells and their degree were set.
-        node_count(self.cells, self.boundary, self.degree()).unwrap_or(usize::MAX)
+        node_count(self.cells, self.boundary, self.degree())
+            .expect("counted when the cells and their degree were set")
     }
 
     /// The number of cells `N`.
