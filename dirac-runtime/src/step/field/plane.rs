@@ -188,9 +188,9 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
     }
 
     /// Whether the passes of a step over the nodes are split across rayon's threads (by default
-    /// not), in bands of rows of about 16 384 nodes. The steps are the same bit for bit; a field
-    /// of fewer than 32 768 nodes (one band) is stepped on one thread all the same, and so are
-    /// cells of degree 2 and above ([`with_degree`](Self::with_degree)). `cargo bench --bench
+    /// not), in bands of rows of about 16 384 nodes (of cells, for cells of degree 2 and above:
+    /// [`with_degree`](Self::with_degree)). The steps are the same bit for bit; a field of fewer
+    /// than 32 768 nodes (one band) is stepped on one thread all the same. `cargo bench --bench
     /// step -- plane_field_step` measures the gain.
     pub fn with_parallel(mut self, parallel: bool) -> Self {
         self.parallel = parallel;
@@ -207,7 +207,7 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
     /// can be counted, `NonFinite` as [`PlaneField::new`] for the new nodes' masses. Ends a run.
     ///
     /// As on a line, the points crowd the cells' edges and the stability limit on `Δt` falls
-    /// about as `1/r²`. Cells of degree 2 and above are stepped on one thread. The measured
+    /// about as `1/r²`. The measured
     /// orders in space are in `docs/mathematics.md`.
     ///
     /// ```
@@ -667,8 +667,15 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
     }
 
     /// Subtracts from `f` cell `(e_x, e_y)`'s share of `∂Φ/∂u` at each of its points `(a, b)`:
-    /// `ΔxΔy [w_a w_b ∂U/∂u + Σ_m w_m w_b ∂U/∂u_x(m, b) D_ma/Δx + Σ_n w_a w_n ∂U/∂u_y(a, n) D_nb/Δy]`.
-    fn cell_force(&self, at: [usize; 2], u: &[SVector<f64, C>], f: &mut [SVector<f64, C>]) {
+    /// `ΔxΔy [w_a w_b ∂U/∂u + Σ_m w_m w_b ∂U/∂u_x(m, b) D_ma/Δx + Σ_n w_a w_n ∂U/∂u_y(a, n) D_nb/Δy]`,
+    /// where `f` holds the rows of nodes from `first_row` on (the shares to other rows are not
+    /// taken).
+    fn cell_force(
+        &self,
+        at: [usize; 2],
+        u: &[SVector<f64, C>],
+        (f, first_row): (&mut [SVector<f64, C>], usize),
+    ) {
         let (r, w) = (self.degree(), &self.elements.weights);
         let ([dx, dy], [nx, ny]) = (self.spacing, self.nodes);
         let cell = self.cell_values(at, u);
@@ -689,7 +696,13 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         }
         let [ex, ey] = at;
         for b in 0..=r {
-            let row = ((ey * r + b) % ny) * nx;
+            let Some(row) = ((ey * r + b) % ny)
+                .checked_sub(first_row)
+                .map(|row| row * nx)
+                .filter(|&start| start < f.len())
+            else {
+                continue;
+            };
             for a in 0..=r {
                 let mut share = own[b][a];
                 for l in 0..=r {
@@ -701,8 +714,19 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         }
     }
 
-    /// `f = −∂Φ/∂u` by cells of degree 2 and above, one cell at a time, then `p += kick · f` at
-    /// every node that moves.
+    /// The rows of cells in a band of the passes split across threads (the last band may hold
+    /// fewer), and the number of bands, for cells of degree 2 and above.
+    fn cell_bands(&self) -> (usize, usize) {
+        let ([nx, ny], rows_of_cells) = (self.nodes, self.cells[1]);
+        // As many bands as `BAND`s of nodes, of 4 rows of cells at least.
+        let bands = (nx * ny / BAND).clamp(1, rows_of_cells.div_ceil(4));
+        let rows = rows_of_cells.div_ceil(bands);
+        (rows, rows_of_cells.div_ceil(rows))
+    }
+
+    /// `f = −∂Φ/∂u` by cells of degree 2 and above, then `p += kick · f` at every node that
+    /// moves: the whole field, or, split across threads, a band of rows of cells to a thread,
+    /// each writing the rows of nodes from its first cells' lowest on.
     fn cells_force_and_kick(
         &self,
         u: &[SVector<f64, C>],
@@ -710,13 +734,45 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         p: &mut [SVector<f64, C>],
         kick: f64,
     ) {
+        if self.in_parallel() {
+            let (rows, _) = self.cell_bands();
+            let nodes = rows * self.degree() * self.nodes[0];
+            let bands = f.par_chunks_mut(nodes).zip(p.par_chunks_mut(nodes));
+            bands.enumerate().for_each(|(b, (f, p))| {
+                self.cells_band(b * rows, u, (f, p), kick);
+            });
+        } else {
+            self.cells_band(0, u, (f, p), kick);
+        }
+    }
+
+    /// [`cells_force_and_kick`](Self::cells_force_and_kick) on the rows of nodes of `f` and `p`,
+    /// from the lowest of row of cells `first` on. Each node gathers its cells' shares in the
+    /// order of a pass over all the cells, so the split steps equal the whole's bit for bit: the
+    /// row of cells below the band first, the band's own, then, where the band holds the first
+    /// row of a periodic field, the last row of cells, whose upper edge that row is.
+    fn cells_band(
+        &self,
+        first: usize,
+        u: &[SVector<f64, C>],
+        (f, p): (&mut [SVector<f64, C>], &mut [SVector<f64, C>]),
+        kick: f64,
+    ) {
+        let ([nx, _], [cells_x, cells_y], r) = (self.nodes, self.cells, self.degree());
+        let first_row = first * r;
         f.fill(SVector::zeros());
-        for ey in 0..self.cells[1] {
-            for ex in 0..self.cells[0] {
-                self.cell_force([ex, ey], u, f);
+        // The rows of cells whose points reach the band's rows of nodes.
+        let last = (first + f.len().div_ceil(r * nx)).min(cells_y);
+        let below = first.checked_sub(1);
+        let wrap = (first == 0 && self.boundary[1] == Boundary::Periodic && last < cells_y)
+            .then_some(cells_y - 1);
+        for ey in below.into_iter().chain(first..last).chain(wrap) {
+            for ex in 0..cells_x {
+                self.cell_force([ex, ey], u, (f, first_row));
             }
         }
-        for ((f, p), mass) in f.iter_mut().zip(p.iter_mut()).zip(&self.mass) {
+        let mass = &self.mass[first_row * nx..first_row * nx + f.len()];
+        for ((f, p), mass) in f.iter_mut().zip(p.iter_mut()).zip(mass) {
             if is_zero(mass) {
                 *f = SVector::zeros();
             } else {
@@ -757,7 +813,11 @@ impl<D: PlaneDensity<C>, const C: usize> Grid<C> for PlaneField<D, C> {
     }
 
     fn in_parallel(&self) -> bool {
-        self.parallel && self.degree() == 1 && self.bands().1 >= PARALLEL_BANDS
+        let bands = match self.degree() {
+            1 => self.bands().1,
+            _ => self.cell_bands().1,
+        };
+        self.parallel && bands >= PARALLEL_BANDS
     }
 
     /// A band of rows at a time (the whole field when not split across threads), row by row:
