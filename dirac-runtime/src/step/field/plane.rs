@@ -605,15 +605,10 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
     }
 
     /// The values of cell `(e_x, e_y)` at its points, `[n][m]` for point `(c_m, c_n)`, and the
-    /// slopes there, `u_x = Σ_l D_ml u_ln / Δx` and `u_y = Σ_l D_nl u_ml / Δy`.
-    fn cell_values(&self, [ex, ey]: [usize; 2], u: &[SVector<f64, C>]) -> CellValues<C> {
+    /// slopes there, `u_x = Σ_l D_ml u_ln / Δx` and `u_y = Σ_l D_nl u_ml / Δy`, into `cell`.
+    fn cell_values(&self, [ex, ey]: [usize; 2], u: &[SVector<f64, C>], cell: &mut CellScratch<C>) {
         let (r, [nx, ny]) = (self.degree(), self.nodes);
         let d = |q: usize, m: usize| self.elements.d(q, m);
-        let mut cell = CellValues {
-            u: [[SVector::zeros(); MOST_DEGREE + 1]; MOST_DEGREE + 1],
-            ux: [[SVector::zeros(); MOST_DEGREE + 1]; MOST_DEGREE + 1],
-            uy: [[SVector::zeros(); MOST_DEGREE + 1]; MOST_DEGREE + 1],
-        };
         for n in 0..=r {
             // The last cell's last points are the first nodes along a periodic axis.
             let row = ((ey * r + n) % ny) * nx;
@@ -633,7 +628,6 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
                 cell.uy[n][m] = uy / dy;
             }
         }
-        cell
     }
 
     /// The position of point `(c_m, c_n)` of cell `(e_x, e_y)`.
@@ -650,10 +644,10 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
     fn cells_potential(&self, u: &[SVector<f64, C>]) -> f64 {
         let (r, w) = (self.degree(), &self.elements.weights);
         let [dx, dy] = self.spacing;
-        let mut sum = 0.0;
+        let (mut sum, mut cell) = (0.0, CellScratch::new());
         for ey in 0..self.cells[1] {
             for ex in 0..self.cells[0] {
-                let cell = self.cell_values([ex, ey], u);
+                self.cell_values([ex, ey], u, &mut cell);
                 for n in 0..=r {
                     for m in 0..=r {
                         let at = self.cell_point([ex, ey], m, n);
@@ -675,18 +669,24 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         at: [usize; 2],
         u: &[SVector<f64, C>],
         (f, first_row): (&mut [SVector<f64, C>], usize),
+        cell: &mut CellScratch<C>,
     ) {
         let (r, w) = (self.degree(), &self.elements.weights);
         let ([dx, dy], [nx, ny]) = (self.spacing, self.nodes);
-        let cell = self.cell_values(at, u);
+        self.cell_values(at, u, cell);
         // At each point: the weighted derivatives in the field and in the two slopes.
-        let mut own = [[SVector::<f64, C>::zeros(); MOST_DEGREE + 1]; MOST_DEGREE + 1];
-        let mut flux_x = own;
-        let mut flux_y = own;
+        let CellScratch {
+            u: values,
+            ux: slope_x,
+            uy: slope_y,
+            own,
+            flux_x,
+            flux_y,
+        } = cell;
         for n in 0..=r {
             for m in 0..=r {
                 let point = self.cell_point(at, m, n);
-                let (v, ux, uy) = (&cell.u[n][m], &cell.ux[n][m], &cell.uy[n][m]);
+                let (v, ux, uy) = (&values[n][m], &slope_x[n][m], &slope_y[n][m]);
                 let (by_u, by_ux, by_uy) = self.potential_gradient(point, v, ux, uy);
                 let weight = w[m] * w[n];
                 own[n][m] = by_u * (weight * dx * dy);
@@ -761,6 +761,8 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         let ([nx, _], [cells_x, cells_y], r) = (self.nodes, self.cells, self.degree());
         let first_row = first * r;
         f.fill(SVector::zeros());
+        // Each cell overwrites the points it reads: set once a pass.
+        let mut cell = CellScratch::new();
         // The rows of cells whose points reach the band's rows of nodes.
         let last = (first + f.len().div_ceil(r * nx)).min(cells_y);
         let below = first.checked_sub(1);
@@ -768,7 +770,7 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
             .then_some(cells_y - 1);
         for ey in below.into_iter().chain(first..last).chain(wrap) {
             for ex in 0..cells_x {
-                self.cell_force([ex, ey], u, (f, first_row));
+                self.cell_force([ex, ey], u, (f, first_row), &mut cell);
             }
         }
         let mass = &self.mass[first_row * nx..first_row * nx + f.len()];
@@ -782,11 +784,35 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
     }
 }
 
-/// A cell's values at its points and the slopes there, `[n][m]` for point `(c_m, c_n)`.
-struct CellValues<const C: usize> {
-    u: [[SVector<f64, C>; MOST_DEGREE + 1]; MOST_DEGREE + 1],
-    ux: [[SVector<f64, C>; MOST_DEGREE + 1]; MOST_DEGREE + 1],
-    uy: [[SVector<f64, C>; MOST_DEGREE + 1]; MOST_DEGREE + 1],
+/// A cell's values at its points and the slopes there, `[n][m]` for point `(c_m, c_n)`, and the
+/// derivatives of its potential there: written by each cell over the last's, kept over a pass.
+struct CellScratch<const C: usize> {
+    u: PointValues<C>,
+    ux: PointValues<C>,
+    uy: PointValues<C>,
+    /// `ΔxΔy w_m w_n ∂U/∂u` at each point.
+    own: PointValues<C>,
+    /// `Δy w_m w_n ∂U/∂u_x` at each point.
+    flux_x: PointValues<C>,
+    /// `Δx w_m w_n ∂U/∂u_y` at each point.
+    flux_y: PointValues<C>,
+}
+
+/// A value at each point `(c_m, c_n)` of a cell, `[n][m]`, for any degree up to the last.
+type PointValues<const C: usize> = [[SVector<f64, C>; MOST_DEGREE + 1]; MOST_DEGREE + 1];
+
+impl<const C: usize> CellScratch<C> {
+    fn new() -> Self {
+        let zeros = [[SVector::zeros(); MOST_DEGREE + 1]; MOST_DEGREE + 1];
+        Self {
+            u: zeros,
+            ux: zeros,
+            uy: zeros,
+            own: zeros,
+            flux_x: zeros,
+            flux_y: zeros,
+        }
+    }
 }
 
 /// The numbers of nodes `[n_x, n_y]` of `cells` of degree `r` held by `boundary`: `N r` along a
