@@ -383,18 +383,26 @@ fn the_energy_error_stays_bounded() {
 
 /// Split across threads, the steps are the same bit for bit: 201 × 181 nodes with free and fixed
 /// edges, and 200 × 200 periodic nodes (the first band reading the last row below it, the last
-/// the first row above it); two bands of rows each. A run may be split across threads midway.
+/// the first row above it); two bands of rows each. Cells of degree 3 alike: 193 × 193 nodes with
+/// free and fixed edges (three bands, the last holding the top row of nodes alone) and 192 × 192
+/// periodic nodes (the first band gathering the last row of cells, above it across the edge). A
+/// run may be split across threads midway.
 #[test]
 fn parallel_and_sequential_membranes_step_alike() {
+    let (free_fixed, periodic) = ([Boundary::Free, Boundary::Fixed], [Boundary::Periodic; 2]);
     let cases = [
-        ([Boundary::Free, Boundary::Fixed], [200, 180]),
-        ([Boundary::Periodic; 2], [200, 200]),
+        (free_fixed, [200, 180], 1, 0.003),
+        (periodic, [200, 200], 1, 0.003),
+        (free_fixed, [64, 64], 3, 0.0005),
+        (periodic, [64, 64], 3, 0.0005),
     ];
-    for (edges, cells) in cases {
+    for (edges, cells, degree, dt) in cases {
         // On one thread, on several, and on one then several from the third step on.
         let runs = [(false, false), (true, true), (false, true)].map(|(first, then)| {
             let sides = [(0.0, 1.6), (0.0, 1.2)];
-            let mut drum = PlaneField::new(DRUM, sides, cells, edges, 0.003)
+            let mut drum = PlaneField::new(DRUM, sides, cells, edges, dt)
+                .unwrap()
+                .with_degree(degree)
                 .unwrap()
                 .with_parallel(first);
             let u0 = at(&drum, |x, y| {
@@ -407,8 +415,13 @@ fn parallel_and_sequential_membranes_step_alike() {
             drum
         });
         for run in &runs[1..] {
-            assert_eq!(runs[0].u().unwrap(), run.u().unwrap(), "{edges:?}");
+            assert_eq!(
+                runs[0].u().unwrap(),
+                run.u().unwrap(),
+                "{edges:?}, {degree}"
+            );
             assert_eq!(runs[0].momenta().unwrap(), run.momenta().unwrap());
+            assert_eq!(runs[0].force().unwrap(), run.force().unwrap());
             assert_eq!(runs[0].t(), run.t());
         }
     }
@@ -746,40 +759,4 @@ fn on_cells_of_higher_degree_momentum_is_kept_and_energy_bounded() {
     assert!(p0.abs() > 1.0 && drift < 1e-13, "{drift:e} of {p0}");
     assert!(first > 1e-9, "the band is round-off: {first:e}");
     assert!(last < 1.5 * first, "drift: {first:e} then {last:e}");
-}
-
-/// Cells of degree 3 split across threads step as on one thread, bit for bit: 193 × 193 nodes
-/// with free and fixed edges (three bands, the last holding the top row of nodes alone) and
-/// 192 × 192 periodic nodes (the first band gathering the last row of cells, above it across the
-/// edge); a run may be split midway.
-#[test]
-fn cells_of_higher_degree_step_alike_split_across_threads() {
-    let cases = [
-        ([Boundary::Free, Boundary::Fixed], [64, 64]),
-        ([Boundary::Periodic; 2], [64, 64]),
-    ];
-    for (edges, cells) in cases {
-        let runs = [(false, false), (true, true), (false, true)].map(|(first, then)| {
-            let sides = [(0.0, 1.6), (0.0, 1.2)];
-            let mut drum = PlaneField::new(DRUM, sides, cells, edges, 0.0005)
-                .unwrap()
-                .with_degree(3)
-                .unwrap()
-                .with_parallel(first);
-            let u0 = at(&drum, |x, y| {
-                (TAU * x / 1.6).cos() * (PI * y / 1.2).sin() + (x * y * (1.2 - y)).sin()
-            });
-            drum.start(&u0, &at(&drum, |_, _| 0.0)).unwrap();
-            drum.run(2).unwrap();
-            let mut drum = drum.with_parallel(then);
-            drum.run(2).unwrap();
-            drum
-        });
-        assert!(runs[0].u().unwrap().iter().any(|u| u[0] != 0.0));
-        for run in &runs[1..] {
-            assert_eq!(runs[0].u().unwrap(), run.u().unwrap(), "{edges:?}");
-            assert_eq!(runs[0].momenta().unwrap(), run.momenta().unwrap());
-            assert_eq!(runs[0].force().unwrap(), run.force().unwrap());
-        }
-    }
 }
