@@ -9,6 +9,7 @@
 //! `∂/∂u_m = w_m Δx ∂U/∂u(q = m) + Σ_q w_q ∂U/∂u_x(q) D_qm`, and the kinetic energy lumps onto the
 //! points, `w_m Δx ρ`. Degree 1 is the trapezoidal cell.
 
+use super::Boundary;
 use crate::base::error::DiracError;
 use crate::quadrature::{Quadrature, Rule, lagrange_derivative};
 
@@ -52,6 +53,20 @@ impl Elements {
     /// The degree `r`.
     pub fn degree(&self) -> usize {
         self.points.len() - 1
+    }
+
+    /// The weight of node `i` of the `n` along an axis of cells of width `width` held by
+    /// `boundary` (its share of the lumped kinetic energy): `w_m width` at point `m` inside a
+    /// cell, twice `w_0 width` where two cells meet, `w_0 width` at a free end, zero at a fixed
+    /// one. For the trapezoidal cell: the width, half of it at a free end.
+    pub fn node_weight(&self, boundary: Boundary, n: usize, i: usize, width: f64) -> f64 {
+        let w = &self.weights;
+        match (boundary, i == 0 || i == n - 1, i % self.degree()) {
+            (Boundary::Fixed, true, _) => 0.0,
+            (Boundary::Free, true, _) => w[0] * width,
+            (_, _, 0) => 2.0 * w[0] * width,
+            (_, _, m) => w[m] * width,
+        }
     }
 
     /// `D_qm`.

@@ -287,8 +287,6 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
     /// inside a cell, `2 w_0 Δx` where two cells meet, `w_0 Δx` at a free end.
     fn masses(&self) -> Result<Vec<SVector<f64, C>>, DiracError> {
         let nodes = self.nodes();
-        let r = self.degree();
-        let inside = |j: usize| self.elements.weights[j % r] * self.dx;
         leapfrog::node_masses(nodes, |j| {
             let x = self.position(j);
             let rho = self.density.inertia(x);
@@ -298,15 +296,15 @@ impl<D: SeparableDensity<C>, const C: usize> Field<D, C> {
                     value: bad,
                 });
             }
+            let weight = self.elements.node_weight(self.boundary, nodes, j, self.dx);
             let end = j == 0 || j == nodes - 1;
             let mass = match (self.boundary, end) {
-                (Boundary::Periodic, _) | (_, false) if j % r == 0 => rho * (2.0 * inside(j)),
-                (Boundary::Periodic, _) | (_, false) => rho * inside(j),
                 (Boundary::Fixed, true) => return Ok(SVector::zeros()),
                 (Boundary::Free, true) => {
                     let end_mass = self.end_masses[usize::from(j > 0)];
-                    (rho * inside(j)).add_scalar(end_mass)
+                    (rho * weight).add_scalar(end_mass)
                 }
+                _ => rho * weight,
             };
             match mass.iter().find(|m| !(**m > 0.0 && m.is_finite())) {
                 Some(&bad) => Err(DiracError::NonFinite {

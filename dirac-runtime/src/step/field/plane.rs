@@ -252,19 +252,10 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         self.elements.degree()
     }
 
-    /// The weight `w` of the nodes of index `i` along `axis`: `w_m Δx` at point `m` inside a
-    /// cell, twice `w_0 Δx` where two cells meet, `w_0 Δx` at a free edge, zero at a fixed one.
-    /// For the box cell: the cell width, half of it at a free edge.
+    /// The weight of the nodes of index `i` along `axis` ([`Elements::node_weight`]).
     fn weight(&self, axis: usize, i: usize) -> f64 {
-        let n = self.nodes[axis];
-        let (r, width) = (self.degree(), self.spacing[axis]);
-        let w = &self.elements.weights;
-        match (self.boundary[axis], i == 0 || i == n - 1, i % r) {
-            (Boundary::Fixed, true, _) => 0.0,
-            (Boundary::Free, true, _) => w[0] * width,
-            (_, _, 0) => 2.0 * w[0] * width,
-            (_, _, m) => w[m] * width,
-        }
+        let (n, width) = (self.nodes[axis], self.spacing[axis]);
+        (self.elements).node_weight(self.boundary[axis], n, i, width)
     }
 
     /// The node masses `w_x w_y ρ`, checked.
@@ -375,7 +366,7 @@ impl<D: PlaneDensity<C>, const C: usize> PlaneField<D, C> {
         u: &[SVector<f64, C>],
         ut: &[SVector<f64, C>],
     ) -> Result<(), DiracError> {
-        // Cells of higher degree keep their scratch on the stack, cell by cell.
+        // Cells of higher degree keep their scratch on the stack, one a pass.
         let row = vec![[SVector::zeros(); 5]; if self.degree() == 1 { self.nodes[0] } else { 0 }];
         let bands = if self.in_parallel() {
             self.bands().1
